@@ -1,0 +1,51 @@
+# Helpers shared by every component's CMakeLists.txt.
+
+# studio_test(NAME name SOURCES a.cc b.cc LIBS lib... [LABELS unit|integration|gl|dataset] [TIMEOUT s])
+# One gtest binary per call; tests are discovered individually so ctest reports each case.
+function(studio_test)
+  cmake_parse_arguments(T "" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  if(NOT T_LABELS)
+    set(T_LABELS unit)
+  endif()
+  if(NOT T_TIMEOUT)
+    set(T_TIMEOUT 120)
+  endif()
+  add_executable(${T_NAME} ${T_SOURCES})
+  target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${T_NAME} PRIVATE
+    STUDIO_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    STUDIO_SHARED_DATA="${STUDIO_SHARED_DATA}"
+    STUDIO_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  gtest_discover_tests(${T_NAME}
+    PROPERTIES LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT}
+    DISCOVERY_TIMEOUT 60)
+endfunction()
+
+# studio_bench(NAME name SOURCES a.cc LIBS lib...): a Google Benchmark binary, run by ./studio bench.
+function(studio_bench)
+  if(NOT STUDIO_BENCH)
+    return()
+  endif()
+  cmake_parse_arguments(B "" "NAME" "SOURCES;LIBS" ${ARGN})
+  add_executable(${B_NAME} ${B_SOURCES})
+  target_link_libraries(${B_NAME} PRIVATE ${B_LIBS} benchmark::benchmark)
+  target_compile_definitions(${B_NAME} PRIVATE
+    STUDIO_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    STUDIO_SHARED_DATA="${STUDIO_SHARED_DATA}"
+    STUDIO_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  set_property(GLOBAL APPEND PROPERTY STUDIO_BENCHMARKS ${B_NAME})
+endfunction()
+
+# studio_fuzz(NAME name SOURCES a.cc LIBS lib...): a libFuzzer target, built only with STUDIO_FUZZ (clang).
+function(studio_fuzz)
+  if(NOT STUDIO_FUZZ)
+    return()
+  endif()
+  cmake_parse_arguments(F "" "NAME" "SOURCES;LIBS" ${ARGN})
+  add_executable(${F_NAME} ${F_SOURCES})
+  target_compile_options(${F_NAME} PRIVATE -fsanitize=fuzzer,address,undefined)
+  target_link_options(${F_NAME} PRIVATE -fsanitize=fuzzer,address,undefined)
+  target_link_libraries(${F_NAME} PRIVATE ${F_LIBS})
+endfunction()
+
+include(GoogleTest)
