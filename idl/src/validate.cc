@@ -1,0 +1,255 @@
+// Validators for every topic type (wire/types.h): the trust boundary between the network and
+// the pure libraries. They check ids, enum ranges, sizes against header fields, finiteness,
+// and the ordering invariants of mask runs (core/run_mask.h) and hull intervals. AlphaMask
+// payloads in MASK_CODEC form are decoded with the mask codec (core/mask_codec.h), which rejects
+// anything that is not exactly a valid mask.
+
+#include <cmath>
+#include <cstring>
+
+#include "core/mask_codec.h"
+#include "wire/sample.h"
+#include "wire/types.h"
+
+namespace studio::wire {
+namespace {
+
+constexpr uint32_t kMaxSide = 16384;           // image / mask sides
+constexpr uint32_t kMaxGridSide = 4096;        // hull grid sides
+constexpr uint64_t kMaxGridColumns = 1u << 22;
+
+template <std::size_t N>
+bool id_ok(const char (&id)[N]) {
+  return id[0] != '\0' && std::memchr(id, 0, N) != nullptr;
+}
+template <std::size_t N>
+bool text_ok(const char (&s)[N]) {  // may be empty, must be terminated
+  return std::memchr(s, 0, N) != nullptr;
+}
+bool finite(std::span<const double> v) {
+  for (double x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+bool finite(std::span<const float> v) {
+  for (float x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+bool side_ok(uint32_t w, uint32_t h, uint32_t max = kMaxSide) {
+  return w >= 1 && h >= 1 && w <= max && h <= max;
+}
+// Pinhole K: finite, fx, fy > 0, last row 0 0 1.
+Verdict check_K(const double (&K)[9]) {
+  if (!finite(K)) return Reject::non_finite;
+  if (!(K[0] > 0 && K[4] > 0) || K[6] != 0 || K[7] != 0 || K[8] != 1) return Reject::out_of_range;
+  return std::nullopt;
+}
+// R: finite and orthonormal with det +1 (to 1e-6 per entry of R Rᵀ − I).
+Verdict check_R(const double (&R)[9]) {
+  if (!finite(R)) return Reject::non_finite;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double d = 0;
+      for (int k = 0; k < 3; ++k) d += R[3 * i + k] * R[3 * j + k];
+      if (std::abs(d - (i == j ? 1.0 : 0.0)) > 1e-6) return Reject::out_of_range;
+    }
+  const double det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) +
+                     R[2] * (R[3] * R[7] - R[4] * R[6]);
+  if (det < 0) return Reject::out_of_range;
+  return std::nullopt;
+}
+
+Verdict check_mask_runs(const studio_AlphaMask& s) {
+  auto row_start = view(s.row_start);
+  auto runs = view(s.runs);
+  if (!view(s.data).empty()) return Reject::bad_size;
+  if (row_start.size() != uint64_t(s.height) + 1 || runs.size() % 2 != 0) return Reject::bad_size;
+  if (row_start.front() != 0 || uint64_t(row_start.back()) * 2 != runs.size()) return Reject::bad_size;
+  uint64_t area = 0;
+  for (uint32_t y = 0; y < s.height; ++y) {
+    const uint32_t a = row_start[y], b = row_start[y + 1];
+    if (b < a) return Reject::bad_runs;
+    int64_t prev_end = -1;
+    for (uint32_t r = a; r < b; ++r) {
+      const uint32_t begin = runs[2 * r], end = runs[2 * r + 1];
+      // RunMask invariant: begin < end <= width, runs sorted and not touching.
+      if (begin >= end || end > s.width || int64_t(begin) <= prev_end) return Reject::bad_runs;
+      prev_end = end;
+      area += end - begin;
+    }
+  }
+  if (area > uint64_t(s.width) * s.height) return Reject::bad_runs;  // implied; kept explicit
+  return std::nullopt;
+}
+
+Verdict check_mask_codec(const studio_AlphaMask& s) {
+  if (!view(s.row_start).empty() || !view(s.runs).empty()) return Reject::bad_size;
+  auto bytes = view(s.data);
+  auto header = decode_mask_header(bytes);
+  if (!header) return Reject::bad_runs;
+  if (uint32_t(header->width) != s.width || uint32_t(header->height) != s.height)
+    return Reject::bad_size;
+  RunMask mask;
+  if (!decode_mask(bytes, mask)) return Reject::bad_runs;
+  return std::nullopt;
+}
+
+}  // namespace
+
+Verdict validate(const studio_CameraCalibration& s) {
+  if (!id_ok(s.camera_id)) return Reject::bad_id;
+  if (!side_ok(s.width, s.height)) return Reject::bad_size;
+  if (auto v = check_K(s.K)) return v;
+  if (!std::isfinite(s.rd3) || !std::isfinite(s.rd5) || !finite(s.t)) return Reject::non_finite;
+  return check_R(s.R);
+}
+
+Verdict validate(const studio_AlphaMask& s) {
+  if (!id_ok(s.camera_id)) return Reject::bad_id;
+  if (!side_ok(s.width, s.height)) return Reject::bad_size;
+  switch (s.encoding) {
+    case studio_MASK_RUNS: return check_mask_runs(s);
+    case studio_MASK_CODEC: return check_mask_codec(s);
+  }
+  return Reject::out_of_range;
+}
+
+Verdict validate(const studio_CameraImage& s) {
+  if (!id_ok(s.camera_id)) return Reject::bad_id;
+  if (!side_ok(s.width, s.height)) return Reject::bad_size;
+  const uint64_t n = view(s.data).size(), pixels = uint64_t(s.width) * s.height;
+  switch (s.format) {
+    case studio_IMAGE_RGB8: return n == 3 * pixels ? Verdict{} : Reject::bad_size;
+    case studio_IMAGE_MONO8: return n == pixels ? Verdict{} : Reject::bad_size;
+    case studio_IMAGE_JPEG: {
+      auto d = view(s.data);
+      if (n < 4 || n > 3 * pixels + 65536) return Reject::bad_size;
+      if (d[0] != 0xFF || d[1] != 0xD8) return Reject::out_of_range;  // SOI marker
+      return std::nullopt;
+    }
+  }
+  return Reject::out_of_range;
+}
+
+Verdict validate(const studio_CameraState& s) {
+  if (!id_ok(s.camera_id)) return Reject::bad_id;
+  if (!text_ok(s.take) || !text_ok(s.error)) return Reject::bad_id;
+  for (const auto& f : view(s.features)) {
+    if (!id_ok(f.name)) return Reject::bad_id;
+    if (!std::isfinite(f.value) || !std::isfinite(f.min) || !std::isfinite(f.max))
+      return Reject::non_finite;
+    if (f.min > f.max) return Reject::out_of_range;
+  }
+  if (!std::isfinite(s.fps)) return Reject::non_finite;
+  if (s.fps < 0 || uint32_t(s.state) > studio_CAMERA_ERROR) return Reject::out_of_range;
+  return std::nullopt;
+}
+
+Verdict validate(const studio_CameraControl& s) {
+  if (!id_ok(s.camera_id) || !id_ok(s.feature)) return Reject::bad_id;
+  if (!std::isfinite(s.value)) return Reject::non_finite;
+  return std::nullopt;
+}
+
+Verdict validate(const studio_CaptureCommand& s) {
+  if (!id_ok(s.take)) return Reject::bad_id;
+  if (uint32_t(s.action) > studio_CAPTURE_STOP) return Reject::out_of_range;
+  return std::nullopt;
+}
+
+Verdict validate(const studio_SegmentSet& s) {
+  if (!id_ok(s.actor_id)) return Reject::bad_id;
+  if (!side_ok(s.nu, s.nv, kMaxGridSide) || uint64_t(s.nu) * s.nv > kMaxGridColumns)
+    return Reject::bad_size;
+  if (!finite(s.box_min) || !finite(s.box_max)) return Reject::non_finite;
+  for (int i = 0; i < 3; ++i)
+    if (!(s.box_min[i] < s.box_max[i])) return Reject::out_of_range;
+  if (s.axis > 2) return Reject::out_of_range;
+  auto start = view(s.interval_start);
+  auto iv = view(s.intervals);
+  const uint64_t columns = uint64_t(s.nu) * s.nv;
+  if (start.size() != columns + 1 || iv.size() % 2 != 0) return Reject::bad_size;
+  if (start.front() != 0 || uint64_t(start.back()) * 2 != iv.size()) return Reject::bad_size;
+  if (!finite(iv)) return Reject::non_finite;
+  const float lo = s.box_min[s.axis], hi = s.box_max[s.axis];
+  for (uint64_t c = 0; c < columns; ++c) {
+    if (start[c + 1] < start[c]) return Reject::bad_runs;
+    float prev_end = lo;
+    for (uint32_t k = start[c]; k < start[c + 1]; ++k) {
+      const float b = iv[2 * k], e = iv[2 * k + 1];
+      if (b > e || b < prev_end || e > hi) return Reject::bad_runs;
+      prev_end = e;
+    }
+  }
+  return std::nullopt;
+}
+
+Verdict validate(const studio_ActorMesh& s) {
+  if (!id_ok(s.actor_id)) return Reject::bad_id;
+  auto v = view(s.vertices), n = view(s.normals);
+  auto t = view(s.triangles);
+  if (v.size() % 3 != 0 || t.size() % 3 != 0) return Reject::bad_size;
+  if (!n.empty() && n.size() != v.size()) return Reject::bad_size;
+  if (!finite(v) || !finite(n)) return Reject::non_finite;
+  const uint64_t nv = v.size() / 3;
+  for (uint32_t i : t)
+    if (i >= nv) return Reject::out_of_range;
+  return std::nullopt;
+}
+
+Verdict validate(const studio_HeadPose& s) {
+  if (!id_ok(s.actor_id)) return Reject::bad_id;
+  if (!finite(s.position) || !finite(s.velocity) || !std::isfinite(s.confidence))
+    return Reject::non_finite;
+  if (s.confidence < 0 || s.confidence > 1) return Reject::out_of_range;
+  return std::nullopt;
+}
+
+Verdict validate(const studio_SceneNode& s) {
+  if (!id_ok(s.node_id)) return Reject::bad_id;
+  if (!text_ok(s.parent) || !text_ok(s.asset) || !text_ok(s.material)) return Reject::bad_id;
+  if (std::strcmp(s.parent, s.node_id) == 0) return Reject::out_of_range;
+  if (!finite(s.parent_from_node)) return Reject::non_finite;
+  const double* m = s.parent_from_node;
+  if (m[12] != 0 || m[13] != 0 || m[14] != 0 || m[15] != 1) return Reject::out_of_range;
+  return std::nullopt;
+}
+
+Verdict validate(const studio_SceneCommand& s) {
+  if (!text_ok(s.target) || !text_ok(s.path)) return Reject::bad_id;
+  if (!std::isfinite(s.value) || !finite(s.transform)) return Reject::non_finite;
+  switch (s.verb) {
+    case studio_SCENE_LOAD_SET: return s.path[0] ? Verdict{} : Reject::bad_id;
+    case studio_SCENE_MOVE_NODE:
+    case studio_SCENE_REMOVE_NODE: return s.target[0] ? Verdict{} : Reject::bad_id;
+    case studio_SCENE_SPEED: return s.value >= 0 ? Verdict{} : Reject::out_of_range;
+    case studio_SCENE_PLAY:
+    case studio_SCENE_PAUSE:
+    case studio_SCENE_SEEK: return std::nullopt;
+  }
+  return Reject::out_of_range;
+}
+
+Verdict validate(const studio_ProjectorCalibration& s) {
+  if (!id_ok(s.projector_id)) return Reject::bad_id;
+  if (!side_ok(s.width, s.height)) return Reject::bad_size;
+  if (auto v = check_K(s.K)) return v;
+  if (!finite(s.t) || !finite(s.screen_corners) || !finite(s.homography)) return Reject::non_finite;
+  return check_R(s.R);
+}
+
+Verdict validate(const studio_ServiceStatus& s) {
+  if (!id_ok(s.service) || !id_ok(s.instance) || !text_ok(s.host)) return Reject::bad_id;
+  if (uint32_t(s.state) > studio_SERVICE_FAILED) return Reject::out_of_range;
+  if (!std::isfinite(s.input_hz) || !std::isfinite(s.output_hz) || !std::isfinite(s.latency_ms))
+    return Reject::non_finite;
+  if (s.input_hz < 0 || s.output_hz < 0 || s.latency_ms < 0) return Reject::out_of_range;
+  for (const auto& c : view(s.counters)) {
+    if (!id_ok(c.name)) return Reject::bad_id;
+    if (!std::isfinite(c.value)) return Reject::non_finite;
+  }
+  return std::nullopt;
+}
+
+}  // namespace studio::wire

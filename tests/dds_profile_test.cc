@@ -1,0 +1,99 @@
+// The DDS profiles of deploy/dds: the production profile parses and carries masks through its
+// own multicast group (network partition) between two processes; both profiles are exercised on
+// the loopback interface only (the production interface line is swapped for lo).
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "harness/fixture.h"
+#include "harness/wire_samples.h"
+#include "wire/endpoint.h"
+
+namespace studio::testing {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void replace(std::string& s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  ASSERT_NE(at, std::string::npos) << "profile no longer contains: " << from;
+  s.replace(at, from.size(), to);
+}
+
+class DdsProfileTest : public ProcessTest {};
+
+TEST_F(DdsProfileTest, StudioProfileRoutesMasksThroughTheirPartitionBetweenProcesses) {
+  // studio.xml, moved onto lo and isolated by this test's discovery tag; the trace shows the
+  // configuration Cyclone actually applied.
+  std::string xml = slurp(std::filesystem::path(STUDIO_SOURCE_DIR) / "deploy/dds/studio.xml");
+  replace(xml, R"(<NetworkInterface autodetermine="true" multicast="default"/>)",
+          R"(<NetworkInterface name="lo" multicast="true"/>)");
+  replace(xml, "<Discovery>", "<Discovery><Tag>" + dds_.tag + "</Tag>");
+  replace(xml, "</Domain>",
+          "<Tracing><Verbosity>config</Verbosity><OutputFile>${STUDIO_TRACE}</OutputFile></Tracing></Domain>");
+  const auto profile = dir_ / "studio-on-lo.xml";
+  std::ofstream(profile) << xml;
+  const auto trace = dir_ / "peer.trace";
+
+  Process peer = Process::start({.name = "peer", .binary = built_binary("tests/wire_peer"),
+                                 .args = {"echo"},
+                                 .env = {{"CYCLONEDDS_URI", "file://" + profile.string()},
+                                         {"STUDIO_DDS_DOMAIN", std::to_string(dds_.domain_id)},
+                                         {"STUDIO_TRACE", trace.string()}},
+                                 .dir = dir_}).value();
+  ASSERT_TRUE(peer.wait_ready(15s)) << peer.log();
+  const std::string applied = slurp(trace);
+  EXPECT_NE(applied.find("239.255.42.1"), std::string::npos) << "mask partition not configured";
+  EXPECT_NE(applied.find("*.studio/camera/mask"), std::string::npos);
+
+  setenv("STUDIO_TRACE", (dir_ / "test.trace").c_str(), 1);
+  auto p = wire::Participant::create(dds_.domain_id, "file://" + profile.string()).value();
+  auto out_topic = wire::Topic<studio_AlphaMask>::create(p).value();
+  auto in_topic = wire::Topic<studio_AlphaMask>::create(p, "studio/camera/mask/echo").value();
+  auto writer = wire::Writer<studio_AlphaMask>::create(p, out_topic).value();
+  auto reader = wire::Reader<studio_AlphaMask>::create(p, in_topic).value();
+  ASSERT_TRUE(writer.wait_for_readers(1, 10s));
+  auto mask = make<studio_AlphaMask>(2);
+  bool echoed = false;
+  const auto deadline = Clock::now() + 10s;
+  while (!echoed && Clock::now() < deadline) {
+    ASSERT_TRUE(writer.write(*mask).has_value());
+    std::this_thread::sleep_for(20ms);
+    for (auto& r : reader.take()) echoed |= r.meta.valid_data && same(*r.data, *mask);
+  }
+  EXPECT_TRUE(echoed);
+  // The writer's locators: the mask topic goes to the partition's multicast group.
+  const std::string ours = slurp(dir_ / "test.trace");
+  EXPECT_NE(ours.find("239.255.42.1"), std::string::npos);
+  EXPECT_EQ(peer.stop(), 0);
+}
+
+TEST_F(DdsProfileTest, LoopbackProfileSelectsOnlyLoWithMulticast) {
+  const auto trace = dir_ / "peer.trace";
+  Env env = dds_.env();
+  env[0].second += ",<Tracing><Verbosity>config</Verbosity><OutputFile>" + trace.string() +
+                   "</OutputFile></Tracing>";
+  Process peer = Process::start({.name = "peer", .binary = built_binary("tests/wire_peer"),
+                                 .args = {"bench-echo"}, .env = env, .dir = dir_}).value();
+  ASSERT_TRUE(peer.wait_ready(15s)) << peer.log();
+  const std::string applied = slurp(trace);
+  EXPECT_NE(applied.find("selected interfaces: lo "), std::string::npos) << applied.substr(0, 2000);
+  EXPECT_EQ(applied.find("eth0 (index"), std::string::npos);
+  EXPECT_NE(applied.find("Tag/#text: " + dds_.tag), std::string::npos);
+  EXPECT_NE(applied.find("NetworkInterface[@multicast]: true"), std::string::npos);
+  EXPECT_EQ(peer.stop(), 0);
+}
+
+}  // namespace
+}  // namespace studio::testing
