@@ -1,0 +1,16 @@
+#pragma once
+// Image files for the CLI (OpenCV; never in the keyer library).
+
+#include <string>
+
+#include "core/error.h"
+#include "core/image.h"
+
+namespace studio::keyer {
+
+// PNG/JPEG/... as 8-bit RGB (grey and 16-bit images are converted). One-line error when the
+// file is missing or cannot be decoded.
+Expected<Image<Rgb8>> read_rgb(const std::string& path);
+Expected<void> write_mask_png(const std::string& path, const Mask& mask);
+
+}  // namespace studio::keyer

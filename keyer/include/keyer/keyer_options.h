@@ -1,0 +1,65 @@
+#pragma once
+// Options of the keyer (keyer/keyer.h). Every field is a key of keyer.yaml (see
+// keyer/keyer.example.yaml, which documents them; keyer/cli/keyer_yaml.cc reads it).
+//
+// Colour-difference key (Vlahos style), for a blue (default) or green backing:
+//   excess  = K - max(O1, O2)           K = key channel (B or G), O1, O2 = the other two, in 0..255
+//   backing = gain * excess
+//   alpha   = 1 - clamp((backing - clip_black) / (clip_white - clip_black), 0, 1)
+// so backing <= clip_black is solid actor (alpha 1) and backing >= clip_white is clean backing
+// (alpha 0). The binary mask holds the pixels with alpha >= matte_threshold.
+// Difference key against a clean plate P (the paper's alternative to the chroma key):
+//   diff  = max over channels |I - P|
+//   alpha = clamp((diff - diff_low) / (diff_high - diff_low), 0, 1)
+// Clean-up runs on the binary mask's runs, at a cost linear in the number of runs: foreground
+// components (8-connected) smaller than min_component_area pixels are removed, then background
+// components (4-connected) that do not touch the image border and are at most max_hole_area
+// pixels are filled.
+
+#include <string>
+#include <string_view>
+
+#include "core/error.h"
+
+namespace studio::keyer {
+
+enum class KeyMode { kBlue, kGreen, kDifference };
+
+std::string_view key_mode_name(KeyMode mode);
+Expected<KeyMode> parse_key_mode(std::string_view name);  // "blue" | "green" | "difference"
+
+struct CleanupOptions {
+  int min_component_area = 64;  // pixels; 0 keeps every component
+  int max_hole_area = 400;      // pixels; 0 fills nothing
+};
+
+struct KeyerOptions {
+  KeyMode mode = KeyMode::kBlue;
+  // Chroma key.
+  float gain = 1.0f;
+  float clip_black = 20.0f;   // backing level at and below which alpha = 1
+  float clip_white = 60.0f;   // backing level at and above which alpha = 0
+  // Difference key.
+  float diff_low = 12.0f;     // difference at and below which alpha = 0
+  float diff_high = 36.0f;    // difference at and above which alpha = 1
+  // Binary mask = alpha >= matte_threshold, in (0, 1].
+  float matte_threshold = 0.5f;
+  CleanupOptions cleanup;
+  // Spill suppression for the preview image: K' = K - spill_strength * max(0, K - max(O1, O2)).
+  float spill_strength = 1.0f;  // 0 = off, 1 = full (key channel limited to the larger other)
+
+  // One line naming the first bad field.
+  Expected<void> validate() const;
+};
+
+// The formulas above, shared by the fast keyer (which tabulates them) and the reference keyer.
+inline float chroma_alpha(float excess, const KeyerOptions& o) {
+  const float t = (o.gain * excess - o.clip_black) / (o.clip_white - o.clip_black);
+  return 1.0f - (t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t);
+}
+inline float difference_alpha(float diff, const KeyerOptions& o) {
+  const float t = (diff - o.diff_low) / (o.diff_high - o.diff_low);
+  return t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+}
+
+}  // namespace studio::keyer
