@@ -19,6 +19,15 @@ double OccupancyGrid::occupied_volume() const {
   return double(sum) / kFull * voxel_volume();
 }
 
+void OccupancyGrid::reset(const Eigen::Vector3d& origin, const Eigen::Vector3d& voxel,
+                          const Eigen::Vector3i& dims) {
+  assert((dims.array() >= 0).all() && (voxel.array() > 0).all());
+  origin_ = origin;
+  voxel_ = voxel;
+  dims_ = dims;
+  data_.assign(std::size_t(dims.x()) * std::size_t(dims.y()) * std::size_t(dims.z()), 0);
+}
+
 void OccupancyGrid::clear() { std::fill(data_.begin(), data_.end(), uint8_t{0}); }
 
 OccupancyGrid OccupancyGrid::cropped_to_occupied() const {

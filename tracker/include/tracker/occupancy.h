@@ -48,6 +48,7 @@ class OccupancyGrid {
     return {data_.data() + index(x, 0, z), size_t(dims_.y())};
   }
   std::span<const uint8_t> data() const { return data_; }
+  std::span<uint8_t> data() { return data_; }
 
   // Studio-frame point at continuous voxel coordinates (voxel (i,j,k) spans [i, i+1) etc.).
   Eigen::Vector3d point(const Eigen::Vector3d& voxel_coords) const {
@@ -61,6 +62,9 @@ class OccupancyGrid {
   double occupied_volume() const;
 
   void clear();
+  // Re-shapes to new geometry with every voxel empty, reusing the storage.
+  void reset(const Eigen::Vector3d& origin, const Eigen::Vector3d& voxel,
+             const Eigen::Vector3i& dims);
   // Smallest sub-grid (same lattice) holding every occupied voxel; an empty grid if none.
   OccupancyGrid cropped_to_occupied() const;
 
