@@ -1,0 +1,82 @@
+#pragma once
+// The silhouette cut (TCSVT 2004 §IV-B, Fig. 9): every line segment is projected into a camera
+// image, intersected with the silhouette and the surviving pieces are re-projected onto the line.
+//
+// Geometry. A line x(t) = o + t d projects (distortion-free part, P = K [R | t]) to the
+// homogeneous image point A + t B with A = P (o, 1), B = P (d, 0). Image intersections map back
+// to t exactly by line-line intersection: v(t) = y  <=>  t = (y A2 - A1) / (B1 - y B2).
+// The silhouette is the RunMask: pixel (x, y) covers [x-0.5, x+0.5) x [y-0.5, y+0.5).
+//
+// Two paths give the same hull to within half a pixel:
+// - Pencil (fast, used when the camera has no lens distortion and every line of the set passes
+//   through one common point X whose image V is outside the image with all pencil lines steeper
+//   than 45° — the studio case: vertical columns, X at infinity along y, V the vanishing point):
+//   the image-based visual hull idea. Once per mask, the lines through V are binned by where
+//   they cross a reference row (bins of half a pixel) and the runs are swept row by row into,
+//   per bin, the v-ranges where the bin's centre line is inside the silhouette; the sweep only
+//   touches bins where the silhouette boundary changes, so it costs the boundary length, not the
+//   area. Cutting one line then costs its bin's run count plus its interval count.
+// - Row walker (exact for pixel squares, general): walks the rows crossed by each surviving
+//   interval and intersects with that row's runs (binary search). Lens distortion: the line's
+//   observed image curve is cut into chords of <= 8 px, each walked as a straight piece.
+// Parts of a line outside an image (or behind the camera) are kept or cut by Options::outside.
+
+#include <Eigen/Core>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/run_mask.h"
+#include "hull/segment_set.h"
+
+namespace studio::hull {
+
+enum class Outside { keep, cut };
+
+struct CutOptions {
+  Outside outside = Outside::keep;  // a line part that leaves an image: keep it or cut it
+  int threads = 1;                  // columns are independent; 1..64
+  bool allow_pencil = true;         // false forces the exact row walker (tests compare both)
+  Expected<void> validate() const;
+};
+
+// A camera and its silhouette, prepared for cutting a family of lines through a common
+// homogeneous point `pencil_point` (for grid columns: (e_axis, 0); for rays of a viewpoint:
+// (centre, 1)). Preparing costs the mask's boundary length; cutting is thread-safe.
+class PreparedView {
+ public:
+  // Fails when the mask size differs from the camera's.
+  static Expected<PreparedView> create(const Camera& camera, const RunMask& mask,
+                                       const Eigen::Vector4d& pencil_point, const CutOptions& options);
+  PreparedView(PreparedView&&) noexcept;
+  PreparedView& operator=(PreparedView&&) noexcept;
+  ~PreparedView();
+
+  bool uses_pencil() const;
+  // Cuts the sorted intervals `in` of the line o + t d; appends the surviving intervals (sorted,
+  // disjoint) to *out. `scratch` is reused between calls.
+  void cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d, std::span<const Interval> in,
+                std::vector<Interval>* out) const;
+
+ private:
+  PreparedView();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+struct View {
+  const Camera* camera;
+  const RunMask* mask;
+};
+
+// Cuts the segment set by every view's silhouette (the visual hull is the intersection).
+// Fails, leaving `set` untouched, on a mask whose size differs from its camera.
+Expected<void> cut(SegmentSet& set, std::span<const View> views, const CutOptions& options = {});
+
+// The hull from scratch: SegmentSet::full(grid) cut by every view.
+Expected<SegmentSet> visual_hull(const GridSpec& grid, std::span<const View> views,
+                                 const CutOptions& options = {});
+
+}  // namespace studio::hull

@@ -1,0 +1,479 @@
+#include "hull/silhouette_cut.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <thread>
+
+namespace studio::hull {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+struct Range {
+  double lo, hi;
+};
+
+// Restricts [lo, hi] to the t where alpha + t beta >= 0.
+inline void clip_halfline(double alpha, double beta, double& lo, double& hi) {
+  if (beta > 0) {
+    lo = std::max(lo, -alpha / beta);
+  } else if (beta < 0) {
+    hi = std::min(hi, -alpha / beta);
+  } else if (alpha < 0) {
+    lo = 1, hi = 0;
+  }
+}
+
+struct Rect {
+  double u0, u1, v0, v1;
+};
+
+// The t-range of [lo, hi] where the homogeneous image point A + t B is in front of the camera
+// (w > 0) and inside the rectangle. Empty when lo >= hi.
+inline Range in_rect(const Vec3& A, const Vec3& B, const Rect& r, double lo, double hi) {
+  clip_halfline(A[2] - 1e-12, B[2], lo, hi);
+  clip_halfline(A[0] - r.u0 * A[2], B[0] - r.u0 * B[2], lo, hi);
+  clip_halfline(r.u1 * A[2] - A[0], r.u1 * B[2] - B[0], lo, hi);
+  clip_halfline(A[1] - r.v0 * A[2], B[1] - r.v0 * B[2], lo, hi);
+  clip_halfline(r.v1 * A[2] - A[1], r.v1 * B[2] - B[1], lo, hi);
+  return {lo, hi};
+}
+
+// Pieces of [ta, tb] where the straight image piece A + t B (homogeneous, w > 0, inside the
+// image) lies on a foreground pixel square. Walks the rows it crosses; appends to *out. Every
+// image constraint is a half-line in t (u >= a  <=>  (A0 - a A2) + t (B0 - a B2) >= 0 while
+// w > 0), which stays exact where the projective map t -> image wraps through infinity.
+void walk_rows(const Vec3& A, const Vec3& B, double ta, double tb, const RunMask& m,
+               std::vector<Range>* out) {
+  const auto U = [&](double t) { return (A[0] + t * B[0]) / (A[2] + t * B[2]); };
+  const auto V = [&](double t) { return (A[1] + t * B[1]) / (A[2] + t * B[2]); };
+  const double va = V(ta), vb = V(tb);
+  const int H = m.height();
+  const int y0 = std::clamp(int(std::floor(std::min(va, vb) + 0.5)), 0, H - 1);
+  const int y1 = std::clamp(int(std::floor(std::max(va, vb) + 0.5)), 0, H - 1);
+  for (int y = y0; y <= y1; ++y) {
+    double r0 = ta, r1 = tb;
+    clip_halfline(A[1] - (y - 0.5) * A[2], B[1] - (y - 0.5) * B[2], r0, r1);
+    clip_halfline((y + 0.5) * A[2] - A[1], (y + 0.5) * B[2] - B[1], r0, r1);
+    if (!(r0 < r1)) continue;
+    const double ua = U(r0), ub = U(r1);
+    const double umin = std::min(ua, ub), umax = std::max(ua, ub);
+    const auto row = m.row(y);
+    auto it = std::partition_point(row.begin(), row.end(),
+                                   [&](const Run& r) { return r.end - 0.5 <= umin; });
+    for (; it != row.end() && it->begin - 0.5 <= umax; ++it) {
+      double s0 = r0, s1 = r1;
+      const double a = it->begin - 0.5, b = it->end - 0.5;
+      clip_halfline(A[0] - a * A[2], B[0] - a * B[2], s0, s1);
+      clip_halfline(b * A[2] - A[0], b * B[2] - B[0], s0, s1);
+      if (s0 < s1) out->push_back({s0, s1});
+    }
+  }
+}
+
+void sort_merge(std::vector<Range>* r, std::size_t from) {
+  auto b = r->begin() + std::ptrdiff_t(from);
+  std::sort(b, r->end(), [](const Range& x, const Range& y) { return x.lo < y.lo; });
+  std::size_t w = from;
+  for (std::size_t k = from; k < r->size(); ++k) {
+    if (!((*r)[k].lo < (*r)[k].hi)) continue;
+    if (w > from && (*r)[w - 1].hi >= (*r)[k].lo) {
+      (*r)[w - 1].hi = std::max((*r)[w - 1].hi, (*r)[k].hi);
+    } else {
+      (*r)[w++] = (*r)[k];
+    }
+  }
+  r->resize(w);
+}
+
+// Appends (sorted, disjoint) pieces as float intervals, merging those that touch after rounding.
+void emit(const std::vector<Range>& keep, std::vector<Interval>* out, std::size_t out_begin) {
+  for (const Range& r : keep) {
+    const float lo = float(r.lo), hi = float(r.hi);
+    if (!(hi > lo)) continue;
+    if (out->size() > out_begin && out->back().hi >= lo) {
+      out->back().hi = std::max(out->back().hi, hi);
+    } else {
+      out->push_back({lo, hi});
+    }
+  }
+}
+
+// Calls f(a, b) for every maximal range of A \ B (A, B sorted disjoint half-open int ranges).
+template <class F>
+void difference(const std::vector<std::pair<int, int>>& A, const std::vector<std::pair<int, int>>& B,
+                F&& f) {
+  std::size_t j = 0;
+  for (const auto& [a0, a1] : A) {
+    int x = a0;
+    while (j < B.size() && B[j].second <= x) ++j;
+    std::size_t k = j;
+    while (x < a1) {
+      if (k < B.size() && B[k].first < a1) {
+        if (B[k].first > x) f(x, B[k].first);
+        x = std::max(x, B[k].second);
+        ++k;
+      } else {
+        f(x, a1);
+        x = a1;
+      }
+    }
+  }
+}
+
+Eigen::Vector2d ideal_to_observed(const Camera& c, const Eigen::Vector2d& ideal) {
+  const Intrinsics& k = c.intrinsics;
+  const double yn = (ideal.y() - k.cy) / k.fy;
+  const double xn = (ideal.x() - k.cx - k.skew * yn) / k.fx;
+  const Eigen::Vector2d d = distort(c.distortion, {xn, yn});
+  return {k.fx * d.x() + k.skew * d.y() + k.cx, k.fy * d.y() + k.cy};
+}
+
+Eigen::Vector2d observed_to_ideal(const Camera& c, const Eigen::Vector2d& obs) {
+  const Intrinsics& k = c.intrinsics;
+  const double yn = (obs.y() - k.cy) / k.fy;
+  const double xn = (obs.x() - k.cx - k.skew * yn) / k.fx;
+  const Eigen::Vector2d d = undistort(c.distortion, {xn, yn});
+  return {k.fx * d.x() + k.skew * d.y() + k.cx, k.fy * d.y() + k.cy};
+}
+
+}  // namespace
+
+Expected<void> CutOptions::validate() const {
+  if (threads < 1 || threads > 64) return fail("threads: " + std::to_string(threads) + " (need 1..64)");
+  return {};
+}
+
+struct PreparedView::Impl {
+  Camera camera;
+  const RunMask* mask = nullptr;
+  Eigen::Matrix<double, 3, 4> P;
+  bool keep_outside = true;
+  bool distorted = false;
+  Rect image{};        // observed image rectangle (pixel-square edges)
+  Rect ideal_image{};  // where the distortion model is trusted (ideal pixels)
+  // Pencil bins.
+  bool pencil = false;
+  Vec3 V = Vec3::Zero();
+  double vref = 0, smin = 0, ds = 0.5;
+  int nbins = 0;
+  std::vector<uint32_t> bin_start;
+  std::vector<float> bin_v;  // pairs (v0, v1) per run, in ideal pixel rows
+
+  double pencil_s(double u, double v) const {
+    const double d0 = V[0] - V[2] * u, d1 = V[1] - V[2] * v;
+    return u + d0 * (vref - v) / d1;
+  }
+  void build_pencil(const Eigen::Vector4d& X);
+  void cut_pencil(const Vec3& A, const Vec3& B, std::span<const Interval> in,
+                  std::vector<Range>* keep) const;
+  void cut_walk(const Vec3& A, const Vec3& B, std::span<const Interval> in,
+                std::vector<Range>* keep) const;
+  void cut_walk_distorted(const Vec3& A, const Vec3& B, std::span<const Interval> in,
+                          std::vector<Range>* keep) const;
+};
+
+void PreparedView::Impl::build_pencil(const Eigen::Vector4d& X) {
+  const int W = mask->width(), H = mask->height();
+  V = P * X;
+  const double corners[4][2] = {{-0.5, -0.5}, {W - 0.5, -0.5}, {-0.5, H - 0.5}, {W - 0.5, H - 0.5}};
+  int sign = 0;
+  for (const auto& c : corners) {
+    const double d0 = V[0] - V[2] * c[0], d1 = V[1] - V[2] * c[1];
+    if (!(std::abs(d0) <= std::abs(d1)) || d1 == 0) return;
+    const int s = d1 > 0 ? 1 : -1;
+    if (sign != 0 && s != sign) return;
+    sign = s;
+  }
+  vref = 0.5 * (H - 1);
+  double lo = 1e300, hi = -1e300;
+  for (const auto& c : corners) {
+    const double s = pencil_s(c[0], c[1]);
+    lo = std::min(lo, s), hi = std::max(hi, s);
+  }
+  smin = lo;
+  const double bins = std::ceil((hi - lo) / ds) + 1;
+  if (!(bins < 1 << 16)) return;
+  nbins = int(bins);
+
+  // Row sweep: per bin, the rows where the bin's centre line is inside a run.
+  struct Emitted {
+    int bin;
+    float v0, v1;
+  };
+  std::vector<Emitted> emitted;
+  std::vector<float> open(std::size_t(nbins), 0.f);
+  std::vector<std::pair<int, int>> prev, cur;
+  const auto first_bin = [&](double s) {
+    return std::clamp(int(std::ceil((s - smin) / ds - 0.5)), 0, nbins);
+  };
+  for (int y = 0; y <= H; ++y) {
+    cur.clear();
+    if (y < H) {
+      const double c = (vref - y) / (V[1] - V[2] * y);
+      const double slope = 1 - V[2] * c, offset = V[0] * c;
+      for (const Run& r : mask->row(y)) {
+        const int kb = first_bin((r.begin - 0.5) * slope + offset);
+        const int ke = first_bin((r.end - 0.5) * slope + offset);
+        if (kb < ke) cur.emplace_back(kb, ke);
+      }
+    }
+    const float edge = float(y - 0.5);
+    difference(cur, prev, [&](int a, int b) { std::fill(open.begin() + a, open.begin() + b, edge); });
+    difference(prev, cur, [&](int a, int b) {
+      for (int k = a; k < b; ++k) emitted.push_back({k, open[k], edge});
+    });
+    std::swap(prev, cur);
+  }
+  bin_start.assign(std::size_t(nbins) + 1, 0);
+  for (const Emitted& e : emitted) ++bin_start[e.bin + 1];
+  for (int k = 0; k < nbins; ++k) bin_start[k + 1] += bin_start[k];
+  bin_v.resize(emitted.size() * 2);
+  std::vector<uint32_t> fill(bin_start.begin(), bin_start.end() - 1);
+  for (const Emitted& e : emitted) {
+    const uint32_t at = fill[e.bin]++;
+    bin_v[2 * at] = e.v0;
+    bin_v[2 * at + 1] = e.v1;
+  }
+  pencil = true;
+}
+
+void PreparedView::Impl::cut_pencil(const Vec3& A, const Vec3& B, std::span<const Interval> in,
+                                    std::vector<Range>* keep) const {
+  const double lo = in.front().lo, hi = in.back().hi;
+  const Range inside = in_rect(A, B, image, lo, hi);
+  if (!(inside.lo < inside.hi)) {
+    if (keep_outside) keep->push_back({lo, hi});
+    return;
+  }
+  if (keep_outside) keep->push_back({lo, inside.lo});
+  const double tm = 0.5 * (inside.lo + inside.hi);
+  const double w = A[2] + tm * B[2];
+  const double s = pencil_s((A[0] + tm * B[0]) / w, (A[1] + tm * B[1]) / w);
+  const int k = int(std::floor((s - smin) / ds));
+  if (k >= 0 && k < nbins) {
+    const std::size_t from = keep->size();
+    for (uint32_t r = bin_start[k]; r < bin_start[k + 1]; ++r) {
+      const double y0 = bin_v[2 * r], y1 = bin_v[2 * r + 1];
+      double p = inside.lo, q = inside.hi;
+      clip_halfline(A[1] - y0 * A[2], B[1] - y0 * B[2], p, q);
+      clip_halfline(y1 * A[2] - A[1], y1 * B[2] - B[1], p, q);
+      if (p < q) keep->push_back({p, q});
+    }
+    // v decreasing along t reverses the order.
+    if (keep->size() - from > 1 && (*keep)[from].lo > keep->back().lo) {
+      std::reverse(keep->begin() + std::ptrdiff_t(from), keep->end());
+    }
+  }
+  if (keep_outside) keep->push_back({inside.hi, hi});
+}
+
+void PreparedView::Impl::cut_walk(const Vec3& A, const Vec3& B, std::span<const Interval> in,
+                                  std::vector<Range>* keep) const {
+  for (const Interval& iv : in) {
+    const Range inside = in_rect(A, B, image, iv.lo, iv.hi);
+    if (!(inside.lo < inside.hi)) {
+      if (keep_outside) keep->push_back({iv.lo, iv.hi});
+      continue;
+    }
+    if (keep_outside) keep->push_back({iv.lo, inside.lo});
+    const std::size_t from = keep->size();
+    walk_rows(A, B, inside.lo, inside.hi, *mask, keep);
+    sort_merge(keep, from);
+    if (keep_outside) keep->push_back({inside.hi, iv.hi});
+  }
+}
+
+void PreparedView::Impl::cut_walk_distorted(const Vec3& A, const Vec3& B,
+                                            std::span<const Interval> in,
+                                            std::vector<Range>* keep) const {
+  for (const Interval& iv : in) {
+    const std::size_t from = keep->size();
+    const Range valid = in_rect(A, B, ideal_image, iv.lo, iv.hi);
+    if (!(valid.lo < valid.hi)) {
+      if (keep_outside) keep->push_back({iv.lo, iv.hi});
+      continue;
+    }
+    if (keep_outside) keep->push_back({iv.lo, valid.lo});
+    const auto ideal = [&](double t) -> Eigen::Vector2d {
+      const Vec3 h = A + t * B;
+      return {h[0] / h[2], h[1] / h[2]};
+    };
+    const double length = (ideal(valid.hi) - ideal(valid.lo)).norm();
+    const int n = std::clamp(int(std::ceil(length / 8.0)), 1, 1024);
+    double ta = valid.lo;
+    Eigen::Vector2d pa = ideal_to_observed(camera, ideal(ta));
+    for (int s = 1; s <= n; ++s) {
+      const double tb = s == n ? valid.hi : valid.lo + (valid.hi - valid.lo) * s / n;
+      const Eigen::Vector2d pb = ideal_to_observed(camera, ideal(tb));
+      // The chord as an affine piece: observed point = pa + (t - ta) g.
+      const Eigen::Vector2d g = (pb - pa) / (tb - ta);
+      const Vec3 Ap(pa.x() - ta * g.x(), pa.y() - ta * g.y(), 1.0), Bp(g.x(), g.y(), 0.0);
+      const Range piece = in_rect(Ap, Bp, image, ta, tb);
+      if (piece.lo < piece.hi) {
+        if (keep_outside) keep->push_back({ta, piece.lo});
+        walk_rows(Ap, Bp, piece.lo, piece.hi, *mask, keep);
+        if (keep_outside) keep->push_back({piece.hi, tb});
+      } else if (keep_outside) {
+        keep->push_back({ta, tb});
+      }
+      ta = tb;
+      pa = pb;
+    }
+    if (keep_outside) keep->push_back({valid.hi, iv.hi});
+    sort_merge(keep, from);
+  }
+}
+
+PreparedView::PreparedView() : impl_(std::make_unique<Impl>()) {}
+PreparedView::PreparedView(PreparedView&&) noexcept = default;
+PreparedView& PreparedView::operator=(PreparedView&&) noexcept = default;
+PreparedView::~PreparedView() = default;
+
+Expected<PreparedView> PreparedView::create(const Camera& camera, const RunMask& mask,
+                                            const Eigen::Vector4d& pencil_point,
+                                            const CutOptions& options) {
+  if (mask.width() != camera.width || mask.height() != camera.height) {
+    return fail("camera " + camera.id + ": mask is " + std::to_string(mask.width()) + "x" +
+                std::to_string(mask.height()) + ", camera is " + std::to_string(camera.width) + "x" +
+                std::to_string(camera.height));
+  }
+  if (camera.width <= 0 || camera.height <= 0) {
+    return fail("camera " + camera.id + ": empty image size");
+  }
+  PreparedView view;
+  Impl& m = *view.impl_;
+  m.camera = camera;
+  m.mask = &mask;
+  m.P = camera.projection_matrix();
+  m.keep_outside = options.outside == Outside::keep;
+  m.distorted = !camera.distortion.is_identity();
+  const int W = camera.width, H = camera.height;
+  m.image = {-0.5, W - 0.5, -0.5, H - 0.5};
+  if (m.distorted) {
+    // Ideal bounding box of the observed image border, padded: beyond it the distortion
+    // polynomial is not trusted and the line counts as outside the image.
+    double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+    for (int k = 0; k <= 64; ++k) {
+      const double fu = -0.5 + W * k / 64.0, fv = -0.5 + H * k / 64.0;
+      for (const Eigen::Vector2d& p :
+           {Eigen::Vector2d(fu, -0.5), Eigen::Vector2d(fu, H - 0.5), Eigen::Vector2d(-0.5, fv),
+            Eigen::Vector2d(W - 0.5, fv)}) {
+        const Eigen::Vector2d q = observed_to_ideal(camera, p);
+        u0 = std::min(u0, q.x()), u1 = std::max(u1, q.x());
+        v0 = std::min(v0, q.y()), v1 = std::max(v1, q.y());
+      }
+    }
+    const double pad = 0.02 * std::max(W, H);
+    m.ideal_image = {u0 - pad, u1 + pad, v0 - pad, v1 + pad};
+  } else if (options.allow_pencil) {
+    m.build_pencil(pencil_point);
+  }
+  return view;
+}
+
+bool PreparedView::uses_pencil() const { return impl_->pencil; }
+
+void PreparedView::cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                            std::span<const Interval> in, std::vector<Interval>* out) const {
+  if (in.empty()) return;
+  thread_local std::vector<Range> keep;
+  keep.clear();
+  const Impl& m = *impl_;
+  const Vec3 A = m.P.leftCols<3>() * o + m.P.col(3);
+  const Vec3 B = m.P.leftCols<3>() * d;
+  if (m.pencil) {
+    m.cut_pencil(A, B, in, &keep);
+  } else if (m.distorted) {
+    m.cut_walk_distorted(A, B, in, &keep);
+  } else {
+    m.cut_walk(A, B, in, &keep);
+  }
+  // out = in ∩ keep (keep is sorted; touching pieces are merged by emit()).
+  thread_local std::vector<Range> result;
+  result.clear();
+  std::size_t p = 0;
+  for (const Interval& iv : in) {
+    while (p < keep.size() && keep[p].hi <= iv.lo) ++p;
+    for (std::size_t q = p; q < keep.size() && keep[q].lo < iv.hi; ++q) {
+      const double lo = std::max<double>(iv.lo, keep[q].lo), hi = std::min<double>(iv.hi, keep[q].hi);
+      if (lo < hi) result.push_back({lo, hi});
+    }
+  }
+  emit(result, out, out->size());
+}
+
+Expected<void> cut(SegmentSet& set, std::span<const View> views, const CutOptions& options) {
+  if (auto ok = options.validate(); !ok) return ok;
+  const GridSpec& g = set.grid();
+  Eigen::Vector4d X = Eigen::Vector4d::Zero();
+  X[g.a()] = 1;  // the columns meet at infinity along the continuous axis
+  std::vector<PreparedView> prepared;
+  prepared.reserve(views.size());
+  for (const View& v : views) {
+    auto p = PreparedView::create(*v.camera, *v.mask, X, options);
+    if (!p) return std::unexpected(p.error());
+    prepared.push_back(std::move(*p));
+  }
+  Vec3 d = Vec3::Zero();
+  d[g.a()] = 1;
+  const std::size_t columns = g.columns();
+  const int T = int(std::min<std::size_t>(std::size_t(options.threads), std::max<std::size_t>(columns / 256, 1)));
+  std::vector<std::vector<Interval>> chunk_iv(T);
+  std::vector<std::vector<uint32_t>> chunk_count(T);
+  const auto work = [&](int chunk) {
+    const std::size_t c0 = columns * chunk / T, c1 = columns * (chunk + 1) / T;
+    std::vector<Interval>& out = chunk_iv[chunk];
+    std::vector<uint32_t>& count = chunk_count[chunk];
+    out.reserve(set.start()[c1] - set.start()[c0]);
+    count.resize(c1 - c0);
+    std::vector<Interval> a, b;
+    for (std::size_t c = c0; c < c1; ++c) {
+      const auto col = set.column(c);
+      const std::size_t before = out.size();
+      if (!col.empty()) {
+        const int i = int(c % std::size_t(g.cells_u)), j = int(c / std::size_t(g.cells_u));
+        const Vec3 o = g.point(i, j, 0.0);
+        a.assign(col.begin(), col.end());
+        for (const PreparedView& view : prepared) {
+          b.clear();
+          view.cut_line(o, d, a, &b);
+          std::swap(a, b);
+          if (a.empty()) break;
+        }
+        out.insert(out.end(), a.begin(), a.end());
+      }
+      count[c - c0] = uint32_t(out.size() - before);
+    }
+  };
+  std::vector<std::jthread> workers;
+  for (int k = 1; k < T; ++k) workers.emplace_back(work, k);
+  work(0);
+  workers.clear();
+  std::vector<Interval> all;
+  std::size_t total = 0;
+  for (const auto& v : chunk_iv) total += v.size();
+  all.reserve(total);
+  std::vector<uint32_t> start(columns + 1, 0);
+  std::size_t c = 0;
+  for (int k = 0; k < T; ++k) {
+    all.insert(all.end(), chunk_iv[k].begin(), chunk_iv[k].end());
+    for (uint32_t n : chunk_count[k]) {
+      start[c + 1] = start[c] + n;
+      ++c;
+    }
+  }
+  set.assign(std::move(all), std::move(start));
+  return {};
+}
+
+Expected<SegmentSet> visual_hull(const GridSpec& grid, std::span<const View> views,
+                                 const CutOptions& options) {
+  if (auto ok = grid.validate(); !ok) return std::unexpected(ok.error());
+  SegmentSet set = SegmentSet::full(grid);
+  if (auto ok = cut(set, views, options); !ok) return std::unexpected(ok.error());
+  return set;
+}
+
+}  // namespace studio::hull
