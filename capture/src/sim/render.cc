@@ -1,0 +1,409 @@
+// The per-frame hot path of the simulated studio: floor shadow, actor ray casting inside the
+// parts' projected rectangles, shading with blue spill, anti-aliased edges and motion blur.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "studio_impl.h"
+
+namespace studio::sim::detail {
+namespace {
+
+constexpr uint8_t kNoPart = 255;
+
+// A part in the camera frame with the per-ray constant terms precomputed (ray origin = 0).
+struct CamPart {
+  bool capsule = true;
+  // Capsule: ends a, b; unit axis e; length len; radius r.
+  Eigen::Vector3d a, b, e;
+  double len = 0, r = 0, r2 = 0;
+  Eigen::Vector3d op;  // (-a) without its component along e
+  double oe = 0, op2_r2 = 0, a2_r2 = 0, b2_r2 = 0;
+  // Ellipsoid: M = diag(1/radii) axes^T, o2 = M (0 - centre).
+  Eigen::Matrix3d M;
+  Eigen::Vector3d c, o2;
+  double o2c = 0;
+  Rect rect;
+  std::array<float, 3> albedo{};
+
+  // Ray parameter of the first hit of t * d (t > 0), or +inf.
+  double hit(const Eigen::Vector3d& d) const {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    if (!capsule) {
+      const Eigen::Vector3d d2 = M * d;
+      const double A = d2.squaredNorm(), B = o2.dot(d2);
+      const double disc = B * B - A * o2c;
+      if (disc < 0) return kInf;
+      const double t = (-B - std::sqrt(disc)) / A;
+      return t > 0 ? t : kInf;
+    }
+    const double dd = d.squaredNorm(), de = d.dot(e);
+    const double A = dd - de * de, B = op.dot(d);
+    const double disc = B * B - A * op2_r2;
+    if (disc < 0) return kInf;
+    double axial = -1;
+    if (A > 1e-14 * dd) {
+      const double t = (-B - std::sqrt(disc)) / A;
+      axial = oe + t * de;
+      if (axial >= 0 && axial <= len) return t > 0 ? t : kInf;
+    } else {
+      axial = de > 0 ? -1 : len + 1;  // parallel to the axis: enters through the near cap
+    }
+    const double B2 = axial < 0 ? -a.dot(d) : -b.dot(d);
+    const double C2 = axial < 0 ? a2_r2 : b2_r2;
+    const double disc2 = B2 * B2 - dd * C2;
+    if (disc2 < 0) return kInf;
+    const double t = (-B2 - std::sqrt(disc2)) / dd;
+    return t > 0 ? t : kInf;
+  }
+  Eigen::Vector3d normal(const Eigen::Vector3d& p) const {
+    if (capsule) {
+      const double h = std::clamp((p - a).dot(e), 0.0, len);
+      return (p - a - h * e) / r;
+    }
+    return (M.transpose() * (M * (p - c))).normalized();
+  }
+};
+
+std::vector<CamPart> to_camera(const CameraCache& cam, const ActorBody& body, int margin) {
+  std::vector<CamPart> out;
+  out.reserve(body.parts.size());
+  for (const Part& p : body.parts) {
+    CamPart c;
+    c.capsule = p.shape == PartShape::capsule;
+    Eigen::Vector3d lo, hi;
+    if (c.capsule) {
+      c.a = cam.R * p.a + cam.t;
+      c.b = cam.R * p.b + cam.t;
+      c.len = (c.b - c.a).norm();
+      c.e = c.len > 0 ? Eigen::Vector3d((c.b - c.a) / c.len) : Eigen::Vector3d::UnitY();
+      c.r = p.radius;
+      c.r2 = p.radius * p.radius;
+      c.oe = -c.a.dot(c.e);
+      c.op = -c.a - c.oe * c.e;
+      c.op2_r2 = c.op.squaredNorm() - c.r2;
+      c.a2_r2 = c.a.squaredNorm() - c.r2;
+      c.b2_r2 = c.b.squaredNorm() - c.r2;
+      lo = c.a.cwiseMin(c.b).array() - c.r;
+      hi = c.a.cwiseMax(c.b).array() + c.r;
+    } else {
+      const Eigen::Matrix3d axes = cam.R * p.axes;
+      c.c = cam.R * p.centre + cam.t;
+      c.M = p.radii.cwiseInverse().asDiagonal() * axes.transpose();
+      c.o2 = -(c.M * c.c);
+      c.o2c = c.o2.squaredNorm() - 1.0;
+      const Eigen::Vector3d half = (axes * p.radii.asDiagonal()).rowwise().norm();
+      lo = c.c - half;
+      hi = c.c + half;
+    }
+    Eigen::Vector3d corners[8];
+    for (int k = 0; k < 8; ++k) {
+      corners[k] = Eigen::Vector3d(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(),
+                                   k & 4 ? hi.z() : lo.z());
+    }
+    c.rect = cam.project_hull(corners, 8, margin);
+    c.albedo = {p.albedo.r, p.albedo.g, p.albedo.b};
+    out.push_back(c);
+  }
+  return out;
+}
+
+// Display transfer (gamma 1/2.2) of linear [0, 1] → [0, 255] as a table.
+struct Gamma {
+  std::array<float, 1025> lut;
+  Gamma() {
+    for (int i = 0; i <= 1024; ++i) lut[i] = 255.0f * std::pow(i / 1024.0f, 1 / 2.2f);
+  }
+  float operator()(float x) const { return lut[std::clamp(static_cast<int>(x * 1024.0f), 0, 1024)]; }
+};
+const Gamma kGamma;
+
+struct Shader {
+  Eigen::Vector3d key, fill;  // camera frame
+  double spill, ring;
+  // Display colour of the hit on `part` along d at t, given the background colour behind it.
+  std::array<float, 3> operator()(const CamPart& part, const Eigen::Vector3d& d, double t,
+                                  const Rgb8& bg) const {
+    const Eigen::Vector3d p = t * d;
+    const Eigen::Vector3d n = part.normal(p);
+    const Eigen::Vector3d v = -d.normalized();
+    const double ndv = std::max(0.0, n.dot(v));
+    const float light = static_cast<float>(0.28 + 0.8 * std::max(0.0, n.dot(key)) +
+                                           0.25 * std::max(0.0, n.dot(fill)));
+    const float ring_w = static_cast<float>(ring * ndv);
+    constexpr float kRing[3] = {0.25f, 0.45f, 1.0f};
+    const float s = static_cast<float>(spill * (1 - ndv) * (1 - ndv));
+    const float back[3] = {float(bg.r), float(bg.g), float(bg.b)};
+    std::array<float, 3> out;
+    for (int k = 0; k < 3; ++k) {
+      const float lin = part.albedo[k] * (light + ring_w * kRing[k]);
+      out[k] = kGamma(lin) * (1 - s) + back[k] * s;
+    }
+    return out;
+  }
+};
+
+Rgb8 to_rgb(const std::array<float, 3>& c) {
+  auto q = [](float x) { return static_cast<uint8_t>(std::clamp(x + 0.5f, 0.0f, 255.0f)); };
+  return {q(c[0]), q(c[1]), q(c[2])};
+}
+
+// Scratch buffers of one thread, reused between frames.
+struct Scratch {
+  std::vector<float> depth;
+  std::vector<uint8_t> id;
+  std::vector<Rgb8> bg;
+  std::vector<std::array<float, 3>> accum;
+};
+thread_local Scratch scratch;
+
+// Nearest part per pixel of rect U: depth (ray parameter) and id (kNoPart for none).
+void cast(const CameraCache& cam, const std::vector<CamPart>& parts, const Rect& U,
+          std::vector<float>* depth, std::vector<uint8_t>* id) {
+  const int w = U.x1 - U.x0;
+  const std::size_t n = static_cast<std::size_t>(w) * (U.y1 - U.y0);
+  depth->assign(n, std::numeric_limits<float>::infinity());
+  id->assign(n, kNoPart);
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const CamPart& part = parts[k];
+    const int x0 = std::max(part.rect.x0, U.x0), x1 = std::min(part.rect.x1, U.x1);
+    const int y0 = std::max(part.rect.y0, U.y0), y1 = std::min(part.rect.y1, U.y1);
+    for (int y = y0; y < y1; ++y) {
+      float* drow = depth->data() + static_cast<std::size_t>(y - U.y0) * w - U.x0;
+      uint8_t* irow = id->data() + static_cast<std::size_t>(y - U.y0) * w - U.x0;
+      for (int x = x0; x < x1; ++x) {
+        const double t = part.hit(cam.ray(x, y));
+        if (t < drow[x]) {
+          drow[x] = static_cast<float>(t);
+          irow[x] = static_cast<uint8_t>(k);
+        }
+      }
+    }
+  }
+}
+
+// Ray of a sub-pixel position (anti-aliasing).
+Eigen::Vector3d sub_ray(const CameraCache& cam, double u, double v) {
+  const auto& k = cam.camera.intrinsics;
+  const double y = (v - k.cy) / k.fy;
+  const Eigen::Vector2d observed((u - k.cx - k.skew * y) / k.fx, y);
+  if (cam.pinhole) return {observed.x(), observed.y(), 1.0};
+  const Eigen::Vector2d ideal = undistort(cam.camera.distortion, observed);
+  return {ideal.x(), ideal.y(), 1.0};
+}
+
+void apply_shadow(const CameraCache& cam, const ShadowMap& shadow, Image<Rgb8>* image) {
+  if (shadow.empty()) return;
+  const double xs[2] = {shadow.x0, shadow.x0 + (shadow.nx - 1) * shadow.cell};
+  const double zs[2] = {shadow.z0, shadow.z0 + (shadow.nz - 1) * shadow.cell};
+  Eigen::Vector3d corners[4];
+  for (int k = 0; k < 4; ++k) corners[k] = cam.R * Eigen::Vector3d(xs[k & 1], 0, zs[k >> 1]) + cam.t;
+  Rect r = cam.project_hull(corners, 4, 1);
+  const Eigen::Matrix3d Rt = cam.R.transpose();
+  for (int y = r.y0; y < r.y1; ++y) {
+    const uint8_t* surf = &cam.surface(0, y);
+    Rgb8* row = &(*image)(0, y);
+    for (int x = r.x0; x < r.x1; ++x) {
+      if (surf[x] != kFloor) continue;
+      const Eigen::Vector3d dir = Rt * cam.ray(x, y);
+      if (dir.y() >= 0) continue;
+      const double t = -cam.centre.y() / dir.y();
+      const float f = shadow.at(cam.centre.x() + t * dir.x(), cam.centre.z() + t * dir.z());
+      if (f >= 1.0f) continue;
+      row[x].r = static_cast<uint8_t>(row[x].r * f + 0.5f);
+      row[x].g = static_cast<uint8_t>(row[x].g * f + 0.5f);
+      row[x].b = static_cast<uint8_t>(row[x].b * f + 0.5f);
+    }
+  }
+}
+
+Rect union_rect(const std::vector<CamPart>& parts) {
+  Rect u;
+  for (const CamPart& p : parts) u = u.united(p.rect);
+  return u;
+}
+
+}  // namespace
+
+float ShadowMap::at(double x, double z) const {
+  const double fx = (x - x0) / cell, fz = (z - z0) / cell;
+  if (!(fx >= 0 && fz >= 0 && fx <= nx - 1 && fz <= nz - 1)) return 1.0f;
+  const int ix = std::min(static_cast<int>(fx), nx - 2), iz = std::min(static_cast<int>(fz), nz - 2);
+  const float ax = static_cast<float>(fx - ix), az = static_cast<float>(fz - iz);
+  const float* f0 = &factor[static_cast<std::size_t>(iz) * nx + ix];
+  const float* f1 = f0 + nx;
+  return (f0[0] * (1 - ax) + f0[1] * ax) * (1 - az) + (f1[0] * (1 - ax) + f1[1] * ax) * az;
+}
+
+ShadowMap make_shadow(const ActorBody& body, double strength) {
+  ShadowMap map;
+  if (strength <= 0 || body.parts.empty()) return map;
+  struct Footprint {
+    Eigen::Vector2d p, q;
+    double r, w, density;
+  };
+  const Eigen::Vector3d& L = kKeyLight;
+  auto floor_of = [&](const Eigen::Vector3d& x) {
+    const Eigen::Vector3d f = x - (x.y() / L.y()) * L;
+    return Eigen::Vector2d(f.x(), f.z());
+  };
+  std::vector<Footprint> prints;
+  Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
+  for (const Part& part : body.parts) {
+    Eigen::Vector3d p, q;
+    double r;
+    if (part.shape == PartShape::capsule) {
+      p = part.a;
+      q = part.b;
+      r = part.radius;
+    } else {
+      int i;
+      part.radii.maxCoeff(&i);
+      r = (part.radii.sum() - part.radii[i]) / 2;
+      const Eigen::Vector3d half = part.axes.col(i) * std::max(0.0, part.radii[i] - r);
+      p = part.centre - half;
+      q = part.centre + half;
+    }
+    const double h = std::max(0.0, 0.5 * (p.y() + q.y()));
+    Footprint f{floor_of(p), floor_of(q), r, 0.02 + 0.10 * h, std::max(0.3, 1.0 - 0.2 * h)};
+    lo = lo.cwiseMin((f.p.cwiseMin(f.q).array() - (f.r + f.w)).matrix());
+    hi = hi.cwiseMax((f.p.cwiseMax(f.q).array() + (f.r + f.w)).matrix());
+    prints.push_back(f);
+  }
+  map.cell = 0.04;
+  map.x0 = lo.x();
+  map.z0 = lo.y();
+  map.nx = static_cast<int>(std::ceil((hi.x() - lo.x()) / map.cell)) + 2;
+  map.nz = static_cast<int>(std::ceil((hi.y() - lo.y()) / map.cell)) + 2;
+  std::vector<float> occlusion(static_cast<std::size_t>(map.nx) * map.nz, 0.0f);
+  for (const Footprint& f : prints) {
+    const Eigen::Vector2d flo = f.p.cwiseMin(f.q).array() - (f.r + f.w);
+    const Eigen::Vector2d fhi = f.p.cwiseMax(f.q).array() + (f.r + f.w);
+    const int i0 = std::max(0, static_cast<int>((flo.x() - map.x0) / map.cell));
+    const int i1 = std::min(map.nx - 1, static_cast<int>((fhi.x() - map.x0) / map.cell) + 1);
+    const int j0 = std::max(0, static_cast<int>((flo.y() - map.z0) / map.cell));
+    const int j1 = std::min(map.nz - 1, static_cast<int>((fhi.y() - map.z0) / map.cell) + 1);
+    const Eigen::Vector2d pq = f.q - f.p;
+    const double pq2 = std::max(pq.squaredNorm(), 1e-12);
+    for (int j = j0; j <= j1; ++j) {
+      for (int i = i0; i <= i1; ++i) {
+        const Eigen::Vector2d x(map.x0 + i * map.cell, map.z0 + j * map.cell);
+        const double h = std::clamp((x - f.p).dot(pq) / pq2, 0.0, 1.0);
+        const double dist = (x - f.p - h * pq).norm();
+        const double s = std::clamp((f.r + f.w - dist) / (2 * f.w), 0.0, 1.0);
+        const float c = static_cast<float>(s * s * (3 - 2 * s) * f.density);
+        float& o = occlusion[static_cast<std::size_t>(j) * map.nx + i];
+        o = std::max(o, c);
+      }
+    }
+  }
+  map.factor.resize(occlusion.size());
+  for (std::size_t k = 0; k < occlusion.size(); ++k) {
+    map.factor[k] = 1.0f - static_cast<float>(strength) * occlusion[k];
+  }
+  return map;
+}
+
+void render_actor(const StudioOptions& options, const CameraCache& cam, const PreparedFrame& frame,
+                  Image<Rgb8>* image, Mask* mask) {
+  apply_shadow(cam, frame.shadow, image);
+  const int width = cam.camera.width;
+  const std::vector<CamPart> parts = to_camera(cam, frame.truth.body, 1);
+  const Shader shader{cam.R * kKeyLight, cam.R * kFillLight, options.spill, options.ring_light};
+  Rect U = union_rect(parts);
+  std::vector<std::vector<CamPart>> blur;
+  for (const ActorBody& b : frame.blur_bodies) {
+    blur.push_back(to_camera(cam, b, 1));
+    U = U.united(union_rect(blur.back()));
+  }
+  if (U.empty()) return;
+  // Grow by one pixel (anti-aliasing looks at neighbours), clipped to the image.
+  U = {std::max(0, U.x0 - 1), std::max(0, U.y0 - 1), std::min(width, U.x1 + 1),
+       std::min(cam.camera.height, U.y1 + 1)};
+  const int w = U.x1 - U.x0;
+  Scratch& s = scratch;
+  // Background behind the actor (after shadow) for spill, anti-aliasing and blur.
+  s.bg.resize(static_cast<std::size_t>(w) * (U.y1 - U.y0));
+  for (int y = U.y0; y < U.y1; ++y) {
+    std::copy_n(&(*image)(U.x0, y), w, s.bg.data() + static_cast<std::size_t>(y - U.y0) * w);
+  }
+  auto bg_at = [&](int x, int y) -> const Rgb8& {
+    return s.bg[static_cast<std::size_t>(y - U.y0) * w + (x - U.x0)];
+  };
+  cast(cam, parts, U, &s.depth, &s.id);
+  for (int y = U.y0; y < U.y1; ++y) {
+    const uint8_t* ids = s.id.data() + static_cast<std::size_t>(y - U.y0) * w;
+    const float* depth = s.depth.data() + static_cast<std::size_t>(y - U.y0) * w;
+    uint8_t* mrow = &(*mask)(0, y);
+    Rgb8* irow = &(*image)(0, y);
+    for (int x = U.x0; x < U.x1; ++x) {
+      const uint8_t k = ids[x - U.x0];
+      if (k == kNoPart) continue;
+      mrow[x] = 255;
+      if (blur.empty()) {
+        irow[x] = to_rgb(shader(parts[k], cam.ray(x, y), depth[x - U.x0], bg_at(x, y)));
+      }
+    }
+  }
+  if (!blur.empty()) {
+    // Motion blur: average the actor over the shutter's sub-instants.
+    s.accum.assign(static_cast<std::size_t>(w) * (U.y1 - U.y0), {0, 0, 0});
+    for (const auto& sub : blur) {
+      cast(cam, sub, U, &s.depth, &s.id);
+      for (int y = U.y0; y < U.y1; ++y) {
+        for (int x = U.x0; x < U.x1; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y - U.y0) * w + (x - U.x0);
+          const Rgb8& b = s.bg[i];
+          const auto c = s.id[i] == kNoPart ? std::array<float, 3>{float(b.r), float(b.g), float(b.b)}
+                                             : shader(sub[s.id[i]], cam.ray(x, y), s.depth[i], b);
+          for (int k = 0; k < 3; ++k) s.accum[i][k] += c[k];
+        }
+      }
+    }
+    const float inv = 1.0f / blur.size();
+    for (int y = U.y0; y < U.y1; ++y) {
+      for (int x = U.x0; x < U.x1; ++x) {
+        const auto& a = s.accum[static_cast<std::size_t>(y - U.y0) * w + (x - U.x0)];
+        (*image)(x, y) = to_rgb({a[0] * inv, a[1] * inv, a[2] * inv});
+      }
+    }
+    return;
+  }
+  if (!options.antialias) return;
+  // Anti-aliasing: pixels on either side of the silhouette get 4 sub-samples (mask unchanged).
+  constexpr double kOff[4][2] = {{-0.25, -0.25}, {0.25, -0.25}, {-0.25, 0.25}, {0.25, 0.25}};
+  const int height = cam.camera.height;
+  for (int y = U.y0; y < U.y1; ++y) {
+    const uint8_t* m = &(*mask)(0, y);
+    const uint8_t* up = y > 0 ? &(*mask)(0, y - 1) : m;
+    const uint8_t* down = y + 1 < height ? &(*mask)(0, y + 1) : m;
+    for (int x = U.x0; x < U.x1; ++x) {
+      const uint8_t c = m[x];
+      const bool edge = (x > 0 && m[x - 1] != c) || (x + 1 < width && m[x + 1] != c) ||
+                        up[x] != c || down[x] != c;
+      if (!edge) continue;
+      std::array<float, 3> sum{0, 0, 0};
+      const Rgb8& b = bg_at(x, y);
+      for (const auto& o : kOff) {
+        const Eigen::Vector3d d = sub_ray(cam, x + o[0], y + o[1]);
+        double best = std::numeric_limits<double>::infinity();
+        int best_k = -1;
+        for (std::size_t k = 0; k < parts.size(); ++k) {
+          if (!parts[k].rect.contains(x, y)) continue;
+          const double t = parts[k].hit(d);
+          if (t < best) {
+            best = t;
+            best_k = static_cast<int>(k);
+          }
+        }
+        const auto col = best_k < 0 ? std::array<float, 3>{float(b.r), float(b.g), float(b.b)}
+                                    : shader(parts[best_k], d, best, b);
+        for (int k = 0; k < 3; ++k) sum[k] += col[k];
+      }
+      (*image)(x, y) = to_rgb({sum[0] / 4, sum[1] / 4, sum[2] / 4});
+    }
+  }
+}
+
+}  // namespace studio::sim::detail
