@@ -22,7 +22,7 @@ std::string quote(const std::string& s) {
   return out + "\"";
 }
 
-std::string num(double v) { return std::isfinite(v) ? format("{:.6g}", v) : "null"; }
+std::string num(double v) { return std::isfinite(v) ? format("{:.6g}", v == 0 ? 0.0 : v) : "null"; }
 
 }  // namespace
 
@@ -84,7 +84,7 @@ Expected<std::vector<std::string>> write_residual_plots(const CalibrationResult&
     const int panel = h;  // square scatter panel on the right
     cv::Mat img(h + 40, w + panel, CV_8UC3, cv::Scalar(255, 255, 255));
     cv::rectangle(img, cv::Rect(0, 0, w, h), cv::Scalar(0, 0, 0));
-    const double magnify = 100;  // residual vectors drawn 100x
+    const double magnify = 40;  // residual vectors drawn 40x
     double max_res = std::max(0.5, 3 * st.rms_px);
     auto draw = [&](const std::vector<ScoredObservation>& v, cv::Scalar colour) {
       for (const auto& o : v) {
