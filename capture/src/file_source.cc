@@ -1,0 +1,194 @@
+#include "capture/file_source.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace studio::capture {
+namespace {
+
+namespace fs = std::filesystem;
+
+int64_t realtime_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+bool has_image_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  for (const char* known : {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm"}) {
+    if (ext == known) return true;
+  }
+  return false;
+}
+
+// Reads any 8-bit image file as RGB8; an empty image when OpenCV cannot decode it.
+Image<Rgb8> read_rgb(const std::string& path) {
+  cv::Mat bgr;
+  try {
+    bgr = cv::imread(path, cv::IMREAD_COLOR);  // grey, palette and alpha images become BGR
+  } catch (const cv::Exception&) {
+    return {};
+  }
+  if (bgr.empty() || bgr.type() != CV_8UC3) return {};
+  Image<Rgb8> image(bgr.cols, bgr.rows);
+  cv::Mat rgb(bgr.rows, bgr.cols, CV_8UC3, image.data());
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  return image;
+}
+
+}  // namespace
+
+Expected<void> FileSourceOptions::validate() const {
+  if (path.empty()) return fail("file source: path is empty");
+  if (!(fps > 0 && fps <= 1000)) {
+    return fail("file source " + path + ": fps must be in (0, 1000], got " + std::to_string(fps));
+  }
+  if (!clock.valid()) return fail("file source " + path + ": clock period must be positive");
+  if (start_ns < 0) return fail("file source " + path + ": start_ns must not be negative");
+  return {};
+}
+
+Expected<std::vector<std::string>> list_image_files(const std::string& folder) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) return fail("image folder " + folder + ": not a directory");
+  std::vector<std::string> files;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code type_ec;
+    if (it->is_regular_file(type_ec) && has_image_extension(it->path())) {
+      files.push_back(it->path().string());
+    }
+  }
+  if (ec) return fail("image folder " + folder + ": " + ec.message());
+  if (files.empty()) return fail("image folder " + folder + ": no PNG/JPEG/BMP/TIFF images");
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+Expected<std::unique_ptr<FileSource>> FileSource::create(const FileSourceOptions& options) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  auto files = list_image_files(options.path);
+  if (!files) return std::unexpected(files.error());
+  std::string id = options.id;
+  if (id.empty()) {
+    fs::path p(options.path);
+    id = (p.has_filename() ? p.filename() : p.parent_path().filename()).string();
+  }
+  return std::unique_ptr<FileSource>(new FileSource(options, std::move(id), std::move(*files)));
+}
+
+FileSource::FileSource(FileSourceOptions options, std::string id, std::vector<std::string> files)
+    : options_(std::move(options)), id_(std::move(id)), files_(std::move(files)) {
+  period_ns_ = std::max<int64_t>(1, int64_t(std::llround(1e9 / options_.fps)));
+}
+
+Expected<void> FileSource::start() {
+  std::lock_guard lock(mutex_);
+  const int64_t now = realtime_ns();
+  if (options_.start_ns == 0) {
+    const FrameClock& c = options_.clock;
+    first_capture_ns_ = c.time_of(c.frame_at(now) + 1) + c.period_ns / 2;
+    first_due_ns_ = first_capture_ns_;
+  } else {
+    first_capture_ns_ = options_.start_ns;
+    first_due_ns_ = now;
+  }
+  index_ = 0;
+  failures_in_pass_ = 0;
+  first_width_ = first_height_ = 0;
+  started_ = true;
+  finished_ = false;
+  stopping_ = false;
+  stats_ = SourceStats{};
+  return {};
+}
+
+void FileSource::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+}
+
+bool FileSource::wait_until(int64_t due_ns, std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    if (stopping_) return false;
+    const int64_t now = realtime_ns();
+    if (now >= due_ns) return true;
+    const auto until_due = std::chrono::steady_clock::now() + std::chrono::nanoseconds(due_ns - now);
+    if (deadline <= until_due) {
+      wake_.wait_until(lock, deadline, [&] { return stopping_; });
+      return false;
+    }
+    wake_.wait_until(lock, until_due, [&] { return stopping_; });
+  }
+}
+
+Expected<std::optional<Frame>> FileSource::next(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  if (!started_) return fail("file source " + id_ + ": next() before start()");
+  for (;;) {
+    if (finished_) {
+      wait_until(INT64_MAX, deadline);
+      return std::optional<Frame>();
+    }
+    const int64_t offset = int64_t(index_) * period_ns_;
+    if (options_.paced && !wait_until(first_due_ns_ + offset, deadline)) {
+      return std::optional<Frame>();
+    }
+    {
+      std::lock_guard lock(mutex_);
+      if (stopping_) return std::optional<Frame>();
+    }
+    const std::size_t file = std::size_t(index_ % files_.size());
+    Frame frame;
+    frame.capture_ns = first_capture_ns_ + offset;
+    frame.frame = options_.clock.frame_at(frame.capture_ns);
+    frame.image = read_rgb(files_[file]);
+    ++index_;
+    const bool end_of_pass = file + 1 == files_.size();
+    bool ok = !frame.image.pixels().empty();
+    if (ok && first_width_ == 0) {
+      first_width_ = frame.image.width();
+      first_height_ = frame.image.height();
+    }
+    ok = ok && frame.image.width() == first_width_ && frame.image.height() == first_height_;
+    {
+      std::lock_guard lock(mutex_);
+      if (ok) {
+        ++stats_.frames;
+      } else {
+        ++stats_.drops;
+      }
+    }
+    failures_in_pass_ += ok ? 0 : 1;
+    if (end_of_pass) {
+      const bool all_failed = failures_in_pass_ == files_.size();
+      failures_in_pass_ = 0;
+      if (all_failed) {
+        finished_ = true;
+        return fail("file source " + id_ + ": none of the " + std::to_string(files_.size()) +
+                    " images in " + options_.path + " could be decoded");
+      }
+      if (!options_.loop) finished_ = true;
+    }
+    if (ok) return std::optional<Frame>(std::move(frame));
+    if (std::chrono::steady_clock::now() >= deadline) return std::optional<Frame>();
+  }
+}
+
+SourceStats FileSource::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+}  // namespace studio::capture
