@@ -1,0 +1,164 @@
+#include "runtime/service.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <string_view>
+
+#include "core/log.h"
+#include "runtime/notify.h"
+#include "runtime/signals.h"
+#include "runtime/status_publisher.h"
+
+namespace studio::runtime {
+namespace {
+
+constexpr std::string_view kCategory = "runtime";
+
+void print_help(const ServiceDefinition& d) {
+  std::printf(
+      "usage: studio-%s --config FILE\n\n%s\n\n"
+      "Runs as a DDS service until SIGINT/SIGTERM; speaks the systemd notify protocol\n"
+      "(READY=1, WATCHDOG=1, STOPPING=1) when $NOTIFY_SOCKET is set.\n\n"
+      "Common config keys (all optional):\n"
+      "  instance: NAME         instance name in studio/service/status (default: host name)\n"
+      "  domain: N              DDS domain id (default: $STUDIO_DDS_DOMAIN, else Cyclone's default)\n"
+      "  dds_config: FILE       Cyclone DDS XML profile (default: $CYCLONEDDS_URI)\n"
+      "  status_period: S       seconds between status samples, 0.1..60 (default 1)\n"
+      "  log: SPEC              log levels, e.g. info,%s=debug (default: $STUDIO_LOG or info)\n\n"
+      "%s keys:\n%s",
+      d.name.c_str(), d.summary.c_str(), d.name.c_str(), d.name.c_str(), d.config_help.c_str());
+}
+
+studio_ServiceState state_of(const NodeHealth& h) { return h.degraded ? studio_SERVICE_DEGRADED : studio_SERVICE_RUNNING; }
+
+}  // namespace
+
+Expected<CommonOptions> read_common_options(yaml::MapReader& config) {
+  CommonOptions o;
+  if (auto n = config.optional("instance")) {
+    auto v = n->as_string();
+    if (!v) return std::unexpected(v.error());
+    if (v->empty() || v->size() > 63) return n->fail("expected a name of 1..63 characters");
+    o.instance = *v;
+  }
+  if (auto n = config.optional("domain")) {
+    auto v = n->as_int();
+    if (!v) return std::unexpected(v.error());
+    if (*v < 0 || *v > 232) return n->fail("expected a DDS domain id in 0..232");
+    o.domain = *v;
+  }
+  if (auto n = config.optional("dds_config")) {
+    auto v = n->as_string();
+    if (!v) return std::unexpected(v.error());
+    if (::access(v->c_str(), R_OK) != 0) return n->fail("cannot read '" + *v + "': " + std::strerror(errno));
+    o.dds_config = "file://" + *v;
+  }
+  if (auto n = config.optional("status_period")) {
+    auto v = n->as_double();
+    if (!v) return std::unexpected(v.error());
+    if (*v < 0.1 || *v > 60) return n->fail("expected seconds in 0.1..60");
+    o.status_period_s = *v;
+  }
+  if (auto n = config.optional("log")) {
+    auto v = n->as_string();
+    if (!v) return std::unexpected(v.error());
+    if (!log::configure(*v)) return n->fail("malformed log spec '" + *v + "' (e.g. info,hull=debug)");
+    o.log_spec = *v;
+  }
+  return o;
+}
+
+int service_main(int argc, char** argv, const ServiceDefinition& definition) {
+  // Before any thread exists (DDS creates threads): signals go to the signalfd only.
+  SignalWatcher signals({SIGINT, SIGTERM});
+  const std::string prog = "studio-" + definition.name;
+
+  std::string config_path;
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    if (a == "-h" || a == "--help") {
+      print_help(definition);
+      return 0;
+    }
+    if (a == "--config" && i + 1 < argc) {
+      config_path = argv[++i];
+    } else if (a.starts_with("--config=")) {
+      config_path = std::string(a.substr(9));
+    } else {
+      std::fprintf(stderr, "%s: unknown argument '%s' (see --help)\n", prog.c_str(), argv[i]);
+      return 2;
+    }
+  }
+  if (config_path.empty()) {
+    std::fprintf(stderr, "%s: --config FILE is required (see --help)\n", prog.c_str());
+    return 2;
+  }
+
+  auto fail = [&](const Error& e) {
+    std::fprintf(stderr, "%s: %s\n", prog.c_str(), e.message.c_str());
+    notify("STATUS=" + e.message);
+    return 1;
+  };
+
+  auto doc = yaml::load_file(config_path);
+  if (!doc) return fail(doc.error());
+  auto reader = yaml::MapReader::from(*doc);
+  if (!reader) return fail(reader.error());
+  auto common = read_common_options(*reader);
+  if (!common) return fail(common.error());
+  if (common->instance.empty()) common->instance = host_name().substr(0, 63);
+
+  auto participant = wire::Participant::create(
+      common->domain >= 0 ? dds_domainid_t(common->domain) : wire::default_domain(), common->dds_config);
+  if (!participant) return fail(participant.error());
+
+  Metrics metrics;
+  NodeContext context{*participant, metrics, common->instance};
+  auto node = definition.create(*reader, context);
+  if (!node) return fail(node.error());
+  if (auto done = reader->finish(); !done) return fail(done.error());
+
+  auto status = StatusPublisher::create(*participant, definition.name, common->instance);
+  if (!status) return fail(status.error());
+  if (auto started = (*node)->start(); !started) {
+    (void)status->publish(studio_SERVICE_FAILED, {}, metrics.snapshot());
+    return fail(started.error());
+  }
+
+  notify("READY=1\nSTATUS=running");
+  STUDIO_LOG(info, kCategory) << definition.name << " (" << common->instance << ") running, pid " << ::getpid();
+
+  using namespace std::chrono;
+  const auto status_period = duration_cast<milliseconds>(duration<double>(common->status_period_s));
+  auto period = status_period;
+  if (auto wd = watchdog_interval()) period = std::min(period, duration_cast<milliseconds>(*wd / 2));
+  auto next_status = steady_clock::now();
+  int signo = 0;
+  while (true) {
+    const auto now = steady_clock::now();
+    if (now >= next_status) {
+      const NodeHealth health = (*node)->health();
+      if (auto r = status->publish(state_of(health), health, metrics.snapshot()); !r)
+        STUDIO_LOG(warn, kCategory) << "status: " << r.error().message;
+      next_status = now + status_period;
+    }
+    notify("WATCHDOG=1");
+    const auto wait = std::min(period, duration_cast<milliseconds>(next_status - steady_clock::now()));
+    if (auto s = signals.wait(std::max(wait, milliseconds(1)))) {
+      signo = *s;
+      break;
+    }
+  }
+
+  STUDIO_LOG(info, kCategory) << "signal " << signo << " (" << strsignal(signo) << "): stopping";
+  notify("STOPPING=1");
+  (*node)->stop();
+  (void)status->publish(studio_SERVICE_STOPPING, (*node)->health(), metrics.snapshot());
+  return 0;
+}
+
+}  // namespace studio::runtime
