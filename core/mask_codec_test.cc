@@ -86,15 +86,22 @@ TEST(MaskCodec, ActorMasksAreSmall) {
 }
 
 TEST(MaskCodec, DecodeReusesStorage) {
-  RunMask out;
   const RunMask a = actor_mask(100, 80, 0.1), b = actor_mask(100, 80, 1.3);
-  ASSERT_TRUE(decode_mask(encode_mask(a), out));
-  EXPECT_EQ(out, a);
-  ASSERT_TRUE(decode_mask(encode_mask(b), out));
-  EXPECT_EQ(out, b);
-  EXPECT_FALSE(decode_mask(std::vector<uint8_t>{1, 2, 3}, out));
-  EXPECT_TRUE(out.valid());
-  EXPECT_EQ(out.area(), 0u);
+  auto ra = decode_mask(encode_mask(a));
+  ASSERT_TRUE(ra);
+  EXPECT_EQ(*ra, a);
+  const studio::Run* storage = ra->runs().data();
+  auto rb = decode_mask(encode_mask(b), std::move(*ra));
+  ASSERT_TRUE(rb);
+  EXPECT_EQ(*rb, b);
+  if (b.runs().size() <= a.runs().size()) {
+    EXPECT_EQ(rb->runs().data(), storage);
+  }
+  EXPECT_FALSE(decode_mask(std::vector<uint8_t>{1, 2, 3}, std::move(*rb)));
+  // A default-constructed mask (no row index) may be passed too.
+  auto rc = decode_mask(encode_mask(a), RunMask());
+  ASSERT_TRUE(rc);
+  EXPECT_EQ(*rc, a);
 }
 
 TEST(MaskCodec, RejectsMalformedHeaders) {
@@ -108,11 +115,11 @@ TEST(MaskCodec, RejectsMalformedHeaders) {
   EXPECT_FALSE(decode_mask(B{kMaskMagic, 1, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x01, 1}));
   const auto err = decode_mask(B{0x00, 2, 1, 1, 0});
   EXPECT_EQ(err.error().message.find('\n'), std::string::npos);
-  auto header = decode_mask_header(encode_mask(RunMask(704, 576)));
-  ASSERT_TRUE(header);
-  EXPECT_EQ(header->width, 704);
-  EXPECT_EQ(header->height, 576);
-  EXPECT_EQ(header->coding, MaskCoding::kRowDelta);
+  auto empty = decode_mask(encode_mask(RunMask(704, 576)));
+  ASSERT_TRUE(empty);
+  EXPECT_EQ(empty->width(), 704);
+  EXPECT_EQ(empty->height(), 576);
+  EXPECT_TRUE(empty->valid());
 }
 
 TEST(MaskCodec, RejectsBadRunsAndTrailingData) {

@@ -164,29 +164,30 @@ void encode_row_delta(const RunMask& mask, std::vector<uint8_t>& out) {
 
 // ---- decoders -----------------------------------------------------------------------------
 
-Expected<void> decode_runs(std::span<const uint8_t> in, std::size_t pos, RunMask& out) {
+// Internal decoders return an error line, empty on success (see read_header on clang 14).
+std::string decode_runs(std::span<const uint8_t> in, std::size_t pos, RunMask& out) {
   const int64_t w = out.width();
   for (int y = 0; y < out.height(); ++y) {
     uint32_t n = 0;
-    if (!get_varint(in, pos, n)) return fail("mask codec: truncated run count in row " + std::to_string(y));
-    if (int64_t(n) > (w + 1) / 2) return fail("mask codec: row " + std::to_string(y) + " has too many runs");
+    if (!get_varint(in, pos, n)) return std::string("mask codec: truncated run count in row " + std::to_string(y));
+    if (int64_t(n) > (w + 1) / 2) return std::string("mask codec: row " + std::to_string(y) + " has too many runs");
     int64_t prev_end = -1;
     for (uint32_t i = 0; i < n; ++i) {
       uint32_t gap = 0, len = 0;
       if (!get_varint(in, pos, gap) || !get_varint(in, pos, len))
-        return fail("mask codec: truncated run in row " + std::to_string(y));
+        return std::string("mask codec: truncated run in row " + std::to_string(y));
       const int64_t begin = prev_end + 1 + int64_t(gap);
       const int64_t end = begin + int64_t(len) + 1;
-      if (end > w) return fail("mask codec: run leaves row " + std::to_string(y));
+      if (end > w) return std::string("mask codec: run leaves row " + std::to_string(y));
       out.push_run(y, int32_t(begin), int32_t(end));
       prev_end = end;
     }
   }
-  if (pos != in.size()) return fail("mask codec: trailing bytes after the last row");
+  if (pos != in.size()) return std::string("mask codec: trailing bytes after the last row");
   return {};
 }
 
-Expected<void> decode_row_delta(std::span<const uint8_t> in, std::size_t pos, RunMask& out) {
+std::string decode_row_delta(std::span<const uint8_t> in, std::size_t pos, RunMask& out) {
   BitReader r(in.subspan(pos));
   const int64_t w = out.width();
   std::size_t above_begin = 0, above_end = 0;  // runs of the row above, as indices into out
@@ -206,51 +207,59 @@ Expected<void> decode_row_delta(std::span<const uint8_t> in, std::size_t pos, Ru
           }
           t[k] = (k == 0 ? a.begin : a.end) + v;
         }
-        if (r.overrun()) return fail("mask codec: truncated data in row " + std::to_string(y));
+        if (r.overrun()) return std::string("mask codec: truncated data in row " + std::to_string(y));
         if (t[0] <= prev_end || t[1] <= t[0] || t[1] > w)
-          return fail("mask codec: malformed runs in row " + std::to_string(y));
+          return std::string("mask codec: malformed runs in row " + std::to_string(y));
         out.push_run(y, int32_t(t[0]), int32_t(t[1]));
         prev_end = t[1];
       }
     } else {
       const uint32_t n = r.eg(0);
-      if (r.overrun()) return fail("mask codec: truncated data in row " + std::to_string(y));
-      if (int64_t(n) > (w + 1) / 2) return fail("mask codec: row " + std::to_string(y) + " has too many runs");
+      if (r.overrun()) return std::string("mask codec: truncated data in row " + std::to_string(y));
+      if (int64_t(n) > (w + 1) / 2) return std::string("mask codec: row " + std::to_string(y) + " has too many runs");
       if (n == above_end - above_begin)  // the encoder codes such a row as deltas: not canonical
-        return fail("mask codec: explicit row " + std::to_string(y) + " repeats the run count above");
+        return std::string("mask codec: explicit row " + std::to_string(y) + " repeats the run count above");
       int64_t prev_end = -1;
       for (uint32_t i = 0; i < n; ++i) {
         const int64_t begin = prev_end + 1 + int64_t(r.eg(2));
         const int64_t end = begin + 1 + int64_t(r.eg(2));
-        if (r.overrun()) return fail("mask codec: truncated data in row " + std::to_string(y));
-        if (end > w) return fail("mask codec: run leaves row " + std::to_string(y));
+        if (r.overrun()) return std::string("mask codec: truncated data in row " + std::to_string(y));
+        if (end > w) return std::string("mask codec: run leaves row " + std::to_string(y));
         out.push_run(y, int32_t(begin), int32_t(end));
         prev_end = end;
       }
     }
-    if (r.overrun()) return fail("mask codec: truncated data in row " + std::to_string(y));
+    if (r.overrun()) return std::string("mask codec: truncated data in row " + std::to_string(y));
     above_begin = row_begin;
     above_end = out.runs().size();
   }
-  if (!r.at_clean_end()) return fail("mask codec: trailing data after the last row");
+  if (!r.at_clean_end()) return std::string("mask codec: trailing data after the last row");
   return {};
 }
 
-Expected<std::size_t> read_header(std::span<const uint8_t> in, MaskHeader& h) {
-  if (in.size() < 2) return fail("mask codec: input too short for a header");
-  if (in[0] != kMaskMagic) return fail("mask codec: bad magic byte");
+// Not Expected<void>: clang 14 (the fuzz preset) cannot destroy a std::expected whose value type
+// is trivially destructible (or void) and whose error type is not (no P0848).
+struct Header {
+  int width = 0;
+  int height = 0;
+  MaskCoding coding = MaskCoding::kRowDelta;
+};
+
+std::string read_header(std::span<const uint8_t> in, Header& h, std::size_t& pos) {
+  if (in.size() < 2) return std::string("mask codec: input too short for a header");
+  if (in[0] != kMaskMagic) return std::string("mask codec: bad magic byte");
   if (in[1] != uint8_t(MaskCoding::kRuns) && in[1] != uint8_t(MaskCoding::kRowDelta))
-    return fail("mask codec: unknown coding " + std::to_string(in[1]));
+    return std::string("mask codec: unknown coding " + std::to_string(in[1]));
   h.coding = MaskCoding(in[1]);
-  std::size_t pos = 2;
+  pos = 2;
   uint32_t w = 0, hh = 0;
-  if (!get_varint(in, pos, w) || !get_varint(in, pos, hh)) return fail("mask codec: truncated header");
+  if (!get_varint(in, pos, w) || !get_varint(in, pos, hh)) return std::string("mask codec: truncated header");
   if (w > uint32_t(kMaxMaskSide) || hh > uint32_t(kMaxMaskSide))
-    return fail("mask codec: mask size " + std::to_string(w) + "x" + std::to_string(hh) +
+    return std::string("mask codec: mask size " + std::to_string(w) + "x" + std::to_string(hh) +
                 " over the limit " + std::to_string(kMaxMaskSide));
   h.width = int(w);
   h.height = int(hh);
-  return pos;
+  return {};
 }
 
 }  // namespace
@@ -280,39 +289,24 @@ std::vector<uint8_t> encode_mask(const RunMask& mask, MaskCoding coding) {
   return out;
 }
 
-Expected<MaskHeader> decode_mask_header(std::span<const uint8_t> bytes) {
-  MaskHeader h;
-  auto pos = read_header(bytes, h);
-  if (!pos) return std::unexpected(pos.error());
-  return h;
-}
-
-Expected<void> decode_mask(std::span<const uint8_t> bytes, RunMask& out) {
-  MaskHeader h;
-  auto pos = read_header(bytes, h);
-  if (!pos) {
-    out = RunMask(0, 0);  // valid (a default RunMask has no row index)
-    return std::unexpected(pos.error());
-  }
-  if (out.width() == h.width && out.height() == h.height)
+std::string detail::decode_mask_into(std::span<const uint8_t> bytes, RunMask& out) {
+  Header h;
+  std::size_t pos = 0;
+  if (std::string e = read_header(bytes, h, pos); !e.empty()) return e;
+  if (out.width() == h.width && out.height() == h.height &&
+      out.row_start().size() == std::size_t(h.height) + 1)
     out.clear();
   else
     out = RunMask(h.width, h.height);
-  Expected<void> result = h.coding == MaskCoding::kRuns ? decode_runs(bytes, *pos, out)
-                                                        : decode_row_delta(bytes, *pos, out);
-  if (!result) {
-    out.clear();
-    return result;
-  }
-  out.finish();
-  return {};
+  std::string e = h.coding == MaskCoding::kRuns ? decode_runs(bytes, pos, out)
+                                                : decode_row_delta(bytes, pos, out);
+  if (e.empty()) out.finish();
+  return e;
 }
 
-Expected<RunMask> decode_mask(std::span<const uint8_t> bytes) {
-  RunMask mask(0, 0);
-  auto r = decode_mask(bytes, mask);
-  if (!r) return std::unexpected(r.error());
-  return mask;
+Expected<RunMask> decode_mask(std::span<const uint8_t> bytes, RunMask reuse) {
+  if (std::string e = detail::decode_mask_into(bytes, reuse); !e.empty()) return fail(std::move(e));
+  return reuse;  // implicitly moved
 }
 
 }  // namespace studio

@@ -31,6 +31,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
@@ -46,23 +47,22 @@ enum class MaskCoding : uint8_t {
 inline constexpr uint8_t kMaskMagic = 0x4D;
 inline constexpr int kMaxMaskSide = 32768;
 
-struct MaskHeader {
-  int width = 0;
-  int height = 0;
-  MaskCoding coding = MaskCoding::kRowDelta;
-};
-
 // Appends nothing; replaces `out` (its capacity is reused). Precondition: mask.valid() and both
 // sides <= kMaxMaskSide (std::invalid_argument otherwise: a programming error).
 void encode_mask(const RunMask& mask, MaskCoding coding, std::vector<uint8_t>& out);
 std::vector<uint8_t> encode_mask(const RunMask& mask, MaskCoding coding = MaskCoding::kRowDelta);
 
-// Reads only the header (magic, coding, sizes).
-Expected<MaskHeader> decode_mask_header(std::span<const uint8_t> bytes);
+// Decodes a mask. To reuse storage frame after frame, move the previous mask in:
+//   auto r = decode_mask(bytes, std::move(mask)); if (r) mask = std::move(*r);
+// (The API has no Expected<void> overload on purpose: clang 14, which builds the fuzzers, cannot
+// compile std::expected<void, Error>.)
+Expected<RunMask> decode_mask(std::span<const uint8_t> bytes, RunMask reuse = RunMask(0, 0));
 
-// Decodes into `out`, reusing its storage when the size matches. On error `out` is a valid mask
-// with no runs.
-Expected<void> decode_mask(std::span<const uint8_t> bytes, RunMask& out);
-Expected<RunMask> decode_mask(std::span<const uint8_t> bytes);
+namespace detail {
+// The decoder behind decode_mask(): an error line, or "" with the mask in `out` (on error `out`
+// holds garbage runs of the right size). For the libFuzzer target, which is built by clang 14
+// and so cannot destroy any std::expected<T, studio::Error>.
+std::string decode_mask_into(std::span<const uint8_t> bytes, RunMask& out);
+}  // namespace detail
 
 }  // namespace studio
