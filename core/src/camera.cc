@@ -47,6 +47,12 @@ Eigen::Vector2d apply(const Coefficients& c, const Eigen::Vector2d& p, Eigen::Ma
 
 bool finite(const Eigen::Vector3d& v) { return v.allFinite(); }
 
+// Overflow on extreme inputs must not leak out as a camera with infinite or NaN parameters.
+bool finite(const Intrinsics& k, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  return std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) && std::isfinite(k.cy) &&
+         std::isfinite(k.skew) && k.fx > 0 && k.fy > 0 && R.allFinite() && t.allFinite();
+}
+
 }  // namespace
 
 Distortion Distortion::radial(double rd3, double rd5) {
@@ -211,6 +217,7 @@ Expected<Camera> camera_from_cahv(const Cahv& cahv, int width, int height) {
   R.row(0) = h.transpose();
   R.row(1) = v.transpose();
   R.row(2) = A.transpose();
+  if (!finite(k, R, -(R * cahv.C))) return fail("CAHV: numerically degenerate (overflow)");
   Camera camera;
   camera.width = width;
   camera.height = height;
@@ -256,10 +263,12 @@ Expected<Camera> camera_from_projection_matrix(const Eigen::Matrix<double, 3, 4>
   // K has been forced exactly upper triangular by construction; t = K^-1 p4 before scaling K.
   const Eigen::Vector3d t = K.triangularView<Eigen::Upper>().solve(p4);
   if (R.determinant() < 0) return fail("P: decomposition gave an improper rotation");
+  const Intrinsics intrinsics = Intrinsics::from_K(K);
+  if (!finite(intrinsics, R, t)) return fail("P: numerically degenerate (overflow)");
   Camera camera;
   camera.width = width;
   camera.height = height;
-  camera.intrinsics = Intrinsics::from_K(K);
+  camera.intrinsics = intrinsics;
   camera.cam_from_world = Rigid3(R, t);
   return camera;
 }

@@ -49,9 +49,14 @@ std::string at(const std::string& path, int line) { return path + ":" + std::to_
 
 Expected<Rig> import_projection_matrices(const std::string& path, int width, int height,
                                          std::string_view id_prefix) {
-  if (width <= 0 || height <= 0) return fail(path + ": image size must be positive");
   Expected<std::string> text = read_text(path);
   if (!text) return std::unexpected(text.error());
+  return parse_projection_matrices(*text, path, width, height, id_prefix);
+}
+
+Expected<Rig> parse_projection_matrices(std::string_view text, const std::string& path, int width,
+                                        int height, std::string_view id_prefix) {
+  if (width <= 0 || height <= 0) return fail(path + ": image size must be positive");
   std::vector<Token> tokens;
   int line = 1;
   std::string current;
@@ -60,7 +65,7 @@ Expected<Rig> import_projection_matrices(const std::string& path, int width, int
     if (!current.empty()) tokens.push_back({std::move(current), line});
     current.clear();
   };
-  for (char ch : *text) {
+  for (char ch : text) {
     if (ch == '\n') {
       flush();
       ++line;
@@ -102,10 +107,15 @@ Expected<Rig> import_projection_matrices(const std::string& path, int width, int
 }
 
 Expected<Rig> import_middlebury(const std::string& path, int width, int height) {
-  if (width <= 0 || height <= 0) return fail(path + ": image size must be positive");
   Expected<std::string> text = read_text(path);
   if (!text) return std::unexpected(text.error());
-  std::istringstream in(*text);
+  return parse_middlebury(*text, path, width, height);
+}
+
+Expected<Rig> parse_middlebury(std::string_view text, const std::string& path, int width,
+                               int height) {
+  if (width <= 0 || height <= 0) return fail(path + ": image size must be positive");
+  std::istringstream in{std::string(text)};
   std::string row;
   int line = 0;
   long count = -1;

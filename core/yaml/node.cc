@@ -43,6 +43,16 @@ std::string child_path(const std::string& parent, std::string_view key) {
   return parent.empty() ? std::string(key) : parent + "." + std::string(key);
 }
 
+// Messages are one line of reasonable length whatever the file holds: control characters become
+// '?', and very long messages (huge scalars quoted back) are shortened in the middle.
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  if (text.size() > 400) text = text.substr(0, 300) + "..." + text.substr(text.size() - 80);
+  return text;
+}
+
 std::string plural(std::size_t n, const char* word) {
   return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
 }
@@ -70,7 +80,7 @@ Error Node::error(std::string_view message) const {
   std::string text = file() + ":" + std::to_string(line()) + ": ";
   if (!path().empty()) text += path() + ": ";
   text += message;
-  return Error{std::move(text)};
+  return Error{one_line(std::move(text))};
 }
 
 Expected<std::string> Node::as_string() const {
@@ -191,9 +201,9 @@ Expected<Node> parse(std::string_view text, const std::string& name) {
     return make(file, "", root, line_of(root, 1));
   } catch (const YAML::Exception& e) {
     const int line = e.mark.is_null() ? 1 : e.mark.line + 1;
-    return studio::fail(name + ":" + std::to_string(line) + ": not valid YAML: " + e.msg);
+    return studio::fail(one_line(name + ":" + std::to_string(line) + ": not valid YAML: " + e.msg));
   } catch (const std::exception& e) {  // e.g. std::bad_alloc on absurd inputs
-    return studio::fail(name + ": cannot parse YAML: " + e.what());
+    return studio::fail(one_line(name + ": cannot parse YAML: " + e.what()));
   }
 }
 
@@ -231,10 +241,8 @@ std::optional<Node> MapReader::optional(std::string_view key) {
 
 Expected<Node> MapReader::required(std::string_view key) {
   if (std::optional<Node> n = optional(key)) return *n;
-  Error e = node_.error("");
-  e.message = node_.file() + ":" + std::to_string(node_.line()) + ": " +
-              child_path(node_.path(), key) + ": missing required key";
-  return std::unexpected(std::move(e));
+  return std::unexpected(Error{one_line(node_.file() + ":" + std::to_string(node_.line()) + ": " +
+                                        child_path(node_.path(), key) + ": missing required key")});
 }
 
 Expected<std::optional<std::string>> MapReader::one_of(std::vector<std::string_view> keys,
@@ -257,8 +265,8 @@ Expected<void> MapReader::finish() const {
   for (std::size_t i = 0; i < entries_.size(); ++i) {
     if (!used_[i]) {
       const Node& n = entries_[i].second;
-      return std::unexpected(Error{n.file() + ":" + std::to_string(n.line()) + ": " + n.path() +
-                                   ": unknown key"});
+      return std::unexpected(Error{one_line(n.file() + ":" + std::to_string(n.line()) + ": " +
+                                            n.path() + ": unknown key")});
     }
   }
   return {};

@@ -64,4 +64,10 @@ Expected<Rig> import_projection_matrices(const std::string& path, int width, int
 // with x_in_cam = R x_in_world + t. Camera ids are the image names without extension.
 Expected<Rig> import_middlebury(const std::string& path, int width, int height);
 
+// The same importers on text already in memory; `name` stands for the file in messages.
+Expected<Rig> parse_projection_matrices(std::string_view text, const std::string& name, int width,
+                                        int height, std::string_view id_prefix = "cam");
+Expected<Rig> parse_middlebury(std::string_view text, const std::string& name, int width,
+                               int height);
+
 }  // namespace studio
