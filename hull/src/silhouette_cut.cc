@@ -10,9 +10,7 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-struct Range {
-  double lo, hi;
-};
+using Range = CutScratch::Piece;
 
 // Restricts [lo, hi] to the t where alpha + t beta >= 0.
 inline void clip_halfline(double alpha, double beta, double& lo, double& hi) {
@@ -155,8 +153,9 @@ struct PreparedView::Impl {
   Rect ideal_image{};  // where the distortion model is trusted (ideal pixels)
   // Pencil bins.
   bool pencil = false;
+  bool all_inside = false;  // the whole domain projects in front of the camera, inside the image
   Vec3 V = Vec3::Zero();
-  double vref = 0, smin = 0, ds = 0.5;
+  double vref = 0, smin = 0, ds = 0.5, inv_ds = 2.0;
   int nbins = 0;
   std::vector<uint32_t> bin_start;
   std::vector<float> bin_v;  // pairs (v0, v1) per run, in ideal pixel rows
@@ -242,17 +241,35 @@ void PreparedView::Impl::build_pencil(const Eigen::Vector4d& X) {
 void PreparedView::Impl::cut_pencil(const Vec3& A, const Vec3& B, std::span<const Interval> in,
                                     std::vector<Range>* keep) const {
   const double lo = in.front().lo, hi = in.back().hi;
-  const Range inside = in_rect(A, B, image, lo, hi);
-  if (!(inside.lo < inside.hi)) {
-    if (keep_outside) keep->push_back({lo, hi});
-    return;
+  // Whole span in front and inside the image when both end points are (w is linear in t and
+  // the image rectangle convex); otherwise clip.
+  Range inside{lo, hi};
+  const double w0 = A[2] + lo * B[2], w1 = A[2] + hi * B[2];
+  bool whole = all_inside;
+  if (!whole && w0 > 1e-12 && w1 > 1e-12) {
+    const double i0 = 1 / w0, i1 = 1 / w1;
+    const double u0 = (A[0] + lo * B[0]) * i0, v0 = (A[1] + lo * B[1]) * i0;
+    const double u1 = (A[0] + hi * B[0]) * i1, v1 = (A[1] + hi * B[1]) * i1;
+    whole = u0 >= image.u0 && u0 <= image.u1 && v0 >= image.v0 && v0 <= image.v1 &&
+            u1 >= image.u0 && u1 <= image.u1 && v1 >= image.v0 && v1 <= image.v1;
   }
-  if (keep_outside) keep->push_back({lo, inside.lo});
+  if (!whole) {
+    inside = in_rect(A, B, image, lo, hi);
+    if (!(inside.lo < inside.hi)) {
+      if (keep_outside) keep->push_back({lo, hi});
+      return;
+    }
+    if (keep_outside) keep->push_back({lo, inside.lo});
+  }
+  // Pencil coordinate of the line from one of its image points x = A + tm B (homogeneous):
+  // s = u + d0 (vref - v) / d1 with u = x0/x2, v = x1/x2, d = V - V2 (u, v), in one division.
   const double tm = 0.5 * (inside.lo + inside.hi);
-  const double w = A[2] + tm * B[2];
-  const double s = pencil_s((A[0] + tm * B[0]) / w, (A[1] + tm * B[1]) / w);
-  const int k = int(std::floor((s - smin) / ds));
-  if (k >= 0 && k < nbins) {
+  const double x0 = A[0] + tm * B[0], x1 = A[1] + tm * B[1], x2 = A[2] + tm * B[2];
+  const double e0 = V[0] * x2 - V[2] * x0, e1 = V[1] * x2 - V[2] * x1;
+  const double s = (x0 * e1 + e0 * (vref * x2 - x1)) / (x2 * e1);
+  const double kf = std::floor((s - smin) * inv_ds);
+  if (kf >= 0 && kf < nbins) {
+    const int k = int(kf);
     const std::size_t from = keep->size();
     for (uint32_t r = bin_start[k]; r < bin_start[k + 1]; ++r) {
       const double y0 = bin_v[2 * r], y1 = bin_v[2 * r + 1];
@@ -266,7 +283,7 @@ void PreparedView::Impl::cut_pencil(const Vec3& A, const Vec3& B, std::span<cons
       std::reverse(keep->begin() + std::ptrdiff_t(from), keep->end());
     }
   }
-  if (keep_outside) keep->push_back({inside.hi, hi});
+  if (keep_outside && !whole) keep->push_back({inside.hi, hi});
 }
 
 void PreparedView::Impl::cut_walk(const Vec3& A, const Vec3& B, std::span<const Interval> in,
@@ -333,7 +350,8 @@ PreparedView::~PreparedView() = default;
 
 Expected<PreparedView> PreparedView::create(const Camera& camera, const RunMask& mask,
                                             const Eigen::Vector4d& pencil_point,
-                                            const CutOptions& options) {
+                                            const CutOptions& options,
+                                            const Eigen::AlignedBox3d* domain) {
   if (mask.width() != camera.width || mask.height() != camera.height) {
     return fail("camera " + camera.id + ": mask is " + std::to_string(mask.width()) + "x" +
                 std::to_string(mask.height()) + ", camera is " + std::to_string(camera.width) + "x" +
@@ -370,28 +388,45 @@ Expected<PreparedView> PreparedView::create(const Camera& camera, const RunMask&
   } else if (options.allow_pencil) {
     m.build_pencil(pencil_point);
   }
+  if (domain != nullptr && !m.distorted) {
+    m.all_inside = true;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 x = domain->corner(Eigen::AlignedBox3d::CornerType(k));
+      const Vec3 h = m.P.leftCols<3>() * x + m.P.col(3);
+      m.all_inside = m.all_inside && h[2] > 1e-9 && h[0] / h[2] >= m.image.u0 &&
+                     h[0] / h[2] <= m.image.u1 && h[1] / h[2] >= m.image.v0 &&
+                     h[1] / h[2] <= m.image.v1;
+    }
+  }
   return view;
 }
 
 bool PreparedView::uses_pencil() const { return impl_->pencil; }
+bool PreparedView::domain_inside_image() const { return impl_->all_inside; }
 
 void PreparedView::cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
-                            std::span<const Interval> in, std::vector<Interval>* out) const {
+                            std::span<const Interval> in, std::vector<Interval>* out,
+                            CutScratch* scratch) const {
   if (in.empty()) return;
-  thread_local std::vector<Range> keep;
+  std::vector<Range>& keep = scratch->keep;
+  std::vector<Range>& result = scratch->result;
   keep.clear();
   const Impl& m = *impl_;
-  const Vec3 A = m.P.leftCols<3>() * o + m.P.col(3);
-  const Vec3 B = m.P.leftCols<3>() * d;
+  const double* P = m.P.data();  // column-major 3x4
+  const Vec3 A(P[0] * o[0] + P[3] * o[1] + P[6] * o[2] + P[9],
+               P[1] * o[0] + P[4] * o[1] + P[7] * o[2] + P[10],
+               P[2] * o[0] + P[5] * o[1] + P[8] * o[2] + P[11]);
+  const Vec3 B(P[0] * d[0] + P[3] * d[1] + P[6] * d[2], P[1] * d[0] + P[4] * d[1] + P[7] * d[2],
+               P[2] * d[0] + P[5] * d[1] + P[8] * d[2]);
   if (m.pencil) {
     m.cut_pencil(A, B, in, &keep);
+    if (keep.empty()) return;
   } else if (m.distorted) {
     m.cut_walk_distorted(A, B, in, &keep);
   } else {
     m.cut_walk(A, B, in, &keep);
   }
   // out = in ∩ keep (keep is sorted; touching pieces are merged by emit()).
-  thread_local std::vector<Range> result;
   result.clear();
   std::size_t p = 0;
   for (const Interval& iv : in) {
@@ -412,7 +447,8 @@ Expected<void> cut(SegmentSet& set, std::span<const View> views, const CutOption
   std::vector<PreparedView> prepared;
   prepared.reserve(views.size());
   for (const View& v : views) {
-    auto p = PreparedView::create(*v.camera, *v.mask, X, options);
+    const Eigen::AlignedBox3d domain(g.box_min, g.box_max);
+    auto p = PreparedView::create(*v.camera, *v.mask, X, options, &domain);
     if (!p) return std::unexpected(p.error());
     prepared.push_back(std::move(*p));
   }
@@ -429,16 +465,21 @@ Expected<void> cut(SegmentSet& set, std::span<const View> views, const CutOption
     out.reserve(set.start()[c1] - set.start()[c0]);
     count.resize(c1 - c0);
     std::vector<Interval> a, b;
+    CutScratch scratch;
+    const double du = g.du(), dv = g.dv();
     for (std::size_t c = c0; c < c1; ++c) {
       const auto col = set.column(c);
       const std::size_t before = out.size();
       if (!col.empty()) {
         const int i = int(c % std::size_t(g.cells_u)), j = int(c / std::size_t(g.cells_u));
-        const Vec3 o = g.point(i, j, 0.0);
+        Vec3 o;
+        o[g.u()] = g.box_min[g.u()] + (i + 0.5) * du;
+        o[g.v()] = g.box_min[g.v()] + (j + 0.5) * dv;
+        o[g.a()] = 0;
         a.assign(col.begin(), col.end());
         for (const PreparedView& view : prepared) {
           b.clear();
-          view.cut_line(o, d, a, &b);
+          view.cut_line(o, d, a, &b, &scratch);
           std::swap(a, b);
           if (a.empty()) break;
         }

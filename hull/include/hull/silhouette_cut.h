@@ -22,6 +22,7 @@
 // Parts of a line outside an image (or behind the camera) are kept or cut by Options::outside.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <memory>
 #include <span>
 #include <vector>
@@ -42,23 +43,35 @@ struct CutOptions {
   Expected<void> validate() const;
 };
 
+// Reusable working memory for PreparedView::cut_line (one per thread).
+struct CutScratch {
+  struct Piece {
+    double lo, hi;
+  };
+  std::vector<Piece> keep, result;
+};
+
 // A camera and its silhouette, prepared for cutting a family of lines through a common
 // homogeneous point `pencil_point` (for grid columns: (e_axis, 0); for rays of a viewpoint:
 // (centre, 1)). Preparing costs the mask's boundary length; cutting is thread-safe.
 class PreparedView {
  public:
-  // Fails when the mask size differs from the camera's.
+  // Fails when the mask size differs from the camera's. `domain`, when given, is a box holding
+  // every interval that will be cut; if it projects entirely inside the image (in front of the
+  // camera) the per-line in-image test is skipped.
   static Expected<PreparedView> create(const Camera& camera, const RunMask& mask,
-                                       const Eigen::Vector4d& pencil_point, const CutOptions& options);
+                                       const Eigen::Vector4d& pencil_point, const CutOptions& options,
+                                       const Eigen::AlignedBox3d* domain = nullptr);
   PreparedView(PreparedView&&) noexcept;
   PreparedView& operator=(PreparedView&&) noexcept;
   ~PreparedView();
 
   bool uses_pencil() const;
+  bool domain_inside_image() const;
   // Cuts the sorted intervals `in` of the line o + t d; appends the surviving intervals (sorted,
-  // disjoint) to *out. `scratch` is reused between calls.
+  // disjoint) to *out. `scratch` is reused between calls (one per thread).
   void cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d, std::span<const Interval> in,
-                std::vector<Interval>* out) const;
+                std::vector<Interval>* out, CutScratch* scratch) const;
 
  private:
   PreparedView();
