@@ -70,7 +70,8 @@ TEST(HeadTracker, KeepsIdentitiesOfTwoActorsAndNumbersNewOnes) {
     const auto poses = t.update(d, int64_t(f) * kFrameNs);
     ASSERT_EQ(poses.size(), 2u);
     for (const auto& p : poses) {
-      if (p.actor_id == 1) EXPECT_NEAR(p.position.z(), 0, 0.02);
+      if (p.actor_id == 1)
+        EXPECT_NEAR(p.position.z(), 0, 0.02);
       else {
         EXPECT_EQ(p.actor_id, 2u);
         EXPECT_NEAR(p.position.z(), 0.6, 0.02);

@@ -29,7 +29,8 @@ TEST(IntegralVolume, BoxCountsMatchBruteForceIncludingClippedAndEmptyBoxes) {
   std::uniform_int_distribution<int> c(-5, 22);
   for (int i = 0; i < 2000; ++i) {
     const Eigen::Vector3i lo(c(rng), c(rng), c(rng)), hi(c(rng), c(rng), c(rng));
-    ASSERT_EQ(iv.count(lo, hi), brute_count(g, lo, hi)) << lo.transpose() << " / " << hi.transpose();
+    ASSERT_EQ(iv.count(lo, hi), brute_count(g, lo, hi))
+        << lo.transpose() << " / " << hi.transpose();
   }
 }
 

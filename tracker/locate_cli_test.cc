@@ -3,11 +3,11 @@
 // give a non-zero exit and one line on stderr.
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <regex>
 #include <string>
 
@@ -26,9 +26,10 @@ struct Exec {
 };
 
 Exec run(const std::string& args) {
-  const fs::path err = fs::temp_directory_path() / ("tracker_cli_err_" + std::to_string(::getpid()));
-  const std::string cmd = std::string(STUDIO_BINARY_DIR) + "/tracker/studio-tracker " + args +
-                          " 2>" + err.string();
+  const fs::path err =
+      fs::temp_directory_path() / ("tracker_cli_err_" + std::to_string(::getpid()));
+  const std::string cmd =
+      std::string(STUDIO_BINARY_DIR) + "/tracker/studio-tracker " + args + " 2>" + err.string();
   Exec r;
   FILE* p = ::popen(cmd.c_str(), "r");
   std::array<char, 4096> buf;
@@ -70,12 +71,14 @@ class LocateCli : public ::testing::Test {
     delete dir_;
   }
   static std::string base() {
-    return "locate --rig " + (*dir_ / "rig.yaml").string() + " --box -1.6,0,-1.6,1.6,2.6,1.6 --grid 128";
+    return "locate --rig " + (*dir_ / "rig.yaml").string() +
+           " --box -1.6,0,-1.6,1.6,2.6,1.6 --grid 128";
   }
   static std::vector<Eigen::Vector3d> positions(const std::string& json) {
     std::vector<Eigen::Vector3d> out;
     const std::regex re(R"re("position": \[([-0-9.e]+), ([-0-9.e]+), ([-0-9.e]+)\])re");
-    for (auto it = std::sregex_iterator(json.begin(), json.end(), re); it != std::sregex_iterator(); ++it)
+    for (auto it = std::sregex_iterator(json.begin(), json.end(), re); it != std::sregex_iterator();
+         ++it)
       out.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3]));
     return out;
   }

@@ -64,10 +64,11 @@ Result run(sim::Motion motion, int frames, int step, int columns = 128) {
     r.nearest_hand = std::min(
         r.nearest_hand, (heads[0].position - truth.body.part(sim::PartId::hand_r).centre).norm());
     if (std::getenv("TRACKER_VERBOSE"))
-      std::printf("frame %3d err %.3f est %.3f %.3f %.3f truth %.3f %.3f %.3f heads %zu conf %.2f\n",
-                  f, e, heads[0].position.x(), heads[0].position.y(), heads[0].position.z(),
-                  truth.head_centre().x(), truth.head_centre().y(), truth.head_centre().z(),
-                  heads.size(), heads[0].confidence);
+      std::printf(
+          "frame %3d err %.3f est %.3f %.3f %.3f truth %.3f %.3f %.3f heads %zu conf %.2f\n", f, e,
+          heads[0].position.x(), heads[0].position.y(), heads[0].position.z(),
+          truth.head_centre().x(), truth.head_centre().y(), truth.head_centre().z(), heads.size(),
+          heads[0].confidence);
   }
   r.rms = std::sqrt(sum2 / std::max(1, r.frames - r.missed));
   std::printf("%s: %d frames, head centre error %.1f mm RMS, worst %.1f mm, missed %d\n",
@@ -97,7 +98,7 @@ TEST(SimAccuracy, HandRaisedAboveTheHeadIsNeverTakenForIt) {
   const Result r = run(sim::Motion::raise_hand, 100, 4);
   EXPECT_EQ(r.missed, 0);
   EXPECT_LE(r.rms, 0.03);
-  EXPECT_LT(r.worst, 0.08);         // every frame on the head, none on the hand
+  EXPECT_LT(r.worst, 0.08);  // every frame on the head, none on the hand
   EXPECT_GT(r.nearest_hand, 0.15);
 }
 

@@ -1,6 +1,6 @@
-// Head tracker benchmarks (./studio bench tracker): the full-volume template search (TCSVT 2004 §IV-D; the paper ran
-// ~5 searches/s at 64x64 columns) by branch and bound over an integral volume, against the
-// exhaustive evaluation of M(P) at every position (same binary: the "speedup" counter).
+// Head tracker benchmarks (./studio bench tracker): the full-volume template search (TCSVT 2004
+// §IV-D; the paper ran ~5 searches/s at 64x64 columns) by branch and bound over an integral volume,
+// against the exhaustive evaluation of M(P) at every position (same binary: the "speedup" counter).
 //
 // A search = integral volume build + exact maximum over every template position + NMS +
 // sub-voxel centre. Grids: 128 columns over a 3 m x 2.4 m x 3 m studio (2.34 cm voxels),
@@ -134,7 +134,8 @@ void BM_HeadSearchVsExhaustive(benchmark::State& state) {
     benchmark::DoNotOptimize(s.find(g).data());
     ++n;
   } while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(300));
-  const double fast = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / n;
+  const double fast =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / n;
   const double slow = seconds_per_exhaustive(s, g);
   state.SetItemsProcessed(state.iterations());
   state.counters["exhaustive_per_s"] = 1.0 / slow;

@@ -7,12 +7,11 @@
 //
 // The DDS node (studio-tracker --config) is not part of this binary yet.
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -103,10 +102,14 @@ int locate(int argc, char** argv) {
     if (i + 1 >= argc) return fail_line("option " + a + " needs a value (see --help)");
     const std::string v = argv[++i];
     char* end = nullptr;
-    if (a == "--rig") rig_path = v;
-    else if (a == "--masks") masks_dir = v;
-    else if (a == "--box") box_text = v;
-    else if (a == "--axis") axis_text = v;
+    if (a == "--rig")
+      rig_path = v;
+    else if (a == "--masks")
+      masks_dir = v;
+    else if (a == "--box")
+      box_text = v;
+    else if (a == "--axis")
+      axis_text = v;
     else if (a == "--grid") {
       const long n = std::strtol(v.c_str(), &end, 10);
       if (*end || n < 4 || n > 4096) return fail_line("--grid: expected an integer in [4, 4096]");
@@ -160,7 +163,8 @@ int locate(int argc, char** argv) {
     const auto masks = load_masks(*rig, frames[f]);
     if (!masks) return fail_line(masks.error().message);
     std::vector<hull::View> views;
-    for (std::size_t c = 0; c < rig->cameras.size(); ++c) views.push_back({&rig->cameras[c], &(*masks)[c]});
+    for (std::size_t c = 0; c < rig->cameras.size(); ++c)
+      views.push_back({&rig->cameras[c], &(*masks)[c]});
     const auto set = hull::visual_hull(spec, views);
     if (!set) return fail_line(set.error().message);
     tracker::rasterise(*set, &occupancy);
@@ -169,7 +173,8 @@ int locate(int argc, char** argv) {
       out = "{\"heads\": " + heads_json(heads) + "}";
     } else {
       out += (f ? ",\n  " : "{\"frames\": [\n  ");
-      out += "{\"frame\": \"" + frames[f].filename().string() + "\", \"heads\": " + heads_json(heads) + "}";
+      out += "{\"frame\": \"" + frames[f].filename().string() +
+             "\", \"heads\": " + heads_json(heads) + "}";
       std::fprintf(stderr, "\rstudio-tracker: frame %zu/%zu", f + 1, frames.size());
     }
   }

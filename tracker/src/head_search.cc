@@ -41,8 +41,8 @@ bool HeadSearch::prepare(const OccupancyGrid& grid) {
   voxel_ = grid.voxel();
   for (int a = 0; a < 3; ++a) {
     s2_[a] = std::max(1, int(std::lround(options_.head_box[a] / voxel_[a])));
-    const int m = std::max(0, int(std::lround((options_.outer_box[a] - options_.head_box[a]) / 2 /
-                                              voxel_[a])));
+    const int m = std::max(
+        0, int(std::lround((options_.outer_box[a] - options_.head_box[a]) / 2 / voxel_[a])));
     m_lo_[a] = m;
     m_hi_[a] = m;
   }
@@ -112,10 +112,12 @@ HeadDetection HeadSearch::make_detection(const OccupancyGrid& grid, const Eigen:
         w += v;
       }
     }
-  Eigen::Vector3d c = w > 0 ? Eigen::Vector3d(sum / w) : (p.cast<double>() + s2_.cast<double>() / 2);
+  Eigen::Vector3d c =
+      w > 0 ? Eigen::Vector3d(sum / w) : (p.cast<double>() + s2_.cast<double>() / 2);
   // Mean shift with a ball kernel kept inside V2 (so it cannot slide down the neck onto the
   // torso): the centroid of the occupancy of V2 within refine_radius of c.
-  const Eigen::Vector3d rv = Eigen::Vector3d::Constant(options_.refine_radius).cwiseQuotient(voxel_);
+  const Eigen::Vector3d rv =
+      Eigen::Vector3d::Constant(options_.refine_radius).cwiseQuotient(voxel_);
   for (int it = 0; it < options_.refine_iterations && options_.refine_radius > 0; ++it) {
     const Eigen::Vector3i blo = (c - rv).array().floor().cast<int>().matrix().cwiseMax(lo);
     const Eigen::Vector3i bhi = ((c + rv).array().ceil().cast<int>().matrix()).cwiseMin(hi);

@@ -18,7 +18,8 @@ Expected<void> HeadTrackerOptions::validate() const {
     return fail("tracker: acceleration_sigma must be positive");
   if (!(gate > 0) || !std::isfinite(gate)) return fail("tracker: gate must be positive");
   if (max_missed < 0) return fail("tracker: max_missed must be >= 0");
-  if (!(coast_decay >= 0 && coast_decay <= 1)) return fail("tracker: coast_decay must be in [0, 1]");
+  if (!(coast_decay >= 0 && coast_decay <= 1))
+    return fail("tracker: coast_decay must be in [0, 1]");
   if (!rest_position.allFinite()) return fail("tracker: rest_position must be finite");
   return {};
 }

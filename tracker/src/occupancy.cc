@@ -47,7 +47,8 @@ OccupancyGrid OccupancyGrid::cropped_to_occupied() const {
   OccupancyGrid out(point(lo.cast<double>()), voxel_, n);
   for (int x = 0; x < n.x(); ++x) {
     for (int z = 0; z < n.z(); ++z) {
-      const auto src = column(x + lo.x(), z + lo.z()).subspan(std::size_t(lo.y()), std::size_t(n.y()));
+      const auto src =
+          column(x + lo.x(), z + lo.z()).subspan(std::size_t(lo.y()), std::size_t(n.y()));
       std::copy(src.begin(), src.end(), out.column(x, z).begin());
     }
   }

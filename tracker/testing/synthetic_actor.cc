@@ -24,7 +24,8 @@ void add_shape(OccupancyGrid& grid, const Eigen::Vector3d& lo, const Eigen::Vect
               const Eigen::Vector3d v(x + (i + 0.5) / kS, y + (j + 0.5) / kS, z + (k + 0.5) / kS);
               hits += inside(grid.point(v));
             }
-        const uint8_t f = uint8_t(std::lround(double(hits) * OccupancyGrid::kFull / (kS * kS * kS)));
+        const uint8_t f =
+            uint8_t(std::lround(double(hits) * OccupancyGrid::kFull / (kS * kS * kS)));
         grid.at(x, y, z) = std::max(grid.at(x, y, z), f);
       }
 }
@@ -33,7 +34,8 @@ void add_shape(OccupancyGrid& grid, const Eigen::Vector3d& lo, const Eigen::Vect
 
 void add_sphere(OccupancyGrid& grid, const Eigen::Vector3d& c, double r) {
   const Eigen::Vector3d e = Eigen::Vector3d::Constant(r);
-  add_shape(grid, c - e, c + e, [&](const Eigen::Vector3d& p) { return (p - c).squaredNorm() < r * r; });
+  add_shape(grid, c - e, c + e,
+            [&](const Eigen::Vector3d& p) { return (p - c).squaredNorm() < r * r; });
 }
 
 void add_capsule(OccupancyGrid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -82,18 +84,18 @@ void add_actor(OccupancyGrid& g, const SyntheticActor& a) {
   const Pose P{a};
   const double s = a.height / 1.75;
   add_sphere(g, a.head_centre(), a.head_radius);
-  add_capsule(g, P(0, 1.55, 0), P(0, 1.42, 0), 0.055 * s);             // neck
-  add_capsule(g, P(-0.07, 0.98, 0), P(-0.07, 1.34, 0), 0.11 * s);      // torso (0.36 x 0.22)
+  add_capsule(g, P(0, 1.55, 0), P(0, 1.42, 0), 0.055 * s);         // neck
+  add_capsule(g, P(-0.07, 0.98, 0), P(-0.07, 1.34, 0), 0.11 * s);  // torso (0.36 x 0.22)
   add_capsule(g, P(0.07, 0.98, 0), P(0.07, 1.34, 0), 0.11 * s);
-  add_capsule(g, P(-0.17, 1.42, 0), P(0.17, 1.42, 0), 0.065 * s);       // shoulders
-  add_capsule(g, P(-0.2, 1.42, 0), P(-0.24, 0.82, 0.02), 0.045 * s);    // left arm
+  add_capsule(g, P(-0.17, 1.42, 0), P(0.17, 1.42, 0), 0.065 * s);     // shoulders
+  add_capsule(g, P(-0.2, 1.42, 0), P(-0.24, 0.82, 0.02), 0.045 * s);  // left arm
   if (a.hand_raised) {
-    add_capsule(g, P(0.2, 1.42, 0), P(0.2, 1.98, 0.02), 0.045 * s);     // right arm, up
-    add_sphere(g, a.raised_hand_centre(), 0.05 * s);                    // right hand
+    add_capsule(g, P(0.2, 1.42, 0), P(0.2, 1.98, 0.02), 0.045 * s);  // right arm, up
+    add_sphere(g, a.raised_hand_centre(), 0.05 * s);                 // right hand
   } else {
     add_capsule(g, P(0.2, 1.42, 0), P(0.24, 0.82, 0.02), 0.045 * s);
   }
-  add_capsule(g, P(-0.1, 0.95, 0), P(-0.11, 0.05, 0.02), 0.07 * s);     // legs
+  add_capsule(g, P(-0.1, 0.95, 0), P(-0.11, 0.05, 0.02), 0.07 * s);  // legs
   add_capsule(g, P(0.1, 0.95, 0), P(0.11, 0.05, 0.02), 0.07 * s);
 }
 

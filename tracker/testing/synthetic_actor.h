@@ -18,9 +18,9 @@ void add_box(OccupancyGrid& grid, const Eigen::Vector3d& lo, const Eigen::Vector
 
 struct SyntheticActor {
   Eigen::Vector2d floor_xz = Eigen::Vector2d::Zero();  // where the actor stands
-  double height = 1.75;                                 // top of the head, standing
+  double height = 1.75;                                // top of the head, standing
   double head_radius = 0.10;
-  double crouch = 0;        // 0 standing .. 1 deep crouch (head at ~60 % height)
+  double crouch = 0;         // 0 standing .. 1 deep crouch (head at ~60 % height)
   bool hand_raised = false;  // right hand straight up, well above the head
   double yaw = 0;            // radians about +y
 

@@ -61,7 +61,7 @@ struct HeadSearchOptions {
 
 struct HeadDetection {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // head centre estimate, studio frame
-  double score = 0;       // M of the best V2, in m³ of occupancy
+  double score = 0;                                    // M of the best V2, in m³ of occupancy
   double confidence = 0;  // score relative to the reference head, in [0, 1]
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero();  // the best V2, studio frame
   Eigen::Vector3d box_max = Eigen::Vector3d::Zero();
@@ -104,11 +104,11 @@ class HeadSearch {
   HeadSearchOptions options_;
   IntegralVolume integral_;
   Eigen::Vector3d voxel_ = Eigen::Vector3d::Ones();
-  Eigen::Vector3i s2_ = Eigen::Vector3i::Ones();     // V2 size
-  Eigen::Vector3i m_lo_ = Eigen::Vector3i::Zero();   // V1 margin below V2 (per axis)
-  Eigen::Vector3i m_hi_ = Eigen::Vector3i::Zero();   // V1 margin above V2
-  int64_t threshold_ = 1;                            // min score in count units
-  double reference_ = 1;                             // reference score in count units
+  Eigen::Vector3i s2_ = Eigen::Vector3i::Ones();    // V2 size
+  Eigen::Vector3i m_lo_ = Eigen::Vector3i::Zero();  // V1 margin below V2 (per axis)
+  Eigen::Vector3i m_hi_ = Eigen::Vector3i::Zero();  // V1 margin above V2
+  int64_t threshold_ = 1;                           // min score in count units
+  double reference_ = 1;                            // reference score in count units
   std::vector<Block> heap_;
   std::vector<Eigen::Vector3i> accepted_;
   HeadSearchStats stats_;

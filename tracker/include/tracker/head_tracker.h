@@ -25,7 +25,7 @@
 namespace studio::tracker {
 
 struct HeadPose {
-  uint32_t actor_id = 0;  // track id; 0 = no track (fallback pose)
+  uint32_t actor_id = 0;                               // track id; 0 = no track (fallback pose)
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // studio frame, at capture_ns
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s
   double confidence = 0;                               // [0, 1]
@@ -37,11 +37,11 @@ struct HeadPose {
 };
 
 struct HeadTrackerOptions {
-  double measurement_sigma = 0.01;   // m, per axis, of one detection
-  double acceleration_sigma = 2.0;   // m/s², white-noise acceleration of a head
-  double gate = 0.5;                 // m, association distance
-  int max_missed = 25;               // frames a track coasts before it is dropped
-  double coast_decay = 0.8;          // confidence factor per missed frame
+  double measurement_sigma = 0.01;           // m, per axis, of one detection
+  double acceleration_sigma = 2.0;           // m/s², white-noise acceleration of a head
+  double gate = 0.5;                         // m, association distance
+  int max_missed = 25;                       // frames a track coasts before it is dropped
+  double coast_decay = 0.8;                  // confidence factor per missed frame
   Eigen::Vector3d rest_position{0, 1.7, 0};  // reported before anything was ever tracked
 
   Expected<void> validate() const;
@@ -66,7 +66,8 @@ class HeadTracker {
     double confidence;
     int missed;
   };
-  explicit HeadTracker(const HeadTrackerOptions& o) : options_(o), last_position_(o.rest_position) {}
+  explicit HeadTracker(const HeadTrackerOptions& o)
+      : options_(o), last_position_(o.rest_position) {}
   void predict(Track& t, double dt) const;
   void correct(Track& t, const Eigen::Vector3d& z) const;
   Track start(const HeadDetection& d);

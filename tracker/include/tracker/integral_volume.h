@@ -35,8 +35,10 @@ class IntegralVolume {
     const std::size_t x0 = std::size_t(lo.x()) * sx_, x1 = std::size_t(hi.x()) * sx_;
     const std::size_t z0 = std::size_t(lo.z()) * sz_, z1 = std::size_t(hi.z()) * sz_;
     const std::size_t y0 = std::size_t(lo.y()), y1 = std::size_t(hi.y());
-    const int64_t a = int64_t(s[x1 + z1 + y1]) - s[x0 + z1 + y1] - s[x1 + z0 + y1] + s[x0 + z0 + y1];
-    const int64_t b = int64_t(s[x1 + z1 + y0]) - s[x0 + z1 + y0] - s[x1 + z0 + y0] + s[x0 + z0 + y0];
+    const int64_t a =
+        int64_t(s[x1 + z1 + y1]) - s[x0 + z1 + y1] - s[x1 + z0 + y1] + s[x0 + z0 + y1];
+    const int64_t b =
+        int64_t(s[x1 + z1 + y0]) - s[x0 + z1 + y0] - s[x1 + z0 + y0] + s[x0 + z0 + y0];
     return a - b;
   }
   int64_t total() const { return count({0, 0, 0}, dims_); }

@@ -43,7 +43,9 @@ class OccupancyGrid {
   uint8_t at(int x, int y, int z) const { return data_[index(x, y, z)]; }
   uint8_t& at(int x, int y, int z) { return data_[index(x, y, z)]; }
   // Contiguous column along y at (x, z).
-  std::span<uint8_t> column(int x, int z) { return {data_.data() + index(x, 0, z), size_t(dims_.y())}; }
+  std::span<uint8_t> column(int x, int z) {
+    return {data_.data() + index(x, 0, z), size_t(dims_.y())};
+  }
   std::span<const uint8_t> column(int x, int z) const {
     return {data_.data() + index(x, 0, z), size_t(dims_.y())};
   }
