@@ -1,0 +1,32 @@
+#pragma once
+// Conversions between wire samples and core types, shared by every node (DESIGN §2 rule 1: the
+// algorithms see only core types). Identity and time fields (camera_id, frame, capture_ns) are
+// the caller's; these functions convert the payload.
+//
+// Inputs come from a wire::Reader, so they passed the type's validator already; the to_core
+// functions still return an Error instead of trusting that (a codec payload is only fully
+// checked by decoding it).
+
+#include <vector>
+
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/mask_codec.h"
+#include "core/run_mask.h"
+#include "studio.h"
+
+namespace studio::wire {
+
+// AlphaMask (either encoding) → RunMask. `reuse` lends its storage (frame after frame).
+Expected<RunMask> to_core(const studio_AlphaMask& sample, RunMask reuse = RunMask(0, 0));
+// RunMask → AlphaMask payload (width, height, encoding, runs or codec bytes).
+// MASK_CODEC uses the default coding of core/mask_codec.h.
+void from_core(const RunMask& mask, studio_MaskEncoding encoding, studio_AlphaMask& sample);
+
+// CameraCalibration → Camera (id, size, K, the paper's radial model, cam_from_world).
+Expected<Camera> to_core(const studio_CameraCalibration& sample);
+// Camera → CameraCalibration. Fails for a distortion the wire cannot carry (OpenCV's model:
+// convert the camera to the paper's radial model first).
+Expected<bool> from_core(const Camera& camera, studio_CameraCalibration& sample);
+
+}  // namespace studio::wire
