@@ -1,0 +1,121 @@
+// studio-hull offline, run as a process: a mesh from a synthetic studio's masks, and one clear
+// error line each for a missing camera mask, a mask of the wrong size and an empty box.
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/rig.h"
+#include "testing/synthetic.h"
+#include "yaml_io/rig_yaml.h"
+
+namespace fs = std::filesystem;
+
+namespace studio::hull {
+namespace {
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+Result run(const std::string& args, const fs::path& dir) {
+  const std::string cmd = std::string(STUDIO_HULL_CLI) + " " + args + " >" + (dir / "out.txt").string() +
+                          " 2>" + (dir / "err.txt").string();
+  const int status = std::system(cmd.c_str());
+  const auto slurp = [](const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+  return {WEXITSTATUS(status), slurp(dir / "out.txt"), slurp(dir / "err.txt")};
+}
+
+class HullCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("hull_cli_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_ / "masks");
+    const testing::Scene scene = testing::actor();
+    Rig rig;
+    rig.cameras = testing::camera_ring(4, 352, 288, 4.0, 1.6, {0, 1, 0}, 300);
+    ASSERT_TRUE(yaml::write_rig(rig, (dir_ / "rig.yaml").string()));
+    for (const Camera& c : rig.cameras) {
+      const Mask m = testing::render_mask(c, scene).to_mask();
+      cv::Mat img(m.height(), m.width(), CV_8U, const_cast<uint8_t*>(m.data()));
+      for (const char* frame : {"", "7/", "8/"}) {
+        fs::create_directories(dir_ / "masks" / frame);
+        ASSERT_TRUE(cv::imwrite((dir_ / "masks" / frame / (c.id + ".png")).string(), img));
+      }
+    }
+    base_ = "offline --rig " + (dir_ / "rig.yaml").string() + " --grid 64 ";
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+  std::string base_;
+};
+
+TEST_F(HullCli, SingleFrameAndSequenceWithTiming) {
+  Result r = run(base_ + "--masks " + (dir_ / "masks").string() + " --box -1,0,-1,1,2,1 --out " +
+                     (dir_ / "a.glb").string() + " --timing",
+                 dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GT(fs::file_size(dir_ / "a.glb"), 1000u);
+  EXPECT_NE(r.out.find("\"cut\":"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"mesh\":"), std::string::npos);
+  // The sequence: masks/7 and masks/8 exist beside the single-frame pngs; a folder of only frames.
+  for (const auto& e : fs::directory_iterator(dir_ / "masks"))
+    if (e.is_regular_file()) fs::remove(e.path());
+  r = run(base_ + "--masks " + (dir_ / "masks").string() + " --box -1,0,-1,1,2,1 --frames 8:9 --out " +
+              (dir_ / "seq").string(),
+          dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "seq" / "8.ply"));
+  EXPECT_FALSE(fs::exists(dir_ / "seq" / "7.ply"));
+}
+
+TEST_F(HullCli, RejectsMissingMask) {
+  for (const auto& e : fs::directory_iterator(dir_ / "masks"))
+    if (e.is_regular_file()) fs::remove(e.path());
+  fs::remove(dir_ / "masks" / "8" / "cam2.png");
+  const Result r = run(base_ + "--masks " + (dir_ / "masks").string() +
+                           " --box -1,0,-1,1,2,1 --frames 8:8 --out " + (dir_ / "seq").string(),
+                       dir_);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("missing mask for camera cam2"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+TEST_F(HullCli, RejectsMaskOfWrongSize) {
+  cv::Mat small(100, 120, CV_8U, cv::Scalar(0));
+  ASSERT_TRUE(cv::imwrite((dir_ / "masks" / "cam1.png").string(), small));
+  const Result r = run(base_ + "--masks " + (dir_ / "masks").string() + " --box -1,0,-1,1,2,1 --out " +
+                           (dir_ / "a.ply").string(),
+                       dir_);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("mask is 120x100, camera cam1 is 352x288"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+TEST_F(HullCli, RejectsEmptyBox) {
+  const Result r = run(base_ + "--masks " + (dir_ / "masks").string() + " --box -1,0,-1,1,0,1 --out " +
+                           (dir_ / "a.ply").string(),
+                       dir_);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("box: empty along y"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+TEST_F(HullCli, HelpAndBadArguments) {
+  EXPECT_EQ(run("--help", dir_).code, 0);
+  const Result r = run("offline --grid x", dir_);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--grid: 'x' is not an integer"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace studio::hull
