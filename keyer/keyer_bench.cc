@@ -26,6 +26,10 @@
 #include <unistd.h>
 
 #include "core/mask_codec.h"
+#ifdef STUDIO_KEYER_BENCH_SIM
+#include "capture/sim/cameras.h"
+#include "capture/sim/studio.h"
+#endif
 #include "keyer/keyer.h"
 #include "keyer/reference_keyer.h"
 #include "test_frames.h"
@@ -256,6 +260,45 @@ void BM_DinoMaskBytes(benchmark::State& state) {
   state.counters["bytes"] = delta / double(views.size());
   state.counters["bytes_plain_runs"] = runs / double(views.size());
 }
+
+#ifdef STUDIO_KEYER_BENCH_SIM
+// The simulated studio (6 cameras, 704x576, every realism knob on incl. motion blur and the
+// projected picture): keying speed on its frames and the mean encoded size of the masks.
+void BM_SimulatedStudio(benchmark::State& state) {
+  sim::StudioOptions so;
+  so.motion_blur = true;
+  so.projected_image = true;
+  auto studio = sim::SimulatedStudio::create(sim::ring_cameras(), so);
+  if (!studio) {
+    state.SkipWithError(studio.error().message.c_str());
+    return;
+  }
+  std::vector<Image<Rgb8>> images, all;
+  for (int64_t frame = 0; frame < 200; frame += 25) {
+    studio->render_all(frame, &images, nullptr);
+    for (auto& im : images) all.push_back(std::move(im));
+  }
+  auto keyer = Keyer::create({});
+  RunMask mask;
+  std::vector<uint8_t> bytes;
+  double total_runs = 0, total_delta = 0;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    (void)keyer->key(all[i++ % all.size()].view(), mask);
+    encode_mask(mask, MaskCoding::kRowDelta, bytes);
+  }
+  for (const auto& im : all) {
+    (void)keyer->key(im.view(), mask);
+    total_delta += double(encode_mask(mask, MaskCoding::kRowDelta).size());
+    total_runs += double(encode_mask(mask, MaskCoding::kRuns).size());
+  }
+  state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["bytes"] = total_delta / double(all.size());
+  state.counters["bytes_plain_runs"] = total_runs / double(all.size());
+  state.SetLabel(std::to_string(all.size()) + " masks");
+}
+BENCHMARK(BM_SimulatedStudio)->Unit(benchmark::kMicrosecond);
+#endif
 
 }  // namespace
 

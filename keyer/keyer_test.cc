@@ -175,7 +175,9 @@ TEST(Keyer, DifferenceKeyAgainstCleanPlate) {
 }
 
 TEST(Keyer, SoftAlphaFollowsTheFormula) {
-  KeyerOptions o;  // clip_black 20, clip_white 60, gain 1
+  KeyerOptions o;
+  o.clip_black = 20;
+  o.clip_white = 60;
   auto keyer = Keyer::create(o);
   Image<Rgb8> im(4, 1);
   im(0, 0) = {50, 50, 50};    // no excess: actor

@@ -38,7 +38,7 @@ struct KeyerOptions {
   // Chroma key.
   float gain = 1.0f;
   float clip_black = 20.0f;   // backing level at and below which alpha = 1
-  float clip_white = 60.0f;   // backing level at and above which alpha = 0
+  float clip_white = 100.0f;  // backing level at and above which alpha = 0
   // Difference key.
   float diff_low = 12.0f;     // difference at and below which alpha = 0
   float diff_high = 36.0f;    // difference at and above which alpha = 1
