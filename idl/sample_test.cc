@@ -1,9 +1,10 @@
 // Owned samples and the sequence / bounded-string helpers; the QoS table.
 
+#include "wire/sample.h"
+
 #include <gtest/gtest.h>
 
 #include "wire/entity.h"
-#include "wire/sample.h"
 
 namespace studio::wire {
 namespace {
@@ -46,7 +47,7 @@ TEST(Qos, RowsFollowTheDesignTable) {
   EXPECT_FALSE(mask.reliable || mask.transient_local);
   const auto& node = topic_row(TopicId::scene_node);
   EXPECT_TRUE(node.reliable && node.transient_local);
-  EXPECT_GT(topic_row(TopicId::service_status).liveliness_lease_ms, 0);
+  EXPECT_GT(topic_row(TopicId::service_status).liveliness_lease_s, 0);
 
   Qos q = qos_for(TopicId::scene_node);
   dds_reliability_kind_t rel;

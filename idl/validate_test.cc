@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "core/mask_codec.h"
 #include "harness/wire_samples.h"
@@ -14,6 +15,13 @@ namespace {
 
 using testing::make;
 const double kNaN = std::nan("");
+
+// Writes an out-of-range value into an enum field, as a malicious or buggy peer could.
+template <class E>
+void poke(E& field, uint32_t value) {
+  static_assert(sizeof(E) == sizeof value);
+  std::memcpy(&field, &value, sizeof value);
+}
 
 TEST(Validate, GeneratedSamplesOfEveryTypeAreValid) {
   for (int seed = 0; seed < 6; ++seed) {
@@ -78,7 +86,7 @@ TEST(Validate, MaskRunsMustBeSortedInsideTheImageAndSumAtMostWH) {
   m->height += 1;  // row_start no longer height+1
   EXPECT_EQ(validate(*m), Reject::bad_size);
   m = make<studio_AlphaMask>(0);
-  m->encoding = studio_MaskEncoding(7);
+  poke(m->encoding, 7);
   EXPECT_EQ(validate(*m), Reject::out_of_range);
   // Overlapping runs in one row (a second run starting inside the first).
   m = make<studio_AlphaMask>(0);
@@ -158,7 +166,7 @@ TEST(Validate, ImagesSegmentsMeshesAndTheRest) {
   set(cmd->target, "");
   EXPECT_EQ(validate(*cmd), Reject::bad_id);
   cmd = make<studio_SceneCommand>(0);
-  cmd->verb = studio_SceneVerb(42);
+  poke(cmd->verb, 42);
   EXPECT_EQ(validate(*cmd), Reject::out_of_range);
 
   auto state = make<studio_CameraState>(0);
@@ -171,7 +179,7 @@ TEST(Validate, ImagesSegmentsMeshesAndTheRest) {
   set(control->feature, "");
   EXPECT_EQ(validate(*control), Reject::bad_id);
   auto capture = make<studio_CaptureCommand>(0);
-  capture->action = studio_CaptureAction(9);
+  poke(capture->action, 9);
   EXPECT_EQ(validate(*capture), Reject::out_of_range);
   auto proj = make<studio_ProjectorCalibration>(0);
   proj->homography[4] = kNaN;

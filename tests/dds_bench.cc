@@ -12,6 +12,7 @@
 // udp_p99_us, udp_lost, ratio_p50 / ratio_p99 (DDS / UDP), bytes.
 
 #include <arpa/inet.h>
+#include <benchmark/benchmark.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -22,8 +23,6 @@
 #include <random>
 #include <thread>
 #include <vector>
-
-#include <benchmark/benchmark.h>
 
 #include "core/mask_codec.h"
 #include "harness/process.h"
@@ -79,7 +78,9 @@ Stats summarize(std::vector<double> one_way_us, int lost) {
   s.lost = lost;
   if (one_way_us.empty()) return s;
   std::sort(one_way_us.begin(), one_way_us.end());
-  auto at = [&](double q) { return one_way_us[std::min(one_way_us.size() - 1, size_t(q * one_way_us.size()))]; };
+  auto at = [&](double q) {
+    return one_way_us[std::min(one_way_us.size() - 1, size_t(q * one_way_us.size()))];
+  };
   s.p50_us = at(0.50);
   s.p99_us = at(0.99);
   s.max_us = one_way_us.back();
@@ -99,8 +100,10 @@ Stats paced(Ping&& ping, Pong&& pong) {
     ping(i);
     const int64_t rtt = pong(i, Clock::now() + kReplyTimeout);
     if (i < kWarmup) continue;
-    if (rtt < 0) ++lost;
-    else one_way.push_back(double(rtt) / 2e3);
+    if (rtt < 0)
+      ++lost;
+    else
+      one_way.push_back(double(rtt) / 2e3);
   }
   return summarize(std::move(one_way), lost);
 }
@@ -121,7 +124,8 @@ Stats run_udp(testing::Process& peer, int port, const std::vector<uint8_t>& payl
   };
   auto pong = [&](int i, Clock::time_point deadline) -> int64_t {
     for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
       if (left.count() < 0) return -1;
       pollfd pfd{fd, POLLIN, 0};
       if (poll(&pfd, 1, int(left.count()) + 1) <= 0) return -1;
@@ -186,8 +190,11 @@ void BM_Mask4kLoopback1kHz(benchmark::State& state) {
   const auto payload = four_kb_mask();
   const int port = 20000 + int(getpid() % 20000);
   auto start = [&](const std::string& name, std::vector<std::string> args) {
-    auto p = testing::Process::start({.name = name, .binary = testing::built_binary("tests/wire_peer"),
-                                      .args = std::move(args), .env = dds.env(), .dir = dir});
+    auto p = testing::Process::start({.name = name,
+                                      .binary = testing::built_binary("tests/wire_peer"),
+                                      .args = std::move(args),
+                                      .env = dds.env(),
+                                      .dir = dir});
     if (!p) throw std::runtime_error(p.error().message);
     if (!p->wait_ready(15s)) throw std::runtime_error(name + " not ready; log: " + p->log());
     return std::move(*p);

@@ -34,11 +34,16 @@ TEST_F(HarnessTest, ReadyArrivesOverTheNotifySocketAndLogsAreCaptured) {
 }
 
 TEST_F(HarnessTest, ChildSeesTheTestDomain) {
-  Process p = Process::start({.name = "env", .binary = "/bin/sh",
-                              .args = {"-c", "echo $STUDIO_DDS_DOMAIN $STUDIO_DDS_TAG $CYCLONEDDS_URI"},
-                              .env = dds_.env(), .dir = dir_}).value();
+  Process p =
+      Process::start({.name = "env",
+                      .binary = "/bin/sh",
+                      .args = {"-c", "echo $STUDIO_DDS_DOMAIN $STUDIO_DDS_TAG $CYCLONEDDS_URI"},
+                      .env = dds_.env(),
+                      .dir = dir_})
+          .value();
   ASSERT_EQ(p.wait_exit(5s), 0);
-  EXPECT_NE(p.log().find(std::to_string(dds_.domain_id) + " " + dds_.tag), std::string::npos) << p.log();
+  EXPECT_NE(p.log().find(std::to_string(dds_.domain_id) + " " + dds_.tag), std::string::npos)
+      << p.log();
   EXPECT_NE(p.log().find("deploy/dds/loopback.xml"), std::string::npos);
 }
 
@@ -72,7 +77,8 @@ TEST_F(HarnessTest, StopEscalatesToSigkillAndTakesTheWholeGroup) {
     return bool(stat >> pid_field >> comm >> state) && state != "Z";
   };
   const auto deadline = std::chrono::steady_clock::now() + 2s;
-  while (alive(child) && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(10ms);
+  while (alive(child) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(10ms);
   EXPECT_FALSE(alive(child)) << "grandchild survived";
 }
 

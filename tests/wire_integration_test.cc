@@ -86,7 +86,8 @@ TEST_F(WireTest, BestEffortMasksArrive) {
   const auto deadline = Clock::now() + 10s;
   while (reader.matched_writers() < 1 && Clock::now() < deadline) std::this_thread::sleep_for(5ms);
 
-  // 200 masks at 100 Hz (4x the studio frame rate), one camera: each must come back.
+  // 200 masks at 100 Hz from 8 cameras (instances; keep-last 1 applies per camera), each must
+  // come back (>= 95% tolerated on a loaded machine: best-effort).
   constexpr int kMasks = 200;
   auto mask = make<studio_AlphaMask>(1);
   std::set<uint64_t> frames;
@@ -97,6 +98,7 @@ TEST_F(WireTest, BestEffortMasksArrive) {
   };
   for (int i = 0; i < kMasks; ++i) {
     mask->frame = 1'000'000 + uint64_t(i);
+    wire::set(mask->camera_id, "cam" + std::to_string(i % 8));
     ASSERT_TRUE(writer.write(*mask).has_value());
     std::this_thread::sleep_for(10ms);
     drain();
@@ -113,7 +115,7 @@ TEST_F(WireTest, BestEffortMasksArrive) {
 TEST_F(WireTest, LateJoiningReaderGetsLastCalibration) {
   Process& peer = spawn("publisher", "tests/wire_peer", {"publisher"});
   ASSERT_TRUE(peer.wait_ready(15s));  // calibrations written before READY
-  auto p = participant();              // joins afterwards
+  auto p = participant();             // joins afterwards
   auto topic = wire::Topic<studio_CameraCalibration>::create(p).value();
   auto reader = wire::Reader<studio_CameraCalibration>::create(p, topic).value();
   std::vector<wire::Received<studio_CameraCalibration>> got;
@@ -169,8 +171,8 @@ TEST_F(WireTest, DisposedSceneNodeDisappears) {
   while (alive_nodes(nodes) != rest && Clock::now() < deadline) std::this_thread::sleep_for(10ms);
   EXPECT_EQ(alive_nodes(nodes), rest);
   // The reader saw the disposal itself: node1's instance is NOT_ALIVE_DISPOSED.
-  auto disposed = nodes.read(64, DDS_ANY_SAMPLE_STATE | DDS_ANY_VIEW_STATE |
-                                     DDS_NOT_ALIVE_DISPOSED_INSTANCE_STATE);
+  auto disposed = nodes.read(
+      64, DDS_ANY_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_NOT_ALIVE_DISPOSED_INSTANCE_STATE);
   ASSERT_FALSE(disposed.empty());
   for (auto& r : disposed) {
     EXPECT_TRUE(r.meta.disposed);
@@ -215,7 +217,8 @@ TEST_F(WireTest, MalformedSamplesAreRejectedAndCounted) {
 
   std::size_t mesh_samples = 0, mask_samples = 0;
   deadline = Clock::now() + 5s;
-  while ((meshes.rejected().total() == 0 || masks.rejected().total() == 0) && Clock::now() < deadline) {
+  while ((meshes.rejected().total() == 0 || masks.rejected().total() == 0) &&
+         Clock::now() < deadline) {
     std::this_thread::sleep_for(10ms);
     mesh_samples += meshes.take().size();
     mask_samples += masks.visit([](const studio_AlphaMask&, const wire::SampleMeta&) {});

@@ -70,7 +70,8 @@ std::unique_ptr<Pump> echo_of(const wire::Participant& p) {
 int serve(const wire::Participant& p, std::vector<Pump*> pumps, runtime::SignalWatcher& signals) {
   auto guard = wire::GuardCondition::create(p).value();
   auto ws = wire::WaitSet::create(p).value();
-  for (std::size_t i = 0; i < pumps.size(); ++i) ws.attach(pumps[i]->source(), dds_attach_t(i)).value();
+  for (std::size_t i = 0; i < pumps.size(); ++i)
+    ws.attach(pumps[i]->source(), dds_attach_t(i)).value();
   constexpr dds_attach_t kStop = 1 << 30;
   ws.attach(guard, kStop).value();
   std::thread watcher([&] {
@@ -116,16 +117,22 @@ int run_echo(runtime::SignalWatcher& signals) {
 
 struct Publisher : Pump {
   const wire::Participant& p;
-  wire::Topic<studio_CameraCalibration> calib_topic = wire::Topic<studio_CameraCalibration>::create(p).value();
+  wire::Topic<studio_CameraCalibration> calib_topic =
+      wire::Topic<studio_CameraCalibration>::create(p).value();
   wire::Topic<studio_SceneNode> node_topic = wire::Topic<studio_SceneNode>::create(p).value();
   wire::Topic<studio_SceneCommand> cmd_topic = wire::Topic<studio_SceneCommand>::create(p).value();
   wire::Topic<studio_AlphaMask> mask_topic = wire::Topic<studio_AlphaMask>::create(p).value();
   wire::Topic<studio_ActorMesh> mesh_topic = wire::Topic<studio_ActorMesh>::create(p).value();
-  wire::Writer<studio_CameraCalibration> calib = wire::Writer<studio_CameraCalibration>::create(p, calib_topic).value();
-  wire::Writer<studio_SceneNode> nodes = wire::Writer<studio_SceneNode>::create(p, node_topic).value();
-  wire::Writer<studio_AlphaMask> masks = wire::Writer<studio_AlphaMask>::create(p, mask_topic).value();
-  wire::Writer<studio_ActorMesh> meshes = wire::Writer<studio_ActorMesh>::create(p, mesh_topic).value();
-  wire::Reader<studio_SceneCommand> commands = wire::Reader<studio_SceneCommand>::create(p, cmd_topic).value();
+  wire::Writer<studio_CameraCalibration> calib =
+      wire::Writer<studio_CameraCalibration>::create(p, calib_topic).value();
+  wire::Writer<studio_SceneNode> nodes =
+      wire::Writer<studio_SceneNode>::create(p, node_topic).value();
+  wire::Writer<studio_AlphaMask> masks =
+      wire::Writer<studio_AlphaMask>::create(p, mask_topic).value();
+  wire::Writer<studio_ActorMesh> meshes =
+      wire::Writer<studio_ActorMesh>::create(p, mesh_topic).value();
+  wire::Reader<studio_SceneCommand> commands =
+      wire::Reader<studio_SceneCommand>::create(p, cmd_topic).value();
 
   explicit Publisher(const wire::Participant& participant) : p(participant) {
     // cam0 twice (seed 0, then seed 4: same key, newer contents), then cam1.
@@ -196,7 +203,8 @@ int run_udp_echo(int port, runtime::SignalWatcher& signals) {
     if (fds[0].revents) {
       sockaddr_in from{};
       socklen_t len = sizeof from;
-      const ssize_t n = recvfrom(fd, buf.data(), buf.size(), 0, reinterpret_cast<sockaddr*>(&from), &len);
+      const ssize_t n =
+          recvfrom(fd, buf.data(), buf.size(), 0, reinterpret_cast<sockaddr*>(&from), &len);
       if (n > 0) sendto(fd, buf.data(), size_t(n), 0, reinterpret_cast<sockaddr*>(&from), len);
     }
   }

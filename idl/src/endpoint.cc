@@ -131,7 +131,8 @@ std::size_t ReaderBase::fill(bool take, uint32_t mask, std::span<void*> buffers,
       take ? dds_take_mask(entity_.handle(), buffers.data(), infos.data(), n, n, mask)
            : dds_read_mask(entity_.handle(), buffers.data(), infos.data(), n, n, mask);
   if (got < 0) {
-    STUDIO_LOG(warn, "dds") << dds_error(std::string(row_->name) + (take ? ": take" : ": read"), got);
+    STUDIO_LOG(warn, "dds") << dds_error(std::string(row_->name) + (take ? ": take" : ": read"),
+                                         got);
     return 0;
   }
   std::size_t accepted = 0;

@@ -39,13 +39,14 @@ Qos& Qos::operator=(Qos&& other) noexcept {
 Qos qos_for(TopicId id) {
   const TopicRow& row = topic_row(id);
   Qos q;
-  dds_qset_reliability(q.get(), row.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
+  dds_qset_reliability(q.get(),
+                       row.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
                        DDS_MSECS(100));
-  dds_qset_durability(q.get(), row.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL
-                                                   : DDS_DURABILITY_VOLATILE);
+  dds_qset_durability(
+      q.get(), row.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, row.depth);
-  if (row.liveliness_lease_ms > 0)
-    dds_qset_liveliness(q.get(), DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(row.liveliness_lease_ms));
+  if (row.liveliness_lease_s > 0)
+    dds_qset_liveliness(q.get(), DDS_LIVELINESS_AUTOMATIC, DDS_SECS(row.liveliness_lease_s));
   return q;
 }
 
@@ -62,7 +63,8 @@ dds_domainid_t default_domain() {
 Expected<Participant> Participant::create(dds_domainid_t domain, const std::string& config) {
   Participant p;
   if (!config.empty()) {
-    if (domain == DDS_DOMAIN_DEFAULT) return fail("dds: an explicit config needs an explicit domain id");
+    if (domain == DDS_DOMAIN_DEFAULT)
+      return fail("dds: an explicit config needs an explicit domain id");
     const dds_entity_t d = dds_create_domain(domain, config.c_str());
     if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET)
       return fail(dds_error("dds: create domain " + std::to_string(domain), d));

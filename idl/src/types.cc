@@ -13,25 +13,31 @@ Verdict erased(const void* sample) {
   return validate(*static_cast<const T*>(sample));
 }
 
-#define ROW(Id, Name, Type) TopicId::Id, Name, &studio_##Type##_desc, sizeof(studio_##Type), &erased<studio_##Type>
+#define R(Id, Type)                                                                     \
+  TopicId::Id, &studio_##Type##_desc, sizeof(studio_##Type), &erased<studio_##Type>
+constexpr bool kRel = true, kBE = false;   // reliable / best-effort
+constexpr bool kTL = true, kVol = false;   // transient-local / volatile
 
-//                                                                        reliable  transient  depth  lease_ms
+// Columns after the row: DDS topic name, reliability, durability, keep-last depth (per instance),
+// liveliness lease in seconds (0 = none).
+// clang-format off
 constexpr std::array<TopicRow, kTopicCount> kTopicTable{{
-    {ROW(camera_calibration, "studio/camera/calibration", CameraCalibration),    true,  true,  1,  0},
-    {ROW(camera_mask, "studio/camera/mask", AlphaMask),                          false, false, 1,  0},
-    {ROW(camera_image, "studio/camera/image", CameraImage),                      false, false, 1,  0},
-    {ROW(camera_state, "studio/camera/state", CameraState),                      true,  true,  1,  0},
-    {ROW(camera_control, "studio/camera/control", CameraControl),                true,  false, 8,  0},
-    {ROW(capture_command, "studio/capture/command", CaptureCommand),             true,  true,  1,  0},
-    {ROW(actor_segments, "studio/actor/segments", SegmentSet),                   false, false, 1,  0},
-    {ROW(actor_mesh, "studio/actor/mesh", ActorMesh),                            true,  false, 1,  0},
-    {ROW(actor_head, "studio/actor/head", HeadPose),                             false, false, 1,  0},
-    {ROW(scene_node, "studio/scene/node", SceneNode),                            true,  true,  1,  0},
-    {ROW(scene_command, "studio/scene/command", SceneCommand),                   true,  false, 32, 0},
-    {ROW(projector_calibration, "studio/projector/calibration", ProjectorCalibration), true, true, 1, 0},
-    {ROW(service_status, "studio/service/status", ServiceStatus),                false, false, 1,  3000},
+{R(camera_calibration, CameraCalibration),       "studio/camera/calibration",    kRel, kTL,  1,  0},
+{R(camera_mask, AlphaMask),                      "studio/camera/mask",           kBE,  kVol, 1,  0},
+{R(camera_image, CameraImage),                   "studio/camera/image",          kBE,  kVol, 1,  0},
+{R(camera_state, CameraState),                   "studio/camera/state",          kRel, kTL,  1,  0},
+{R(camera_control, CameraControl),               "studio/camera/control",        kRel, kVol, 8,  0},
+{R(capture_command, CaptureCommand),             "studio/capture/command",       kRel, kTL,  1,  0},
+{R(actor_segments, SegmentSet),                  "studio/actor/segments",        kBE,  kVol, 1,  0},
+{R(actor_mesh, ActorMesh),                       "studio/actor/mesh",            kRel, kVol, 1,  0},
+{R(actor_head, HeadPose),                        "studio/actor/head",            kBE,  kVol, 1,  0},
+{R(scene_node, SceneNode),                       "studio/scene/node",            kRel, kTL,  1,  0},
+{R(scene_command, SceneCommand),                 "studio/scene/command",         kRel, kVol, 32, 0},
+{R(projector_calibration, ProjectorCalibration), "studio/projector/calibration", kRel, kTL,  1,  0},
+{R(service_status, ServiceStatus),               "studio/service/status",        kBE,  kVol, 1,  3},
 }};
-#undef ROW
+// clang-format on
+#undef R
 
 constexpr bool table_in_enum_order() {
   for (std::size_t i = 0; i < kTopicTable.size(); ++i)
@@ -52,11 +58,16 @@ std::span<const TopicRow> topic_table() { return kTopicTable; }
 
 std::string_view reject_name(Reject reason) {
   switch (reason) {
-    case Reject::bad_id: return "bad_id";
-    case Reject::bad_size: return "bad_size";
-    case Reject::out_of_range: return "out_of_range";
-    case Reject::non_finite: return "non_finite";
-    case Reject::bad_runs: return "bad_runs";
+    case Reject::bad_id:
+      return "bad_id";
+    case Reject::bad_size:
+      return "bad_size";
+    case Reject::out_of_range:
+      return "out_of_range";
+    case Reject::non_finite:
+      return "non_finite";
+    case Reject::bad_runs:
+      return "bad_runs";
   }
   return "unknown";
 }

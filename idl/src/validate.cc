@@ -14,8 +14,8 @@
 namespace studio::wire {
 namespace {
 
-constexpr uint32_t kMaxSide = 16384;           // image / mask sides
-constexpr uint32_t kMaxGridSide = 4096;        // hull grid sides
+constexpr uint32_t kMaxSide = 16384;     // image / mask sides
+constexpr uint32_t kMaxGridSide = 4096;  // hull grid sides
 constexpr uint64_t kMaxGridColumns = 1u << 22;
 
 template <std::size_t N>
@@ -35,6 +35,15 @@ bool finite(std::span<const float> v) {
   for (float x : v)
     if (!std::isfinite(x)) return false;
   return true;
+}
+// Enum fields come off the wire as raw 32-bit values: read them as integers (loading an
+// out-of-range value as the C enum type is undefined behaviour).
+template <class E>
+uint32_t raw(const E& e) {
+  static_assert(sizeof(E) == sizeof(uint32_t));
+  uint32_t v;
+  std::memcpy(&v, &e, sizeof v);
+  return v;
 }
 bool side_ok(uint32_t w, uint32_t h, uint32_t max = kMaxSide) {
   return w >= 1 && h >= 1 && w <= max && h <= max;
@@ -65,7 +74,8 @@ Verdict check_mask_runs(const studio_AlphaMask& s) {
   auto runs = view(s.runs);
   if (!view(s.data).empty()) return Reject::bad_size;
   if (row_start.size() != uint64_t(s.height) + 1 || runs.size() % 2 != 0) return Reject::bad_size;
-  if (row_start.front() != 0 || uint64_t(row_start.back()) * 2 != runs.size()) return Reject::bad_size;
+  if (row_start.front() != 0 || uint64_t(row_start.back()) * 2 != runs.size())
+    return Reject::bad_size;
   uint64_t area = 0;
   for (uint32_t y = 0; y < s.height; ++y) {
     const uint32_t a = row_start[y], b = row_start[y + 1];
@@ -85,13 +95,18 @@ Verdict check_mask_runs(const studio_AlphaMask& s) {
 
 Verdict check_mask_codec(const studio_AlphaMask& s) {
   if (!view(s.row_start).empty() || !view(s.runs).empty()) return Reject::bad_size;
-  auto bytes = view(s.data);
-  auto header = decode_mask_header(bytes);
-  if (!header) return Reject::bad_runs;
-  if (uint32_t(header->width) != s.width || uint32_t(header->height) != s.height)
-    return Reject::bad_size;
-  RunMask mask;
-  if (!decode_mask(bytes, mask)) return Reject::bad_runs;
+  // The decoder rejects anything that is not exactly a valid mask; the decoded mask is reused
+  // per thread so validation does not allocate in the steady state.
+  thread_local RunMask scratch(0, 0);
+  auto mask = decode_mask(view(s.data), std::move(scratch));
+  if (!mask) {
+    scratch = RunMask(0, 0);
+    return Reject::bad_runs;
+  }
+  const bool sizes_match =
+      uint32_t(mask->width()) == s.width && uint32_t(mask->height()) == s.height;
+  scratch = std::move(*mask);
+  if (!sizes_match) return Reject::bad_size;
   return std::nullopt;
 }
 
@@ -108,9 +123,11 @@ Verdict validate(const studio_CameraCalibration& s) {
 Verdict validate(const studio_AlphaMask& s) {
   if (!id_ok(s.camera_id)) return Reject::bad_id;
   if (!side_ok(s.width, s.height)) return Reject::bad_size;
-  switch (s.encoding) {
-    case studio_MASK_RUNS: return check_mask_runs(s);
-    case studio_MASK_CODEC: return check_mask_codec(s);
+  switch (raw(s.encoding)) {
+    case studio_MASK_RUNS:
+      return check_mask_runs(s);
+    case studio_MASK_CODEC:
+      return check_mask_codec(s);
   }
   return Reject::out_of_range;
 }
@@ -119,9 +136,11 @@ Verdict validate(const studio_CameraImage& s) {
   if (!id_ok(s.camera_id)) return Reject::bad_id;
   if (!side_ok(s.width, s.height)) return Reject::bad_size;
   const uint64_t n = view(s.data).size(), pixels = uint64_t(s.width) * s.height;
-  switch (s.format) {
-    case studio_IMAGE_RGB8: return n == 3 * pixels ? Verdict{} : Reject::bad_size;
-    case studio_IMAGE_MONO8: return n == pixels ? Verdict{} : Reject::bad_size;
+  switch (raw(s.format)) {
+    case studio_IMAGE_RGB8:
+      return n == 3 * pixels ? Verdict{} : Reject::bad_size;
+    case studio_IMAGE_MONO8:
+      return n == pixels ? Verdict{} : Reject::bad_size;
     case studio_IMAGE_JPEG: {
       auto d = view(s.data);
       if (n < 4 || n > 3 * pixels + 65536) return Reject::bad_size;
@@ -142,7 +161,7 @@ Verdict validate(const studio_CameraState& s) {
     if (f.min > f.max) return Reject::out_of_range;
   }
   if (!std::isfinite(s.fps)) return Reject::non_finite;
-  if (s.fps < 0 || uint32_t(s.state) > studio_CAMERA_ERROR) return Reject::out_of_range;
+  if (s.fps < 0 || raw(s.state) > studio_CAMERA_ERROR) return Reject::out_of_range;
   return std::nullopt;
 }
 
@@ -154,7 +173,7 @@ Verdict validate(const studio_CameraControl& s) {
 
 Verdict validate(const studio_CaptureCommand& s) {
   if (!id_ok(s.take)) return Reject::bad_id;
-  if (uint32_t(s.action) > studio_CAPTURE_STOP) return Reject::out_of_range;
+  if (raw(s.action) > studio_CAPTURE_STOP) return Reject::out_of_range;
   return std::nullopt;
 }
 
@@ -219,14 +238,18 @@ Verdict validate(const studio_SceneNode& s) {
 Verdict validate(const studio_SceneCommand& s) {
   if (!text_ok(s.target) || !text_ok(s.path)) return Reject::bad_id;
   if (!std::isfinite(s.value) || !finite(s.transform)) return Reject::non_finite;
-  switch (s.verb) {
-    case studio_SCENE_LOAD_SET: return s.path[0] ? Verdict{} : Reject::bad_id;
+  switch (raw(s.verb)) {
+    case studio_SCENE_LOAD_SET:
+      return s.path[0] ? Verdict{} : Reject::bad_id;
     case studio_SCENE_MOVE_NODE:
-    case studio_SCENE_REMOVE_NODE: return s.target[0] ? Verdict{} : Reject::bad_id;
-    case studio_SCENE_SPEED: return s.value >= 0 ? Verdict{} : Reject::out_of_range;
+    case studio_SCENE_REMOVE_NODE:
+      return s.target[0] ? Verdict{} : Reject::bad_id;
+    case studio_SCENE_SPEED:
+      return s.value >= 0 ? Verdict{} : Reject::out_of_range;
     case studio_SCENE_PLAY:
     case studio_SCENE_PAUSE:
-    case studio_SCENE_SEEK: return std::nullopt;
+    case studio_SCENE_SEEK:
+      return std::nullopt;
   }
   return Reject::out_of_range;
 }
@@ -241,7 +264,7 @@ Verdict validate(const studio_ProjectorCalibration& s) {
 
 Verdict validate(const studio_ServiceStatus& s) {
   if (!id_ok(s.service) || !id_ok(s.instance) || !text_ok(s.host)) return Reject::bad_id;
-  if (uint32_t(s.state) > studio_SERVICE_FAILED) return Reject::out_of_range;
+  if (raw(s.state) > studio_SERVICE_FAILED) return Reject::out_of_range;
   if (!std::isfinite(s.input_hz) || !std::isfinite(s.output_hz) || !std::isfinite(s.latency_ms))
     return Reject::non_finite;
   if (s.input_hz < 0 || s.output_hz < 0 || s.latency_ms < 0) return Reject::out_of_range;

@@ -37,9 +37,13 @@ class ProcessTest : public ::testing::Test {
   }
 
   // Starts a binary of this build tree (path relative to the build dir) in the test's domain.
-  Process& spawn(const std::string& name, const std::string& binary, std::vector<std::string> args) {
-    auto p = Process::start({.name = name, .binary = built_binary(binary), .args = std::move(args),
-                             .env = dds_.env(), .dir = dir_});
+  Process& spawn(const std::string& name, const std::string& binary,
+                 std::vector<std::string> args) {
+    auto p = Process::start({.name = name,
+                             .binary = built_binary(binary),
+                             .args = std::move(args),
+                             .env = dds_.env(),
+                             .dir = dir_});
     if (!p) throw std::runtime_error(p.error().message);
     processes_.push_back(std::move(*p));
     return processes_.back();

@@ -10,8 +10,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <atomic>
+#include <cctype>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
@@ -100,7 +100,9 @@ void DdsDomain::apply_to_this_process() const {
   for (const auto& [k, v] : env()) setenv(k.c_str(), v.c_str(), 1);
 }
 
-fs::path built_binary(const std::string& relative) { return fs::path(STUDIO_BINARY_DIR) / relative; }
+fs::path built_binary(const std::string& relative) {
+  return fs::path(STUDIO_BINARY_DIR) / relative;
+}
 
 Expected<Process> Process::start(Options o) {
   if (!fs::exists(o.binary)) return fail("harness: no such binary: " + o.binary.string());
@@ -115,7 +117,8 @@ Expected<Process> Process::start(Options o) {
   if (p.notify_fd_ < 0) return fail("harness: socket: " + std::string(std::strerror(errno)));
   sockaddr_un addr{};
   addr.sun_family = AF_UNIX;
-  if (abstract_name.size() + 1 > sizeof addr.sun_path) return fail("harness: process name too long");
+  if (abstract_name.size() + 1 > sizeof addr.sun_path)
+    return fail("harness: process name too long");
   std::memcpy(addr.sun_path + 1, abstract_name.data(), abstract_name.size());
   const socklen_t len = socklen_t(offsetof(sockaddr_un, sun_path) + 1 + abstract_name.size());
   if (bind(p.notify_fd_, reinterpret_cast<sockaddr*>(&addr), len) != 0)
@@ -211,7 +214,8 @@ bool Process::running() {
 std::optional<std::string> Process::next_notification(std::chrono::milliseconds timeout) {
   const auto deadline = Clock::now() + timeout;
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
     pollfd pfd{notify_fd_, POLLIN, 0};
     const int r = poll(&pfd, 1, int(std::clamp<int64_t>(left.count(), 0, 50)));
     if (r > 0) {

@@ -46,11 +46,11 @@ struct DdsDomain {
 class Process {
  public:
   struct Options {
-    std::string name;                  // for logs ("peer", "hull", ...)
+    std::string name;  // for logs ("peer", "hull", ...)
     std::filesystem::path binary;
     std::vector<std::string> args;
-    Env env;                           // added to (and overriding) this process's environment
-    std::filesystem::path dir;         // where <name>.log and the notify socket live
+    Env env;                    // added to (and overriding) this process's environment
+    std::filesystem::path dir;  // where <name>.log and the notify socket live
   };
 
   static Expected<Process> start(Options options);

@@ -39,7 +39,8 @@ void identity4(double (&m)[16], double tx) {
 template <class Seq>
 bool seq_same(const Seq& a, const Seq& b) {
   auto x = view(a), y = view(b);
-  return x.size() == y.size() && (x.empty() || std::memcmp(x.data(), y.data(), x.size_bytes()) == 0);
+  return x.size() == y.size() &&
+         (x.empty() || std::memcmp(x.data(), y.data(), x.size_bytes()) == 0);
 }
 template <std::size_t N>
 bool str_same(const char (&a)[N], const char (&b)[N]) {
@@ -249,8 +250,8 @@ bool same(const studio_CameraState& a, const studio_CameraState& b) {
   auto fa = view(a.features), fb = view(b.features);
   if (fa.size() != fb.size()) return false;
   for (size_t i = 0; i < fa.size(); ++i)
-    if (!str_same(fa[i].name, fb[i].name) || fa[i].value != fb[i].value ||
-        fa[i].min != fb[i].min || fa[i].max != fb[i].max)
+    if (!str_same(fa[i].name, fb[i].name) || fa[i].value != fb[i].value || fa[i].min != fb[i].min ||
+        fa[i].max != fb[i].max)
       return false;
   return str_same(a.camera_id, b.camera_id) && a.frame == b.frame && a.capture_ns == b.capture_ns &&
          a.fps == b.fps && a.drops == b.drops && a.recording == b.recording &&
@@ -301,10 +302,10 @@ bool same(const studio_ServiceStatus& a, const studio_ServiceStatus& b) {
   if (ca.size() != cb.size()) return false;
   for (size_t i = 0; i < ca.size(); ++i)
     if (!str_same(ca[i].name, cb[i].name) || ca[i].value != cb[i].value) return false;
-  return str_same(a.service, b.service) && str_same(a.instance, b.instance) &&
-         a.frame == b.frame && a.capture_ns == b.capture_ns && a.state == b.state &&
-         str_same(a.host, b.host) && a.pid == b.pid && a.input_hz == b.input_hz &&
-         a.output_hz == b.output_hz && a.latency_ms == b.latency_ms;
+  return str_same(a.service, b.service) && str_same(a.instance, b.instance) && a.frame == b.frame &&
+         a.capture_ns == b.capture_ns && a.state == b.state && str_same(a.host, b.host) &&
+         a.pid == b.pid && a.input_hz == b.input_hz && a.output_hz == b.output_hz &&
+         a.latency_ms == b.latency_ms;
 }
 
 }  // namespace studio::testing

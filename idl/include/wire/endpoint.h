@@ -2,11 +2,11 @@
 // Typed topics, writers and readers over the idlc-generated C types.
 //
 //   auto p = wire::Participant::create().value();
-//   auto topic = wire::Topic<studio_AlphaMask>::create(p).value();       // name + QoS from the table
-//   auto writer = wire::Writer<studio_AlphaMask>::create(p, topic).value();
-//   auto reader = wire::Reader<studio_AlphaMask>::create(p, topic).value();
-//   reader.visit([](const studio_AlphaMask& m, const wire::SampleMeta&) { ... });  // loaned, zero-copy
-//   for (auto& s : reader.take()) use(*s.data);                          // owned copies
+//   auto topic = wire::Topic<studio_AlphaMask>::create(p).value();       // name + QoS from the
+//   table auto writer = wire::Writer<studio_AlphaMask>::create(p, topic).value(); auto reader =
+//   wire::Reader<studio_AlphaMask>::create(p, topic).value(); reader.visit([](const
+//   studio_AlphaMask& m, const wire::SampleMeta&) { ... });  // loaned, zero-copy for (auto& s :
+//   reader.take()) use(*s.data);                          // owned copies
 //
 // Every received sample with data is validated (wire/types.h validators) before it is handed
 // out; a rejected sample is dropped and counted per reason (Reader::rejected()). Loans are
@@ -115,8 +115,10 @@ class ReaderBase {
 
   // Sample/instance selection masks (DDS_*_STATE bits).
   static constexpr uint32_t kAny = DDS_ANY_STATE;
-  static constexpr uint32_t kAlive = DDS_ANY_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_ALIVE_INSTANCE_STATE;
-  static constexpr uint32_t kNotRead = DDS_NOT_READ_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_ANY_INSTANCE_STATE;
+  static constexpr uint32_t kAlive =
+      DDS_ANY_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_ALIVE_INSTANCE_STATE;
+  static constexpr uint32_t kNotRead =
+      DDS_NOT_READ_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_ANY_INSTANCE_STATE;
 
  protected:
   ReaderBase() = default;

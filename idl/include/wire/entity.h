@@ -3,13 +3,13 @@
 // GuardCondition, WaitSet. Creation returns studio::Expected with a one-line error naming the
 // DDS return code; destruction deletes the entity (and thereby its children).
 
+#include <dds/dds.h>
+
 #include <chrono>
 #include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <dds/dds.h>
 
 #include "core/error.h"
 #include "wire/types.h"
@@ -69,7 +69,7 @@ class Participant {
   dds_entity_t handle() const { return participant_.handle(); }
 
  private:
-  Entity domain_;       // explicit domain (when config given); deleted after the participant
+  Entity domain_;  // explicit domain (when config given); deleted after the participant
   Entity participant_;
 };
 

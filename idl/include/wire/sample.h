@@ -3,9 +3,9 @@
 // dds_free directly.
 //
 //   wire::Owned<studio_AlphaMask> m;              // zeroed sample, contents freed on destruction
-//   wire::set(m->camera_id, "cam0");              // bounded string; throws std::length_error if too long
-//   wire::assign(m->data, std::span(bytes));      // sequence from a span / vector (copies)
-//   for (uint8_t b : wire::view(m->data)) ...     // sequence as a span
+//   wire::set(m->camera_id, "cam0");              // bounded string; throws std::length_error if
+//   too long wire::assign(m->data, std::span(bytes));      // sequence from a span / vector
+//   (copies) for (uint8_t b : wire::view(m->data)) ...     // sequence as a span
 //
 // Sequences filled by these helpers own their buffer (_release = true) and are freed by the
 // Owned<T> destructor through the type's descriptor (dds_sample_free(..., DDS_FREE_CONTENTS)).

@@ -48,14 +48,14 @@ using Verdict = std::optional<Reject>;
 
 struct TopicRow {
   TopicId id;
-  const char* name;                        // DDS topic name, e.g. "studio/camera/mask"
   const dds_topic_descriptor_t* descriptor;
   std::size_t sample_size;
   Verdict (*validate)(const void* sample);  // the type's validator
-  bool reliable;                           // else best-effort
-  bool transient_local;                    // else volatile
-  int32_t depth;                           // keep-last depth (per instance)
-  int64_t liveliness_lease_ms;             // 0 = infinite (no liveliness contract)
+  const char* name;                         // DDS topic name, e.g. "studio/camera/mask"
+  bool reliable;                            // else best-effort
+  bool transient_local;                     // else volatile
+  int32_t depth;                            // keep-last depth (per instance)
+  int32_t liveliness_lease_s;               // 0 = infinite (no liveliness contract)
 };
 
 const TopicRow& topic_row(TopicId id);
@@ -79,15 +79,13 @@ Verdict validate(const studio_ServiceStatus& s);
 template <class T>
 struct TopicTraits;  // specialised below for every topic type only
 
-#define STUDIO_WIRE_TOPIC(Type, Id)                                    \
-  template <>                                                          \
-  struct TopicTraits<studio_##Type> {                                  \
-    static constexpr TopicId id = TopicId::Id;                         \
-    static const TopicRow& row() { return topic_row(id); }             \
-    static const char* name() { return row().name; }                   \
-    static const dds_topic_descriptor_t* descriptor() {                \
-      return &studio_##Type##_desc;                                    \
-    }                                                                  \
+#define STUDIO_WIRE_TOPIC(Type, Id)                                                     \
+  template <>                                                                           \
+  struct TopicTraits<studio_##Type> {                                                   \
+    static constexpr TopicId id = TopicId::Id;                                          \
+    static const TopicRow& row() { return topic_row(id); }                              \
+    static const char* name() { return row().name; }                                    \
+    static const dds_topic_descriptor_t* descriptor() { return &studio_##Type##_desc; } \
   };
 STUDIO_WIRE_TOPIC(CameraCalibration, camera_calibration)
 STUDIO_WIRE_TOPIC(AlphaMask, camera_mask)
@@ -105,6 +103,8 @@ STUDIO_WIRE_TOPIC(ServiceStatus, service_status)
 #undef STUDIO_WIRE_TOPIC
 
 template <class T>
-concept WireType = requires { TopicTraits<T>::id; };
+concept WireType = requires {
+  TopicTraits<T>::id;
+};
 
 }  // namespace studio::wire
