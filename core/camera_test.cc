@@ -16,7 +16,7 @@ Camera look_at(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, dou
                int h) {
   const Eigen::Vector3d z = (target - centre).normalized();
   const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitY()).normalized();  // right
-  const Eigen::Vector3d y = z.cross(x);                                        // down
+  const Eigen::Vector3d y = z.cross(x);                                      // down
   Eigen::Matrix3d R;
   R.row(0) = x.transpose();
   R.row(1) = y.transpose();
@@ -154,8 +154,8 @@ TEST(Camera, CentreAxisProjectUnproject) {
     cam.distortion = d;
     const Eigen::Vector3d C = cam.centre_in_world();
     EXPECT_LT((cam.cam_from_world * C).norm(), 1e-12);
-    EXPECT_NEAR((cam.cam_from_world.R() * cam.axis_in_world() - Eigen::Vector3d::UnitZ()).norm(),
-                0, 1e-12);
+    EXPECT_NEAR((cam.cam_from_world.R() * cam.axis_in_world() - Eigen::Vector3d::UnitZ()).norm(), 0,
+                1e-12);
     for (int v = 0; v < cam.height; v += 48) {
       for (int u = 0; u < cam.width; u += 64) {
         const Eigen::Vector2d pixel(u, v);
@@ -201,14 +201,14 @@ TEST(Cahv, RoundTripIsExactIncludingSkew) {
     Eigen::Vector2d p;
     ASSERT_TRUE(cam.project(X, &p));
     const Eigen::Vector3d d = X - cahv.C;
-    worst_px = std::max(worst_px, (Eigen::Vector2d(d.dot(cahv.H), d.dot(cahv.V)) / d.dot(cahv.A) - p)
-                                      .norm());
+    worst_px = std::max(worst_px,
+                        (Eigen::Vector2d(d.dot(cahv.H), d.dot(cahv.V)) / d.dot(cahv.A) - p).norm());
     Expected<Camera> back = camera_from_cahv(cahv, cam.width, cam.height);
     ASSERT_TRUE(back) << back.error().message;
     worst_k = std::max(worst_k, max_abs(back->intrinsics.K() - cam.intrinsics.K()));
     worst_R = std::max(worst_R, max_abs(back->cam_from_world.R() - cam.cam_from_world.R()));
-    worst_t = std::max(worst_t, max_abs(back->cam_from_world.translation -
-                                        cam.cam_from_world.translation));
+    worst_t = std::max(worst_t,
+                       max_abs(back->cam_from_world.translation - cam.cam_from_world.translation));
     EXPECT_EQ(back->width, cam.width);
     // A non-unit A describes the same camera.
     Cahv scaled = cahv;
@@ -219,9 +219,10 @@ TEST(Cahv, RoundTripIsExactIncludingSkew) {
     ASSERT_TRUE(back2);
     EXPECT_LT(max_abs(back2->projection_matrix() - cam.projection_matrix()), 1e-9);
   }
-  std::printf("[ measured ] K/Rt -> CAHV -> K/Rt max error: K %.3g, R %.3g, t %.3g; CAHV "
-              "projection %.3g px\n",
-              worst_k, worst_R, worst_t, worst_px);
+  std::printf(
+      "[ measured ] K/Rt -> CAHV -> K/Rt max error: K %.3g, R %.3g, t %.3g; CAHV "
+      "projection %.3g px\n",
+      worst_k, worst_R, worst_t, worst_px);
   EXPECT_LT(worst_k, 1e-9);
   EXPECT_LT(worst_R, 1e-9);
   EXPECT_LT(worst_t, 1e-9);

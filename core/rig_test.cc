@@ -32,14 +32,16 @@ TEST(Rig, FindByIdAndValidate) {
   rig.cameras = {camera("a"), camera("b")};
   Projector p;
   p.camera = camera("p");
-  p.screen = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(0, 1, 0)};
+  p.screen = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 1, 0),
+              Eigen::Vector3d(0, 1, 0)};
   rig.projectors.push_back(p);
   ASSERT_TRUE(rig.validate());
   EXPECT_EQ(rig.find_camera("b"), &rig.cameras[1]);
   EXPECT_EQ(rig.find_camera("p"), nullptr);
   EXPECT_EQ(rig.find_projector("p"), &rig.projectors[0]);
   rig.find_camera("a")->width = 0;
-  EXPECT_EQ(rig.validate().error().message, "cameras[0] (a): image size must be positive, got 0x480");
+  EXPECT_EQ(rig.validate().error().message,
+            "cameras[0] (a): image size must be positive, got 0x480");
   rig.cameras[0].width = 640;
   rig.projectors[0].camera.id = "a";
   EXPECT_EQ(rig.validate().error().message, "projectors[0] (a): duplicate id");
@@ -71,7 +73,8 @@ TEST(RigImport, ProjectionMatrixLists) {
   text.precision(17);
   text << "# two cameras\n";
   for (int k = 0; k < 2; ++k) {
-    for (int r = 0; r < 3; ++r) text << P(r, 0) << ", " << P(r, 1) << ", " << P(r, 2) << ", " << P(r, 3) << "\n";
+    for (int r = 0; r < 3; ++r)
+      text << P(r, 0) << ", " << P(r, 1) << ", " << P(r, 2) << ", " << P(r, 3) << "\n";
   }
   Expected<Rig> rig = import_projection_matrices(write_temp("p2.txt", text.str()), 640, 480, "v");
   ASSERT_TRUE(rig) << rig.error().message;
@@ -80,29 +83,40 @@ TEST(RigImport, ProjectionMatrixLists) {
   EXPECT_LT((rig->cameras[1].projection_matrix() - P).cwiseAbs().maxCoeff(), 1e-9);
 
   const std::string dir = testing::TempDir();
-  EXPECT_EQ(error_of(import_projection_matrices("/nonexistent/p.txt", 640, 480)), "/nonexistent/p.txt: cannot open file");
-  EXPECT_EQ(error_of(import_projection_matrices(write_temp("p_empty.txt", "# nothing\n"), 640, 480)),
-            dir + "/p_empty.txt: no projection matrices (empty file)");
-  EXPECT_EQ(error_of(import_projection_matrices(write_temp("p11.txt", "1 0 0 0\n0 1 0 0\n0 0 1\n"), 640, 480)),
+  EXPECT_EQ(error_of(import_projection_matrices("/nonexistent/p.txt", 640, 480)),
+            "/nonexistent/p.txt: cannot open file");
+  EXPECT_EQ(
+      error_of(import_projection_matrices(write_temp("p_empty.txt", "# nothing\n"), 640, 480)),
+      dir + "/p_empty.txt: no projection matrices (empty file)");
+  EXPECT_EQ(error_of(import_projection_matrices(write_temp("p11.txt", "1 0 0 0\n0 1 0 0\n0 0 1\n"),
+                                                640, 480)),
             dir + "/p11.txt:3: expected 12 numbers per camera, got 11 numbers in total");
-  EXPECT_EQ(error_of(import_projection_matrices(write_temp("pnan.txt", "1 0 0 0\n0 nan 0 0\n0 0 1 0\n"), 640, 480)),
+  EXPECT_EQ(error_of(import_projection_matrices(
+                write_temp("pnan.txt", "1 0 0 0\n0 nan 0 0\n0 0 1 0\n"), 640, 480)),
             dir + "/pnan.txt:2: non-finite number 'nan'");
-  EXPECT_EQ(error_of(import_projection_matrices(write_temp("pword.txt", "1 0 0 0\n0 1 0 0\n0 0 one 0\n"), 640, 480)),
+  EXPECT_EQ(error_of(import_projection_matrices(
+                write_temp("pword.txt", "1 0 0 0\n0 1 0 0\n0 0 one 0\n"), 640, 480)),
             dir + "/pword.txt:3: expected a number, got 'one'");
-  EXPECT_EQ(error_of(import_projection_matrices(write_temp("prank.txt", "1 0 0 0\n1 0 0 0\n0 0 1 0\n"), 640, 480)),
-            dir + "/prank.txt:1: camera 0: P: left 3x3 block is rank-deficient (not a finite projective camera)");
+  EXPECT_EQ(error_of(import_projection_matrices(
+                write_temp("prank.txt", "1 0 0 0\n1 0 0 0\n0 0 1 0\n"), 640, 480)),
+            dir +
+                "/prank.txt:1: camera 0: P: left 3x3 block is rank-deficient (not a finite "
+                "projective camera)");
 }
 
 TEST(RigImport, MiddleburyParFiles) {
-  const std::string line =
-      "view1.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 1 0.1 0.2 3\n";
-  Expected<Rig> rig = import_middlebury(write_temp("ok_par.txt", "2\n" + line + "view2.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 1 0 0 3\n"), 640, 480);
+  const std::string line = "view1.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 1 0.1 0.2 3\n";
+  Expected<Rig> rig = import_middlebury(
+      write_temp("ok_par.txt",
+                 "2\n" + line + "view2.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 1 0 0 3\n"),
+      640, 480);
   ASSERT_TRUE(rig) << rig.error().message;
   EXPECT_EQ(rig->cameras[0].id, "view1");
   EXPECT_EQ(rig->cameras[0].cam_from_world.translation, Eigen::Vector3d(0.1, 0.2, 3));
 
   const std::string dir = testing::TempDir();
-  EXPECT_EQ(error_of(import_middlebury(write_temp("m0.txt", ""), 640, 480)), dir + "/m0.txt: empty file");
+  EXPECT_EQ(error_of(import_middlebury(write_temp("m0.txt", ""), 640, 480)),
+            dir + "/m0.txt: empty file");
   EXPECT_EQ(error_of(import_middlebury(write_temp("m1.txt", "two\n" + line), 640, 480)),
             dir + "/m1.txt:1: expected the camera count on the first line");
   EXPECT_EQ(error_of(import_middlebury(write_temp("m2.txt", "2\n" + line), 640, 480)),
@@ -111,13 +125,20 @@ TEST(RigImport, MiddleburyParFiles) {
             dir + "/m3.txt:3: more camera lines than the count 1");
   EXPECT_EQ(error_of(import_middlebury(write_temp("m4.txt", "1\nview1.png 500 0 320\n"), 640, 480)),
             dir + "/m4.txt:2: expected a name and 21 numbers, got 4 fields");
-  EXPECT_EQ(error_of(import_middlebury(write_temp("m5.txt", "1\nview1.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 -1 0 0 3\n"), 640, 480)),
-            dir + "/m5.txt:2: R: not a rotation matrix (max |R^T R - I| = 0, det = -1)");
-  EXPECT_EQ(error_of(import_middlebury(write_temp("m6.txt", "1\nview1.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 1 0 inf 3\n"), 640, 480)),
+  EXPECT_EQ(
+      error_of(import_middlebury(
+          write_temp("m5.txt", "1\nview1.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 -1 0 0 3\n"),
+          640, 480)),
+      dir + "/m5.txt:2: R: not a rotation matrix (max |R^T R - I| = 0, det = -1)");
+  EXPECT_EQ(error_of(import_middlebury(
+                write_temp("m6.txt",
+                           "1\nview1.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 1 0 inf 3\n"),
+                640, 480)),
             dir + "/m6.txt:2: non-finite number 'inf'");
   EXPECT_EQ(error_of(import_middlebury(write_temp("m7.txt", "2\n" + line + line), 640, 480)),
             dir + "/m7.txt:3: duplicate camera 'view1'");
-  EXPECT_EQ(error_of(import_middlebury("/nonexistent/x_par.txt", 640, 480)), "/nonexistent/x_par.txt: cannot open file");
+  EXPECT_EQ(error_of(import_middlebury("/nonexistent/x_par.txt", 640, 480)),
+            "/nonexistent/x_par.txt: cannot open file");
 }
 
 }  // namespace

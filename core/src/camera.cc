@@ -190,7 +190,8 @@ Cahv to_cahv(const Camera& camera) {
 
 Expected<Camera> camera_from_cahv(const Cahv& cahv, int width, int height) {
   if (width < 0 || height < 0) {
-    return fail("CAHV: negative image size " + std::to_string(width) + "x" + std::to_string(height));
+    return fail("CAHV: negative image size " + std::to_string(width) + "x" +
+                std::to_string(height));
   }
   if (!finite(cahv.C) || !finite(cahv.A) || !finite(cahv.H) || !finite(cahv.V)) {
     return fail("CAHV: non-finite vector");

@@ -84,7 +84,8 @@ Expected<void> Rig::validate() const {
     }
     // Non-degenerate: the two diagonals' cross product gives twice the (planar) area.
     const Eigen::Vector3d normal = (p.screen[2] - p.screen[0]).cross(p.screen[3] - p.screen[1]);
-    const double size = std::max((p.screen[2] - p.screen[0]).norm(), (p.screen[3] - p.screen[1]).norm());
+    const double size =
+        std::max((p.screen[2] - p.screen[0]).norm(), (p.screen[3] - p.screen[1]).norm());
     if (!(normal.norm() > 1e-9 * size * size) || !(size > 0)) {
       return fail(at + "corners are degenerate (zero area)");
     }
@@ -100,7 +101,8 @@ Expected<void> Rig::validate() const {
 
 Expected<Rigid3> rigid_from_matrix(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
   if (!R.allFinite() || !t.allFinite()) return fail("non-finite number");
-  const double orthogonality = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orthogonality =
+      (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   const double det = R.determinant();
   if (orthogonality > 1e-4 || !(det > 0)) {
     return fail("not a rotation matrix (max |R^T R - I| = " + num(orthogonality) +

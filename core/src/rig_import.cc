@@ -43,7 +43,9 @@ Expected<double> parse_number(const std::string& path, const Token& t) {
   return value;
 }
 
-std::string at(const std::string& path, int line) { return path + ":" + std::to_string(line) + ": "; }
+std::string at(const std::string& path, int line) {
+  return path + ":" + std::to_string(line) + ": ";
+}
 
 }  // namespace
 

@@ -79,10 +79,24 @@ const char* kText =
     "view2.png 500 0 320 0 500 240 0 0 1 0 0 -1 0 1 0 1 0 0 0 0 3\n";
 
 std::string mutate(std::string s, std::mt19937& rng) {
-  static const char* tokens[] = {"[", "]", "{", "}", ":", ": ", "- ", "\n", "\n  ", ",", "#", "&a ",
-                                 "*a", "!!opencv-matrix", "%YAML 1.2\n", "\"", "'", ".inf", ".nan",
-                                 "-", "1e308", "1e-320", "0", "99999999999999999999", "~", "K",
-                                 "P", "R", "t", "cahv", "radial", "id", "\t", "\x01", "\xff"};
+  static const char* tokens[] = {"[",           "]",
+                                 "{",           "}",
+                                 ":",           ": ",
+                                 "- ",          "\n",
+                                 "\n  ",        ",",
+                                 "#",           "&a ",
+                                 "*a",          "!!opencv-matrix",
+                                 "%YAML 1.2\n", "\"",
+                                 "'",           ".inf",
+                                 ".nan",        "-",
+                                 "1e308",       "1e-320",
+                                 "0",           "99999999999999999999",
+                                 "~",           "K",
+                                 "P",           "R",
+                                 "t",           "cahv",
+                                 "radial",      "id",
+                                 "\t",          "\x01",
+                                 "\xff"};
   const int edits = 1 + static_cast<int>(rng() % 4);
   for (int e = 0; e < edits && !s.empty(); ++e) {
     const std::size_t at = rng() % s.size();
@@ -128,8 +142,9 @@ TEST(DecoderMutations, RigYaml) {
     ASSERT_TRUE(again) << again.error().message << "\n" << format_rig(*rig);
     ASSERT_EQ(again->cameras.size(), rig->cameras.size());
   }
-  std::printf("[ measured ] rig.yaml mutations: %d of 3000 still valid rigs, the rest one-line errors\n",
-              accepted);
+  std::printf(
+      "[ measured ] rig.yaml mutations: %d of 3000 still valid rigs, the rest one-line errors\n",
+      accepted);
 }
 
 TEST(DecoderMutations, OpenCvYaml) {
@@ -149,8 +164,8 @@ TEST(DecoderMutations, TextImporters) {
   std::mt19937 rng(11);
   for (int i = 0; i < 3000; ++i) {
     const std::string text = mutate(kText, rng);
-    for (const Expected<Rig>& rig :
-         {parse_middlebury(text, "m_par.txt", 640, 480), parse_projection_matrices(text, "p.txt", 640, 480)}) {
+    for (const Expected<Rig>& rig : {parse_middlebury(text, "m_par.txt", 640, 480),
+                                     parse_projection_matrices(text, "p.txt", 640, 480)}) {
       if (!rig) {
         expect_one_line(rig.error());
         continue;
@@ -163,9 +178,10 @@ TEST(DecoderMutations, TextImporters) {
 TEST(DecoderMutations, PathologicalYaml) {
   // Deep nesting, alias fan-out and huge scalars end in an error, not a stack overflow.
   for (const std::string& text :
-       {std::string(100000, '[') , "cameras: " + std::string(50000, '{'),
-        std::string("a: &a [1, 2, 3, 4, 5, 6, 7, 8, 9]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\n"
-        "cameras: [*b, *b, *b, *b, *b, *b, *b, *b, *b]\n"),
+       {std::string(100000, '['), "cameras: " + std::string(50000, '{'),
+        std::string(
+            "a: &a [1, 2, 3, 4, 5, 6, 7, 8, 9]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\n"
+            "cameras: [*b, *b, *b, *b, *b, *b, *b, *b, *b]\n"),
         "cameras:\n  - id: " + std::string(1 << 20, 'x') + "\n"}) {
     Expected<Rig> rig = parse_rig(text, "p.yaml");
     ASSERT_FALSE(rig);

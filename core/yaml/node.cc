@@ -154,7 +154,11 @@ Expected<std::vector<double>> Node::as_doubles(std::optional<std::size_t> count)
   const auto expected_what = [&] {
     return count ? "expected " + plural(*count, "number") : std::string("expected numbers");
   };
-  if (!is_sequence()) return fail(expected_what() + ", got " + (is_map() ? "a mapping" : is_null() ? "nothing" : "a scalar"));
+  if (!is_sequence())
+    return fail(expected_what() + ", got " +
+                (is_map()    ? "a mapping"
+                 : is_null() ? "nothing"
+                             : "a scalar"));
   if (count && size() != *count) return fail(expected_what() + ", got " + std::to_string(size()));
   Expected<std::vector<Node>> items = elements();
   if (!items) return std::unexpected(items.error());
@@ -254,7 +258,9 @@ Expected<std::optional<std::string>> MapReader::one_of(std::vector<std::string_v
   }
   for (std::string_view k : keys) {
     if (!has(k)) continue;
-    if (found) return node_.fail("expected exactly one of " + names + ", got both " + *found + " and " + std::string(k));
+    if (found)
+      return node_.fail("expected exactly one of " + names + ", got both " + *found + " and " +
+                        std::string(k));
     found = std::string(k);
   }
   if (!found && required) return node_.fail("expected one of " + names);
@@ -265,8 +271,8 @@ Expected<void> MapReader::finish() const {
   for (std::size_t i = 0; i < entries_.size(); ++i) {
     if (!used_[i]) {
       const Node& n = entries_[i].second;
-      return std::unexpected(Error{one_line(n.file() + ":" + std::to_string(n.line()) + ": " +
-                                            n.path() + ": unknown key")});
+      return std::unexpected(Error{
+          one_line(n.file() + ":" + std::to_string(n.line()) + ": " + n.path() + ": unknown key")});
     }
   }
   return {};

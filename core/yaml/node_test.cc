@@ -12,7 +12,8 @@ namespace {
 testing::AssertionResult FailsWith(const Expected<void>& r, const std::string& text) {
   if (r) return testing::AssertionFailure() << "succeeded, expected an error containing: " << text;
   if (r.error().message.find(text) == std::string::npos) {
-    return testing::AssertionFailure() << "error '" << r.error().message << "' lacks '" << text << "'";
+    return testing::AssertionFailure()
+           << "error '" << r.error().message << "' lacks '" << text << "'";
   }
   return testing::AssertionSuccess();
 }
@@ -49,14 +50,21 @@ TEST(YamlNode, TypedScalarsAreStrict) {
   ASSERT_TRUE(map);
   EXPECT_EQ(*map->required("i")->as_int(), 42);
   EXPECT_EQ(*map->required("f")->as_double(), 2.5);
-  EXPECT_TRUE(FailsWith(status(map->required("bad")->as_double()), "s.yaml:3: bad: expected a number, got '4x'"));
-  EXPECT_TRUE(FailsWith(status(map->required("frac")->as_int()), "s.yaml:4: frac: expected an integer, got '3.5'"));
-  EXPECT_TRUE(FailsWith(status(map->required("inf")->as_double()), "s.yaml:5: inf: non-finite number"));
-  EXPECT_TRUE(FailsWith(status(map->required("nan")->as_double()), "s.yaml:6: nan: non-finite number"));
-  EXPECT_TRUE(FailsWith(status(map->required("big")->as_int()), "s.yaml:7: big: integer out of range"));
+  EXPECT_TRUE(FailsWith(status(map->required("bad")->as_double()),
+                        "s.yaml:3: bad: expected a number, got '4x'"));
+  EXPECT_TRUE(FailsWith(status(map->required("frac")->as_int()),
+                        "s.yaml:4: frac: expected an integer, got '3.5'"));
+  EXPECT_TRUE(
+      FailsWith(status(map->required("inf")->as_double()), "s.yaml:5: inf: non-finite number"));
+  EXPECT_TRUE(
+      FailsWith(status(map->required("nan")->as_double()), "s.yaml:6: nan: non-finite number"));
+  EXPECT_TRUE(
+      FailsWith(status(map->required("big")->as_int()), "s.yaml:7: big: integer out of range"));
   EXPECT_EQ(*map->required("b")->as_bool(), true);
-  EXPECT_TRUE(FailsWith(status(map->required("nb")->as_bool()), "s.yaml:9: nb: expected true or false"));
-  EXPECT_TRUE(FailsWith(status(map->required("cinf")->as_double()), "s.yaml:10: cinf: non-finite number"));
+  EXPECT_TRUE(
+      FailsWith(status(map->required("nb")->as_bool()), "s.yaml:9: nb: expected true or false"));
+  EXPECT_TRUE(
+      FailsWith(status(map->required("cinf")->as_double()), "s.yaml:10: cinf: non-finite number"));
   EXPECT_TRUE(map->finish());
 }
 
@@ -73,8 +81,10 @@ TEST(YamlNode, MapReaderReportsUnknownMissingDuplicateAndAmbiguousKeys) {
   ASSERT_TRUE(bmap);
   Expected<Node> c = bmap->required("c");
   EXPECT_TRUE(FailsWith(status(c->as_doubles(4)), "m.yaml:3: b.c: expected 4 numbers, got 3"));
-  EXPECT_TRUE(FailsWith(status(bmap->required("d")->as_doubles()), "m.yaml:4: b.d: expected numbers, got a scalar"));
-  EXPECT_TRUE(FailsWith(status(bmap->required("missing")), "m.yaml:2: b.missing: missing required key"));
+  EXPECT_TRUE(FailsWith(status(bmap->required("d")->as_doubles()),
+                        "m.yaml:4: b.d: expected numbers, got a scalar"));
+  EXPECT_TRUE(
+      FailsWith(status(bmap->required("missing")), "m.yaml:2: b.missing: missing required key"));
   EXPECT_TRUE(bmap->finish());
   EXPECT_TRUE(FailsWith(map->finish(), "m.yaml:5: foo: unknown key"));
   EXPECT_TRUE(FailsWith(status(map->one_of({"a", "foo"}, true)), "expected exactly one of a, foo"));
@@ -84,8 +94,10 @@ TEST(YamlNode, MapReaderReportsUnknownMissingDuplicateAndAmbiguousKeys) {
   Expected<Node> dup = parse("a: 1\na: 2\n", "d.yaml");
   ASSERT_TRUE(dup);
   EXPECT_TRUE(FailsWith(status(dup->entries()), "d.yaml:2: a: duplicate key"));
-  EXPECT_TRUE(FailsWith(status(MapReader::from(*parse("- 1\n- 2\n", "l.yaml"))), "l.yaml:1: expected a mapping"));
-  EXPECT_TRUE(FailsWith(status(MapReader::from(*parse("just text", "t.yaml"))), "t.yaml:1: expected a mapping"));
+  EXPECT_TRUE(FailsWith(status(MapReader::from(*parse("- 1\n- 2\n", "l.yaml"))),
+                        "l.yaml:1: expected a mapping"));
+  EXPECT_TRUE(FailsWith(status(MapReader::from(*parse("just text", "t.yaml"))),
+                        "t.yaml:1: expected a mapping"));
 }
 
 TEST(YamlNode, ElementPathsAndLines) {
@@ -96,12 +108,13 @@ TEST(YamlNode, ElementPathsAndLines) {
   ASSERT_TRUE(items);
   ASSERT_EQ(items->size(), 2u);
   EXPECT_EQ((*items)[1].path(), "list[1]");
-  EXPECT_TRUE(FailsWith(status((*items)[1].as_doubles(2)), "p.yaml:3: list[1][1]: expected a number, got 'x'"));
+  EXPECT_TRUE(FailsWith(status((*items)[1].as_doubles(2)),
+                        "p.yaml:3: list[1][1]: expected a number, got 'x'"));
 }
 
 TEST(YamlNode, FormatDoubleRoundTripsExactly) {
-  for (double x : {0.1, 1.0 / 3.0, -2.5e-300, 6.02214076e23, 704.0, -0.0, 1e-7,
-                   std::nextafter(1.0, 2.0)}) {
+  for (double x :
+       {0.1, 1.0 / 3.0, -2.5e-300, 6.02214076e23, 704.0, -0.0, 1e-7, std::nextafter(1.0, 2.0)}) {
     const std::string s = format_double(x);
     Expected<Node> n = parse("v: " + s + "\n", "f.yaml");
     ASSERT_TRUE(n);

@@ -58,7 +58,8 @@ Expected<MatrixValue> read_matrix(const Node& n) {
 }
 
 // The first key of `names` present in the map, read as a matrix.
-Expected<std::optional<MatrixValue>> find_matrix(MapReader& map, std::initializer_list<const char*> names) {
+Expected<std::optional<MatrixValue>> find_matrix(MapReader& map,
+                                                 std::initializer_list<const char*> names) {
   for (const char* name : names) {
     if (std::optional<Node> n = map.optional(name)) {
       Expected<MatrixValue> m = read_matrix(*n);
@@ -136,7 +137,8 @@ Expected<int> find_size(MapReader& map, std::initializer_list<const char*> names
   return fallback;
 }
 
-void write_matrix(std::ostringstream& out, const char* name, int rows, int cols, const double* data) {
+void write_matrix(std::ostringstream& out, const char* name, int rows, int cols,
+                  const double* data) {
   out << name << ": !!opencv-matrix\n   rows: " << rows << "\n   cols: " << cols
       << "\n   dt: d\n   data: [ ";
   for (int i = 0; i < rows * cols; ++i) out << (i ? ", " : "") << format_double(data[i]);
@@ -198,7 +200,8 @@ Expected<Rig> parse_opencv_yaml(std::string_view text, const std::string& name, 
     if (!D1) return std::unexpected(D1.error());
     Expected<std::optional<MatrixValue>> D2 = find_matrix(*map, {"D2"});
     if (!D2) return std::unexpected(D2.error());
-    if (auto ok = add_camera(**K1, *D1, Rigid3::identity()); !ok) return std::unexpected(ok.error());
+    if (auto ok = add_camera(**K1, *D1, Rigid3::identity()); !ok)
+      return std::unexpected(ok.error());
     if (auto ok = add_camera(**K2, *D2, *pose); !ok) return std::unexpected(ok.error());
     return rig;
   }

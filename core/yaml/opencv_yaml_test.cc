@@ -15,7 +15,8 @@ Camera sample_camera() {
   c.height = 720;
   c.intrinsics = Intrinsics{1012.123456789, 1009.87654321, 641.25, 359.75, 0.125};
   c.distortion = Distortion::opencv(-0.2345, 0.0789, 0.00123, -0.00045, -0.0123);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, -1, 0.2).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, -1, 0.2).normalized()).toRotationMatrix();
   c.cam_from_world = Rigid3(R, Eigen::Vector3d(0.25, -1.5, 3.75));
   return c;
 }
@@ -30,7 +31,8 @@ cv::Mat to_cv(const Eigen::MatrixXd& m) {
 double max_diff(const cv::Mat& a, const Eigen::MatrixXd& b) {
   double worst = 0;
   for (int r = 0; r < a.rows; ++r)
-    for (int c = 0; c < a.cols; ++c) worst = std::max(worst, std::abs(a.at<double>(r, c) - b(r, c)));
+    for (int c = 0; c < a.cols; ++c)
+      worst = std::max(worst, std::abs(a.at<double>(r, c) - b(r, c)));
   return worst;
 }
 
@@ -55,8 +57,10 @@ TEST(OpenCvYaml, ExportIsReadByCvFileStorage) {
   const double eR = max_diff(R, cam.cam_from_world.R());
   const double eT = max_diff(T, cam.cam_from_world.translation);
   const Distortion& d = cam.distortion;
-  const double eD = max_diff(D.reshape(1, 5), Eigen::Matrix<double, 5, 1>(d.k1, d.k2, d.p1, d.p2, d.k3));
-  std::printf("[ measured ] export -> cv::FileStorage: max diff K %.3g, D %.3g, R %.3g, T %.3g\n", eK, eD, eR, eT);
+  const double eD =
+      max_diff(D.reshape(1, 5), Eigen::Matrix<double, 5, 1>(d.k1, d.k2, d.p1, d.p2, d.k3));
+  std::printf("[ measured ] export -> cv::FileStorage: max diff K %.3g, D %.3g, R %.3g, T %.3g\n",
+              eK, eD, eR, eT);
   EXPECT_EQ(eK, 0);
   EXPECT_EQ(eD, 0);
   EXPECT_EQ(eR, 0);
@@ -66,7 +70,8 @@ TEST(OpenCvYaml, ExportIsReadByCvFileStorage) {
   ASSERT_TRUE(back) << back.error().message;
   ASSERT_EQ(back->cameras.size(), 1u);
   EXPECT_EQ((back->cameras[0].intrinsics.K() - cam.intrinsics.K()).cwiseAbs().maxCoeff(), 0);
-  EXPECT_LT((back->cameras[0].cam_from_world.R() - cam.cam_from_world.R()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_LT((back->cameras[0].cam_from_world.R() - cam.cam_from_world.R()).cwiseAbs().maxCoeff(),
+            1e-15);
 }
 
 TEST(OpenCvYaml, ImportsFilesWrittenByCvFileStorage) {
@@ -99,7 +104,8 @@ TEST(OpenCvYaml, ImportsFilesWrittenByCvFileStorage) {
     cv::FileStorage fs(stereo, cv::FileStorage::WRITE);
     fs << "image_width" << 640 << "image_height" << 480;
     fs << "K1" << to_cv(cam.intrinsics.K()) << "D1" << cv::Mat::zeros(1, 8, CV_64F);
-    fs << "K2" << to_cv(cam.intrinsics.K()) << "D2" << (cv::Mat_<double>(5, 1) << -0.1, 0.01, 0, 0, 0);
+    fs << "K2" << to_cv(cam.intrinsics.K()) << "D2"
+       << (cv::Mat_<double>(5, 1) << -0.1, 0.01, 0, 0, 0);
     fs << "R" << to_cv(cam.cam_from_world.R()) << "T" << to_cv(cam.cam_from_world.translation);
     fs << "E" << cv::Mat::eye(3, 3, CV_64F) << "F" << cv::Mat::eye(3, 3, CV_64F);
   }
@@ -109,7 +115,8 @@ TEST(OpenCvYaml, ImportsFilesWrittenByCvFileStorage) {
   EXPECT_EQ(pair->cameras[1].id, "stereo1");
   EXPECT_EQ(pair->cameras[0].width, 640);
   EXPECT_LT(pair->cameras[0].centre_in_world().norm(), 1e-15);
-  EXPECT_LT((pair->cameras[1].cam_from_world.R() - cam.cam_from_world.R()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_LT((pair->cameras[1].cam_from_world.R() - cam.cam_from_world.R()).cwiseAbs().maxCoeff(),
+            1e-15);
   EXPECT_EQ(pair->cameras[1].distortion.k1, -0.1);
 }
 
@@ -119,34 +126,42 @@ std::string error_of(const std::string& text, int w = 640, int h = 480) {
 }
 
 const char* kMatrix =
-    "%YAML:1.0\n---\nK: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n";
+    "%YAML:1.0\n---\nK: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., "
+    "320., 0., 500., 240., 0., 0., 1. ]\n";
 
 TEST(OpenCvYaml, BadInputNamesFileLineAndField) {
   EXPECT_EQ(error_of(kMatrix), "<ok>");
-  EXPECT_EQ(error_of(std::string(kMatrix) + "T: [1, 2, 3]\n"), "cv.yaml:3: R and T must be given together");
+  EXPECT_EQ(error_of(std::string(kMatrix) + "T: [1, 2, 3]\n"),
+            "cv.yaml:3: R and T must be given together");
   std::string s = kMatrix;
   s.replace(s.find(" 1. ]"), 5, " ]");
   EXPECT_EQ(error_of(s), "cv.yaml:7: K.data: expected 9 numbers (3x3), got 8");
   s = kMatrix;
   s.replace(s.find("dt: d"), 5, "dt: q");
-  EXPECT_EQ(error_of(s), "cv.yaml:6: K.dt: unsupported element type 'q' (expected one of d f i s u w c)");
+  EXPECT_EQ(error_of(s),
+            "cv.yaml:6: K.dt: unsupported element type 'q' (expected one of d f i s u w c)");
   s = kMatrix;
   s.replace(s.find("rows: 3"), 7, "rows: x");
   EXPECT_EQ(error_of(s), "cv.yaml:4: K.rows: expected an integer, got 'x'");
-  EXPECT_EQ(error_of(kMatrix, 0, 0), "cv.yaml:3: image size unknown: the file has no image_width/image_height; pass it");
-  EXPECT_EQ(error_of("%YAML:1.0\n---\nfoo: 1\n"), "cv.yaml:3: no camera matrix (expected K, camera_matrix or K1/K2)");
+  EXPECT_EQ(error_of(kMatrix, 0, 0),
+            "cv.yaml:3: image size unknown: the file has no image_width/image_height; pass it");
+  EXPECT_EQ(error_of("%YAML:1.0\n---\nfoo: 1\n"),
+            "cv.yaml:3: no camera matrix (expected K, camera_matrix or K1/K2)");
   EXPECT_EQ(error_of(std::string(kMatrix) + "distCoeffs: [0.1, 0, 0, 0, 0, 0.5, 0, 0]\n"),
-            "cv.yaml:8: distCoeffs: only k1 k2 p1 p2 k3 are supported; coefficient 5 (rational / thin-prism / tilt) is not zero");
+            "cv.yaml:8: distCoeffs: only k1 k2 p1 p2 k3 are supported; coefficient 5 (rational / "
+            "thin-prism / tilt) is not zero");
   EXPECT_EQ(error_of(std::string(kMatrix) + "distCoeffs: [0.1, 0, 0]\n"),
             "cv.yaml:8: distCoeffs: expected 4, 5, 8, 12 or 14 distortion coefficients, got 3");
   EXPECT_EQ(error_of(std::string(kMatrix) + "R: [1, 0, 0, 1]\nT: [0, 0, 0]\n"),
             "cv.yaml:8: R: expected a 3x3 rotation matrix or a 3-vector, got 4x1");
-  EXPECT_EQ(error_of(std::string(kMatrix) +
-                     "R: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [1, 0, 0, 0, 1, 0, 0, 0, 2]\nT: [0, 0, .nan]\n"),
-            "cv.yaml:13: T[2]: non-finite number '.nan'");
-  EXPECT_EQ(error_of(std::string(kMatrix) +
-                     "R: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [1, 0, 0, 0, 1, 0, 0, 0, 2]\nT: [0, 0, 0]\n"),
-            "cv.yaml:8: R: not a rotation matrix (max |R^T R - I| = 3, det = 2)");
+  EXPECT_EQ(
+      error_of(std::string(kMatrix) + "R: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   "
+                                      "data: [1, 0, 0, 0, 1, 0, 0, 0, 2]\nT: [0, 0, .nan]\n"),
+      "cv.yaml:13: T[2]: non-finite number '.nan'");
+  EXPECT_EQ(
+      error_of(std::string(kMatrix) + "R: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   "
+                                      "data: [1, 0, 0, 0, 1, 0, 0, 0, 2]\nT: [0, 0, 0]\n"),
+      "cv.yaml:8: R: not a rotation matrix (max |R^T R - I| = 3, det = 2)");
   EXPECT_EQ(error_of("%YAML:1.0\n---\nK: [1, 2\n").substr(0, 8), "cv.yaml:");
   Expected<Rig> missing = import_opencv_yaml("/nonexistent/calib.yml");
   ASSERT_FALSE(missing);

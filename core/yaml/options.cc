@@ -1,10 +1,11 @@
 // Built-in value readers of yaml_io/options.h. Pure Node API: no yaml-cpp here.
+#include "yaml_io/options.h"
+
 #include <cmath>
 #include <filesystem>
 #include <limits>
 
 #include "yaml_io/node.h"
-#include "yaml_io/options.h"
 
 namespace studio::yaml {
 namespace {
@@ -55,9 +56,15 @@ Expected<void> read_value(const Node& n, bool& out, const Constraints&) {
   return {};
 }
 
-Expected<void> read_value(const Node& n, int& out, const Constraints& c) { return read_integer(n, out, c); }
-Expected<void> read_value(const Node& n, unsigned& out, const Constraints& c) { return read_integer(n, out, c); }
-Expected<void> read_value(const Node& n, std::int64_t& out, const Constraints& c) { return read_integer(n, out, c); }
+Expected<void> read_value(const Node& n, int& out, const Constraints& c) {
+  return read_integer(n, out, c);
+}
+Expected<void> read_value(const Node& n, unsigned& out, const Constraints& c) {
+  return read_integer(n, out, c);
+}
+Expected<void> read_value(const Node& n, std::int64_t& out, const Constraints& c) {
+  return read_integer(n, out, c);
+}
 
 Expected<void> read_value(const Node& n, std::uint64_t& out, const Constraints& c) {
   std::int64_t v = 0;
@@ -78,7 +85,8 @@ Expected<void> read_value(const Node& n, double& out, const Constraints& c) {
 Expected<void> read_value(const Node& n, float& out, const Constraints& c) {
   double v = 0;
   if (Expected<void> ok = read_value(n, v, c); !ok) return ok;
-  if (std::abs(v) > std::numeric_limits<float>::max()) return n.fail("number out of range for float");
+  if (std::abs(v) > std::numeric_limits<float>::max())
+    return n.fail("number out of range for float");
   out = static_cast<float>(v);
   return {};
 }

@@ -54,7 +54,9 @@ Expected<Options> read(const std::string& text) {
   return schema.read(*root);
 }
 
-std::string error_of(const Expected<Options>& o) { return o ? std::string("<ok>") : o.error().message; }
+std::string error_of(const Expected<Options>& o) {
+  return o ? std::string("<ok>") : o.error().message;
+}
 
 TEST(YamlOptions, ReadsDeclaredFieldsAndKeepsDefaults) {
   Expected<Options> o = read(
@@ -77,24 +79,38 @@ TEST(YamlOptions, ReadsDeclaredFieldsAndKeepsDefaults) {
 
 TEST(YamlOptions, EveryKindOfBadInputNamesFileLineAndField) {
   EXPECT_EQ(error_of(read("grid: 64\n")), "/etc/studio/hull.yaml:1: rig: missing required key");
-  EXPECT_EQ(error_of(read("rig: r\ngrid: 4\n")), "/etc/studio/hull.yaml:2: grid: must be in [8, 1024], got 4");
-  EXPECT_EQ(error_of(read("rig: r\ngrid: many\n")), "/etc/studio/hull.yaml:2: grid: expected an integer, got 'many'");
-  EXPECT_EQ(error_of(read("rig: r\nmargin: -1\n")), "/etc/studio/hull.yaml:2: margin: must be at least 0, got -1");
-  EXPECT_EQ(error_of(read("rig: r\nmargin: .nan\n")), "/etc/studio/hull.yaml:2: margin: non-finite number '.nan'");
-  EXPECT_EQ(error_of(read("rig: r\ntiming: 1\n")), "/etc/studio/hull.yaml:2: timing: expected true or false, got '1'");
-  EXPECT_EQ(error_of(read("rig: r\naxis: w\n")), "/etc/studio/hull.yaml:2: axis: expected one of x, y, z, got 'w'");
+  EXPECT_EQ(error_of(read("rig: r\ngrid: 4\n")),
+            "/etc/studio/hull.yaml:2: grid: must be in [8, 1024], got 4");
+  EXPECT_EQ(error_of(read("rig: r\ngrid: many\n")),
+            "/etc/studio/hull.yaml:2: grid: expected an integer, got 'many'");
+  EXPECT_EQ(error_of(read("rig: r\nmargin: -1\n")),
+            "/etc/studio/hull.yaml:2: margin: must be at least 0, got -1");
+  EXPECT_EQ(error_of(read("rig: r\nmargin: .nan\n")),
+            "/etc/studio/hull.yaml:2: margin: non-finite number '.nan'");
+  EXPECT_EQ(error_of(read("rig: r\ntiming: 1\n")),
+            "/etc/studio/hull.yaml:2: timing: expected true or false, got '1'");
+  EXPECT_EQ(error_of(read("rig: r\naxis: w\n")),
+            "/etc/studio/hull.yaml:2: axis: expected one of x, y, z, got 'w'");
   EXPECT_EQ(error_of(read("rig: r\nkey: red\n")),
             "/etc/studio/hull.yaml:2: key: expected one of blue, green, difference, got 'red'");
-  EXPECT_EQ(error_of(read("rig: r\nbox: [0, 0, 0, 1, 1]\n")), "/etc/studio/hull.yaml:2: box: expected 6 numbers, got 5");
-  EXPECT_EQ(error_of(read("rig: r\nbox: 3\n")), "/etc/studio/hull.yaml:2: box: expected a sequence of numbers");
-  EXPECT_EQ(error_of(read("rig: r\nepoch_ns: -5\n")), "/etc/studio/hull.yaml:2: epoch_ns: must not be negative, got -5");
+  EXPECT_EQ(error_of(read("rig: r\nbox: [0, 0, 0, 1, 1]\n")),
+            "/etc/studio/hull.yaml:2: box: expected 6 numbers, got 5");
+  EXPECT_EQ(error_of(read("rig: r\nbox: 3\n")),
+            "/etc/studio/hull.yaml:2: box: expected a sequence of numbers");
+  EXPECT_EQ(error_of(read("rig: r\nepoch_ns: -5\n")),
+            "/etc/studio/hull.yaml:2: epoch_ns: must not be negative, got -5");
   EXPECT_EQ(error_of(read("rig: r\ngird: 64\n")), "/etc/studio/hull.yaml:2: gird: unknown key");
-  EXPECT_EQ(error_of(read("rig: r\ninner:\n  gain: 11\n")), "/etc/studio/hull.yaml:3: inner.gain: must be in [0, 10], got 11");
-  EXPECT_EQ(error_of(read("rig: r\ninner:\n  ports: [0]\n")), "/etc/studio/hull.yaml:3: inner.ports[0]: must be in [1, 65535], got 0");
-  EXPECT_EQ(error_of(read("rig: r\ninner:\n  extra: 1\n")), "/etc/studio/hull.yaml:3: inner.extra: unknown key");
-  EXPECT_EQ(error_of(read("rig: r\ninner: 5\n")), "/etc/studio/hull.yaml:2: inner: expected a mapping");
+  EXPECT_EQ(error_of(read("rig: r\ninner:\n  gain: 11\n")),
+            "/etc/studio/hull.yaml:3: inner.gain: must be in [0, 10], got 11");
+  EXPECT_EQ(error_of(read("rig: r\ninner:\n  ports: [0]\n")),
+            "/etc/studio/hull.yaml:3: inner.ports[0]: must be in [1, 65535], got 0");
+  EXPECT_EQ(error_of(read("rig: r\ninner:\n  extra: 1\n")),
+            "/etc/studio/hull.yaml:3: inner.extra: unknown key");
+  EXPECT_EQ(error_of(read("rig: r\ninner: 5\n")),
+            "/etc/studio/hull.yaml:2: inner: expected a mapping");
   EXPECT_EQ(error_of(read("rig: [a]\n")), "/etc/studio/hull.yaml:1: rig: expected a scalar");
-  EXPECT_EQ(error_of(read("rig: r\nbox: [1, 0, 0, 0, 1, 1]\n")), "/etc/studio/hull.yaml:1: box: x1 must exceed x0");
+  EXPECT_EQ(error_of(read("rig: r\nbox: [1, 0, 0, 0, 1, 1]\n")),
+            "/etc/studio/hull.yaml:1: box: x1 must exceed x0");
   EXPECT_EQ(error_of(read("- a\n")), "/etc/studio/hull.yaml:1: expected a mapping");
   Expected<Options> missing = schema.read_file("/nonexistent/hull.yaml");
   EXPECT_EQ(error_of(missing), "/nonexistent/hull.yaml: cannot open file");

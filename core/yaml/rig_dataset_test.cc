@@ -29,8 +29,10 @@ TEST(MiddleburyDino, CamerasLookAtOneObject) {
   int pairs = 0;
   for (std::size_t i = 0; i < rig->cameras.size(); ++i) {
     for (std::size_t j = i + 1; j < rig->cameras.size(); ++j) {
-      const Eigen::Vector3d c1 = rig->cameras[i].centre_in_world(), d1 = rig->cameras[i].axis_in_world();
-      const Eigen::Vector3d c2 = rig->cameras[j].centre_in_world(), d2 = rig->cameras[j].axis_in_world();
+      const Eigen::Vector3d c1 = rig->cameras[i].centre_in_world(),
+                            d1 = rig->cameras[i].axis_in_world();
+      const Eigen::Vector3d c2 = rig->cameras[j].centre_in_world(),
+                            d2 = rig->cameras[j].axis_in_world();
       const Eigen::Vector3d w = c1 - c2;
       const double b = d1.dot(d2), d = d1.dot(w), e = d2.dot(w), denom = 1 - b * b;
       if (denom < 1e-6) continue;  // nearly parallel axes: no stable nearest point
@@ -50,8 +52,9 @@ TEST(MiddleburyDino, CamerasLookAtOneObject) {
     ASSERT_TRUE(cam.project(object, &pixel)) << cam.id << ": object behind the camera";
     EXPECT_TRUE(cam.in_image(pixel)) << cam.id << ": object projects to " << pixel.transpose();
   }
-  std::printf("[ measured ] dino: object point (%.4f, %.4f, %.4f) m, camera distances %.4f..%.4f m\n",
-              object.x(), object.y(), object.z(), dmin, dmax);
+  std::printf(
+      "[ measured ] dino: object point (%.4f, %.4f, %.4f) m, camera distances %.4f..%.4f m\n",
+      object.x(), object.y(), object.z(), dmin, dmax);
   EXPECT_LT(dmax / dmin, 1.1);  // the views lie on a ring (hemisphere) around the dino
 
   // rig.yaml and OpenCV YAML of real cameras round-trip.
@@ -61,10 +64,13 @@ TEST(MiddleburyDino, CamerasLookAtOneObject) {
   ASSERT_TRUE(back) << back.error().message;
   double worst = 0;
   for (std::size_t i = 0; i < 16; ++i) {
-    worst = std::max(worst, (back->cameras[i].projection_matrix() - rig->cameras[i].projection_matrix())
-                                .cwiseAbs().maxCoeff());
+    worst =
+        std::max(worst, (back->cameras[i].projection_matrix() - rig->cameras[i].projection_matrix())
+                            .cwiseAbs()
+                            .maxCoeff());
   }
-  std::printf("[ measured ] dino rig.yaml round trip: max |dP| = %.3g (P entries up to ~3e3)\n", worst);
+  std::printf("[ measured ] dino rig.yaml round trip: max |dP| = %.3g (P entries up to ~3e3)\n",
+              worst);
   EXPECT_LT(worst, 1e-9);
 
   // P-matrix list export/import.
@@ -75,17 +81,22 @@ TEST(MiddleburyDino, CamerasLookAtOneObject) {
     out << "# 16 projection matrices, row-major\n";
     for (const Camera& c : rig->cameras) {
       const Eigen::Matrix<double, 3, 4> P = c.projection_matrix();
-      for (int r = 0; r < 3; ++r) out << P(r, 0) << ' ' << P(r, 1) << ' ' << P(r, 2) << ' ' << P(r, 3) << '\n';
+      for (int r = 0; r < 3; ++r)
+        out << P(r, 0) << ' ' << P(r, 1) << ' ' << P(r, 2) << ' ' << P(r, 3) << '\n';
     }
   }
   Expected<Rig> from_p = import_projection_matrices(plist, 640, 480);
   ASSERT_TRUE(from_p) << from_p.error().message;
   double worst_k = 0, worst_c = 0;
   for (std::size_t i = 0; i < 16; ++i) {
-    worst_k = std::max(worst_k, (from_p->cameras[i].intrinsics.K() - rig->cameras[i].intrinsics.K()).cwiseAbs().maxCoeff());
-    worst_c = std::max(worst_c, (from_p->cameras[i].centre_in_world() - rig->cameras[i].centre_in_world()).norm());
+    worst_k = std::max(
+        worst_k,
+        (from_p->cameras[i].intrinsics.K() - rig->cameras[i].intrinsics.K()).cwiseAbs().maxCoeff());
+    worst_c = std::max(
+        worst_c, (from_p->cameras[i].centre_in_world() - rig->cameras[i].centre_in_world()).norm());
   }
-  std::printf("[ measured ] dino P-list import: max |dK| = %.3g px, max centre error %.3g m\n", worst_k, worst_c);
+  std::printf("[ measured ] dino P-list import: max |dK| = %.3g px, max centre error %.3g m\n",
+              worst_k, worst_c);
   EXPECT_LT(worst_k, 1e-6);
   EXPECT_LT(worst_c, 1e-9);
 }

@@ -29,7 +29,8 @@ Expected<int> read_size(MapReader& map, std::string_view key) {
   if (!n) return std::unexpected(n.error());
   Expected<std::int64_t> v = n->as_int();
   if (!v) return std::unexpected(v.error());
-  if (*v <= 0 || *v > 1'000'000) return n->fail("must be a positive pixel count, got " + std::to_string(*v));
+  if (*v <= 0 || *v > 1'000'000)
+    return n->fail("must be a positive pixel count, got " + std::to_string(*v));
   return static_cast<int>(*v);
 }
 
@@ -37,8 +38,10 @@ Expected<Cahv> read_cahv(const Node& n) {
   Expected<MapReader> map = MapReader::from(n);
   if (!map) return std::unexpected(map.error());
   Cahv cahv;
-  for (auto [key, target] : {std::pair<const char*, Eigen::Vector3d*>{"C", &cahv.C}, {"A", &cahv.A},
-                             {"H", &cahv.H}, {"V", &cahv.V}}) {
+  for (auto [key, target] : {std::pair<const char*, Eigen::Vector3d*>{"C", &cahv.C},
+                             {"A", &cahv.A},
+                             {"H", &cahv.H},
+                             {"V", &cahv.V}}) {
     Expected<Node> v = map->required(key);
     if (!v) return std::unexpected(v.error());
     Expected<Eigen::Vector3d> x = read_vector3(*v);
@@ -123,8 +126,8 @@ Expected<Camera> read_camera_fields(MapReader& map) {
     Expected<std::vector<double>> c = n.as_doubles(radial ? 2 : 5);
     if (!c) return std::unexpected(c.error());
     const std::vector<double>& v = *c;
-    camera.distortion = radial ? Distortion::radial(v[0], v[1])
-                               : Distortion::opencv(v[0], v[1], v[2], v[3], v[4]);
+    camera.distortion =
+        radial ? Distortion::radial(v[0], v[1]) : Distortion::opencv(v[0], v[1], v[2], v[3], v[4]);
   }
   return camera;
 }
@@ -136,9 +139,10 @@ Expected<std::array<Eigen::Vector3d, 4>> read_screen(const Node& n) {
   if (!corners) return std::unexpected(corners.error());
   if (Expected<void> ok = map->finish(); !ok) return std::unexpected(ok.error());
   if (!corners->is_sequence() || corners->size() != 4) {
-    return corners->fail("expected 4 corners [x, y, z] (lower-left, lower-right, upper-right, "
-                         "upper-left), got " +
-                         (corners->is_sequence() ? std::to_string(corners->size()) : std::string("no sequence")));
+    return corners->fail(
+        "expected 4 corners [x, y, z] (lower-left, lower-right, upper-right, "
+        "upper-left), got " +
+        (corners->is_sequence() ? std::to_string(corners->size()) : std::string("no sequence")));
   }
   std::array<Eigen::Vector3d, 4> out;
   Expected<std::vector<Node>> items = corners->elements();
@@ -192,7 +196,8 @@ Expected<Rig> read_rig(const Node& root) {
   if (std::optional<Node> units = map->optional("units")) {
     Expected<std::string> u = units->as_string();
     if (!u) return std::unexpected(u.error());
-    if (*u != "metres" && *u != "meters") return units->fail("only metres are supported, got '" + *u + "'");
+    if (*u != "metres" && *u != "meters")
+      return units->fail("only metres are supported, got '" + *u + "'");
   }
   Rig rig;
   Expected<std::vector<Camera>> cameras = read_list<Camera>(*map, "cameras", read_camera_fields);
@@ -232,12 +237,13 @@ Expected<Rig> read_rig(const std::string& path) {
 
 std::string quote(std::string_view text) {
   static const std::set<std::string, std::less<>> special = {
-      "~", "null", "Null", "NULL", "true", "True", "TRUE", "false", "False", "FALSE",
-      "yes", "Yes", "YES", "no", "No", "NO", "on", "On", "ON", "off", "Off", "OFF"};
+      "~",   "null", "Null", "NULL", "true", "True", "TRUE", "false", "False", "FALSE", "yes",
+      "Yes", "YES",  "no",   "No",   "NO",   "on",   "On",   "ON",    "off",   "Off",   "OFF"};
   bool plain = !text.empty() && !special.contains(text);
   for (std::size_t i = 0; plain && i < text.size(); ++i) {
     const char c = text[i];
-    const bool word = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+    const bool word =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
     plain = word || (i > 0 && (c == '-' || c == '.' || c == '/'));
   }
   if (plain) return std::string(text);
@@ -312,7 +318,8 @@ std::string format_rig(const Rig& rig) {
 }
 
 Expected<void> write_rig(const Rig& rig, const std::string& path) {
-  if (Expected<void> ok = rig.validate(); !ok) return fail(path + ": not written: " + ok.error().message);
+  if (Expected<void> ok = rig.validate(); !ok)
+    return fail(path + ": not written: " + ok.error().message);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) return fail(path + ": cannot open for writing");
   out << format_rig(rig);

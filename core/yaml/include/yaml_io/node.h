@@ -40,7 +40,9 @@ class Node {
 
   // "file:line: path: message" (the path part is left out at the root).
   Error error(std::string_view message) const;
-  std::unexpected<Error> fail(std::string_view message) const { return std::unexpected(error(message)); }
+  std::unexpected<Error> fail(std::string_view message) const {
+    return std::unexpected(error(message));
+  }
 
   // Scalars. Numbers are parsed strictly (whole scalar, C locale); non-finite numbers (.inf,
   // .nan) are errors. Integers reject fractions and out-of-range values. Booleans: true/false.

@@ -96,7 +96,9 @@ class Field {
 
   const std::string& name() const { return name_; }
   bool is_required() const { return required_; }
-  Expected<void> read(const Node& node, T& target) const { return reader_(node, target, constraints_); }
+  Expected<void> read(const Node& node, T& target) const {
+    return reader_(node, target, constraints_);
+  }
 
  private:
   std::string name_;
@@ -115,10 +117,11 @@ Field<T> field(std::string name, M T::*member) {
 
 // A member read by a custom parser: Expected<M> parse(const Node&).
 template <class T, class M, class Parse>
-  requires std::invocable<const Parse&, const Node&>
-Field<T> field(std::string name, M T::*member, Parse parse) {
+requires std::invocable<const Parse&, const Node&> Field<T> field(std::string name, M T::*member,
+                                                                  Parse parse) {
   return Field<T>(std::move(name),
-                  [member, parse = std::move(parse)](const Node& n, T& t, const Constraints&) -> Expected<void> {
+                  [member, parse = std::move(parse)](const Node& n, T& t,
+                                                     const Constraints&) -> Expected<void> {
                     Expected<M> v = parse(n);
                     if (!v) return std::unexpected(v.error());
                     t.*member = std::move(*v);
@@ -129,32 +132,34 @@ Field<T> field(std::string name, M T::*member, Parse parse) {
 // A nested struct with its own schema (a sub-mapping).
 template <class T, class M>
 Field<T> field(std::string name, M T::*member, Schema<M> nested) {
-  return Field<T>(std::move(name), [member, nested = std::move(nested)](
-                                       const Node& n, T& t, const Constraints&) -> Expected<void> {
-    Expected<M> v = nested.read(n, t.*member);
-    if (!v) return std::unexpected(v.error());
-    t.*member = std::move(*v);
-    return {};
-  });
+  return Field<T>(std::move(name),
+                  [member, nested = std::move(nested)](const Node& n, T& t,
+                                                       const Constraints&) -> Expected<void> {
+                    Expected<M> v = nested.read(n, t.*member);
+                    if (!v) return std::unexpected(v.error());
+                    t.*member = std::move(*v);
+                    return {};
+                  });
 }
 
 // An enum member spelled by names: "expected one of x, y, z, got 'w'".
 template <class T, class E>
 Field<T> enum_field(std::string name, E T::*member, std::vector<std::pair<std::string, E>> names) {
-  return Field<T>(std::move(name), [member, names = std::move(names)](
-                                       const Node& n, T& t, const Constraints&) -> Expected<void> {
-    Expected<std::string> s = n.as_string();
-    if (!s) return std::unexpected(s.error());
-    std::string list;
-    for (const auto& [text, value] : names) {
-      if (text == *s) {
-        t.*member = value;
-        return {};
-      }
-      list += (list.empty() ? "" : ", ") + text;
-    }
-    return n.fail("expected one of " + list + ", got '" + *s + "'");
-  });
+  return Field<T>(std::move(name),
+                  [member, names = std::move(names)](const Node& n, T& t,
+                                                     const Constraints&) -> Expected<void> {
+                    Expected<std::string> s = n.as_string();
+                    if (!s) return std::unexpected(s.error());
+                    std::string list;
+                    for (const auto& [text, value] : names) {
+                      if (text == *s) {
+                        t.*member = value;
+                        return {};
+                      }
+                      list += (list.empty() ? "" : ", ") + text;
+                    }
+                    return n.fail("expected one of " + list + ", got '" + *s + "'");
+                  });
 }
 
 template <class T>
