@@ -274,9 +274,10 @@ void BM_SimulatedStudio(benchmark::State& state) {
     return;
   }
   std::vector<Image<Rgb8>> images, all;
+  std::vector<Mask> truths;
   for (int64_t frame = 0; frame < 200; frame += 25) {
-    studio->render_all(frame, &images, nullptr);
-    for (auto& im : images) all.push_back(std::move(im));
+    studio->render_all(frame, &images, &truths);
+    all.insert(all.end(), images.begin(), images.end());  // copies: a moved-from Image keeps its size
   }
   auto keyer = Keyer::create({});
   RunMask mask;
