@@ -1,6 +1,8 @@
 // File replay: ordering, pixel exactness against OpenCV, frame numbering from the studio clock,
 // looping, pacing (never early), stop(), corrupt files counted as drops, bad options.
 // (Real data: file_source_dataset_test.cc.)
+#include "capture/file_source.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -9,8 +11,6 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <thread>
-
-#include "capture/file_source.h"
 
 namespace studio::capture {
 namespace {
@@ -95,7 +95,8 @@ TEST(FileSource, ReplaysAFolderInNameOrderWithExactPixels) {
 
 TEST(FileSource, LoopsAndNumbersFramesFromTheStudioClock) {
   TempDir dir;
-  for (int i = 0; i < 3; ++i) ASSERT_TRUE(cv::imwrite(dir.file(std::to_string(i) + ".png"), pattern_bgr(i)));
+  for (int i = 0; i < 3; ++i)
+    ASSERT_TRUE(cv::imwrite(dir.file(std::to_string(i) + ".png"), pattern_bgr(i)));
   FileSourceOptions o;
   o.id = "cam7";
   o.path = dir.str();
@@ -120,7 +121,8 @@ TEST(FileSource, LoopsAndNumbersFramesFromTheStudioClock) {
 
 TEST(FileSource, PacedReplayIsNeverEarlyAndStopWakesIt) {
   TempDir dir;
-  for (int i = 0; i < 2; ++i) ASSERT_TRUE(cv::imwrite(dir.file(std::to_string(i) + ".png"), pattern_bgr(i)));
+  for (int i = 0; i < 2; ++i)
+    ASSERT_TRUE(cv::imwrite(dir.file(std::to_string(i) + ".png"), pattern_bgr(i)));
   FileSourceOptions o;
   o.path = dir.str();
   o.loop = true;

@@ -1,6 +1,8 @@
 // Free-D D1 decoding (the test vector, exact), rejection reasons, the pose and lens
 // mapping to studio::Camera, the UDP listener on loopback and the per-frame calibration
 // decorator.
+#include "capture/freed.h"
+
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -11,7 +13,6 @@
 #include <deque>
 #include <vector>
 
-#include "capture/freed.h"
 #include "capture/freed_listener.h"
 
 namespace studio::capture {
@@ -103,9 +104,7 @@ TEST(FreeD, RejectsWithAReason) {
   EXPECT_STREQ(to_string(FreeDReject::bad_checksum), "bad_checksum");
 }
 
-LensTable fixed_lens() {
-  return LensTable{{LensSample{0, 0, 800, 800, 352, 288, 0, 0}}};
-}
+LensTable fixed_lens() { return LensTable{{LensSample{0, 0, 800, 800, 352, 288, 0, 0}}}; }
 
 FreeDCameraOptions camera_options() {
   FreeDCameraOptions o;
@@ -175,9 +174,9 @@ TEST(FreeD, MountingOffsetAndTrackerPlacement) {
   EXPECT_TRUE(c.axis_in_world().isApprox(Eigen::Vector3d(1, 0, 0), 1e-12));
   // Tracker origin surveyed at (5, 0, -3) and turned 90° about the vertical.
   o.head_from_lens = Rigid3();
-  o.world_from_tracker = Rigid3(
-      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix(),
-      Eigen::Vector3d(5, 0, -3));
+  o.world_from_tracker =
+      Rigid3(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+             Eigen::Vector3d(5, 0, -3));
   c = camera_at(0, 0, 0, 1000, 0, 0, o);  // tracker x = 1 m → studio -z after the 90° turn
   EXPECT_TRUE(c.centre_in_world().isApprox(Eigen::Vector3d(5, 0, -4), 1e-12));
   EXPECT_TRUE(c.axis_in_world().isApprox(Eigen::Vector3d(-1, 0, 0), 1e-12));
@@ -221,7 +220,11 @@ TEST(FreeD, LensTableInterpolatesZoomAndFocus) {
   EXPECT_NEAR(c.axis_in_world().y(), std::sin(p->tilt_deg * M_PI / 180), 1e-12);
   EXPECT_EQ(c.distortion.model, Distortion::Model::none);
   EXPECT_EQ(freed_to_camera(decode_freed(encode_freed(FreeDPacket{})).value(),
-                            [&] { auto q = camera_options(); q.lens = t; return q; }())
+                            [&] {
+                              auto q = camera_options();
+                              q.lens = t;
+                              return q;
+                            }())
                 .distortion.model,
             Distortion::Model::radial);
 }
@@ -260,9 +263,9 @@ class Sender {
   }
   ~Sender() { close(fd_); }
   void send(std::span<const uint8_t> bytes) {
-    ASSERT_EQ(sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<sockaddr*>(&to_),
-                     sizeof to_),
-              ssize_t(bytes.size()));
+    ASSERT_EQ(
+        sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<sockaddr*>(&to_), sizeof to_),
+        ssize_t(bytes.size()));
   }
 
  private:

@@ -22,7 +22,8 @@ int64_t realtime_ns() {
 
 bool has_image_extension(const fs::path& path) {
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   for (const char* known : {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm"}) {
     if (ext == known) return true;
   }
@@ -124,7 +125,8 @@ bool FileSource::wait_until(int64_t due_ns, std::chrono::steady_clock::time_poin
     if (stopping_) return false;
     const int64_t now = realtime_ns();
     if (now >= due_ns) return true;
-    const auto until_due = std::chrono::steady_clock::now() + std::chrono::nanoseconds(due_ns - now);
+    const auto until_due =
+        std::chrono::steady_clock::now() + std::chrono::nanoseconds(due_ns - now);
     if (deadline <= until_due) {
       wake_.wait_until(lock, deadline, [&] { return stopping_; });
       return false;

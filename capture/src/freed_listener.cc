@@ -61,7 +61,8 @@ struct FreeDListener::State {
 
 FreeDListener::FreeDListener(std::unique_ptr<State> state) : state_(std::move(state)) {}
 
-Expected<std::unique_ptr<FreeDListener>> FreeDListener::create(const FreeDListenerOptions& options) {
+Expected<std::unique_ptr<FreeDListener>> FreeDListener::create(
+    const FreeDListenerOptions& options) {
   if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
   auto state = std::make_unique<State>();
   state->options = options;
@@ -191,9 +192,9 @@ Expected<std::optional<Frame>> TrackedSource::next(std::chrono::milliseconds tim
   if (!frame || !*frame) return frame;
   Frame& f = **frame;
   if (f.image.width() != options_.camera.width || f.image.height() != options_.camera.height) {
-    return fail("tracked camera " + inner_->id() + ": frame is " +
-                std::to_string(f.image.width()) + "x" + std::to_string(f.image.height()) +
-                " but its lens table describes " + std::to_string(options_.camera.width) + "x" +
+    return fail("tracked camera " + inner_->id() + ": frame is " + std::to_string(f.image.width()) +
+                "x" + std::to_string(f.image.height()) + " but its lens table describes " +
+                std::to_string(options_.camera.width) + "x" +
                 std::to_string(options_.camera.height));
   }
   auto sample = listener_->nearest(options_.camera.freed_id, f.capture_ns + options_.latency_ns,

@@ -34,13 +34,13 @@
 namespace studio::capture {
 
 struct FileSourceOptions {
-  std::string id;          // camera id; empty = the folder's name
-  std::string path;        // an image folder
-  double fps = 25.0;       // replay rate, > 0 and <= 1000
+  std::string id;     // camera id; empty = the folder's name
+  std::string path;   // an image folder
+  double fps = 25.0;  // replay rate, > 0 and <= 1000
   bool loop = false;
   bool paced = true;
   FrameClock clock;
-  int64_t start_ns = 0;    // capture time of the first frame; 0 = from the clock (see above)
+  int64_t start_ns = 0;  // capture time of the first frame; 0 = from the clock (see above)
 
   Expected<void> validate() const;
 };
@@ -74,7 +74,7 @@ class FileSource : public FrameSource {
   int64_t period_ns_ = 0;
   int64_t first_capture_ns_ = 0;
   int64_t first_due_ns_ = 0;
-  uint64_t index_ = 0;            // frames consumed since start()
+  uint64_t index_ = 0;  // frames consumed since start()
   uint64_t failures_in_pass_ = 0;
   int first_width_ = 0, first_height_ = 0;
   bool started_ = false;

@@ -40,6 +40,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -70,6 +71,12 @@ struct FreeDPacket {
 // Decodes one datagram. Never reads outside `bytes`, never throws; on rejection returns an Error
 // with one line and, when `reason` is given, stores why.
 Expected<FreeDPacket> decode_freed(std::span<const uint8_t> bytes, FreeDReject* reason = nullptr);
+
+namespace detail {
+// The decoder behind decode_freed(), without Expected (the fuzz build's clang 14 cannot
+// instantiate std::expected): nullopt with *packet filled, or the reason.
+std::optional<FreeDReject> parse_freed(std::span<const uint8_t> bytes, FreeDPacket* packet);
+}  // namespace detail
 
 // Encodes a packet (rounding to the wire resolution, saturating out-of-range values) with a
 // valid checksum. decode_freed(encode_freed(p)) == p up to the wire resolution.
@@ -102,12 +109,12 @@ struct LensTable {
 // Everything needed to turn a D1 packet into a studio::Camera (the camera's section of the
 // capture config; YAML parsing lives in the capture node).
 struct FreeDCameraOptions {
-  std::string camera_id;         // studio camera id (the Camera::id of the result)
-  uint8_t freed_id = 0;          // the D1 camera id byte of this camera's tracker
-  int width = 0, height = 0;     // image size the lens table's pixels refer to
+  std::string camera_id;      // studio camera id (the Camera::id of the result)
+  uint8_t freed_id = 0;       // the D1 camera id byte of this camera's tracker
+  int width = 0, height = 0;  // image size the lens table's pixels refer to
   LensTable lens;
-  Rigid3 world_from_tracker;     // tracker frame (after the fixed axis mapping) → studio frame
-  Rigid3 head_from_lens;         // mounting offset of the entrance pupil (metres, head axes)
+  Rigid3 world_from_tracker;  // tracker frame (after the fixed axis mapping) → studio frame
+  Rigid3 head_from_lens;      // mounting offset of the entrance pupil (metres, head axes)
 
   Expected<void> validate() const;
 };

@@ -1,0 +1,233 @@
+// AravisSource against a real GigE Vision stack: Aravis' arv-fake-gv-camera-0.8 serving GVCP /
+// GVSP on 127.0.0.1, inside a private network namespace (run by ctest through
+// run_in_netns.sh, which does `unshare -n` and brings lo up), so discovery broadcasts never
+// leave the machine. Proves discovery and open by id, streaming with the requested format and
+// size, one frame per software trigger, and the disappear → retry with back-off → resume path.
+// Every test runs under a watchdog (55 s) besides ctest's timeout.
+#include <gtest/gtest.h>
+#include <net/if.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <condition_variable>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include "capture/aravis_source.h"
+
+namespace studio::capture {
+namespace {
+
+using std::chrono::milliseconds;
+using Clock = std::chrono::steady_clock;
+constexpr char kDeviceId[] = "Aravis-Fake-GV01";
+
+// True when loopback is the only network interface: we are in a private namespace.
+bool only_loopback() {
+  struct if_nameindex* list = if_nameindex();
+  if (!list) return false;
+  bool only_lo = true;
+  for (struct if_nameindex* i = list; i->if_index != 0; ++i)
+    only_lo &= std::string(i->if_name) == "lo";
+  if_freenameindex(list);
+  return only_lo;
+}
+
+// arv-fake-gv-camera-0.8 -i 127.0.0.1 as a child process, killed with the test (PDEATHSIG).
+class FakeGvCamera {
+ public:
+  ~FakeGvCamera() { kill(); }
+  void start() {
+    ASSERT_LT(pid_, 0);
+    pid_ = fork();
+    ASSERT_GE(pid_, 0);
+    if (pid_ == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      std::freopen("/dev/null", "w", stdout);
+      std::freopen("/dev/null", "w", stderr);
+      execlp("arv-fake-gv-camera-0.8", "arv-fake-gv-camera-0.8", "-i", "127.0.0.1", nullptr);
+      _exit(127);
+    }
+  }
+  void kill() {
+    if (pid_ <= 0) return;
+    ::kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+    pid_ = -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+bool wait_for_device(milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    const auto ids = list_aravis_devices({"GigEVision"});
+    if (std::find(ids.begin(), ids.end(), kDeviceId) != ids.end()) return true;
+    std::this_thread::sleep_for(milliseconds(100));
+  }
+  return false;
+}
+
+class AravisGv : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!only_loopback()) {
+      GTEST_SKIP() << "not in a private network namespace (interfaces besides lo exist); run "
+                      "through ctest, which wraps this binary in run_in_netns.sh";
+    }
+    watchdog_ = std::thread([this] {
+      std::unique_lock lock(mutex_);
+      if (!done_cv_.wait_for(lock, std::chrono::seconds(55), [this] { return done_; })) {
+        std::fprintf(stderr, "watchdog: test exceeded 55 s\n");
+        std::_Exit(3);
+      }
+    });
+    camera_.start();
+    ASSERT_TRUE(wait_for_device(milliseconds(10000))) << kDeviceId << " not discovered on lo";
+  }
+  void TearDown() override {
+    camera_.kill();
+    if (watchdog_.joinable()) {
+      {
+        std::lock_guard lock(mutex_);
+        done_ = true;
+      }
+      done_cv_.notify_all();
+      watchdog_.join();
+    }
+  }
+  static AravisOptions options() {
+    AravisOptions o;
+    o.device_id = kDeviceId;
+    o.camera_id = "gv0";
+    o.interfaces = {"GigEVision"};
+    o.pixel_format = CameraPixelFormat::bayer_rg8;
+    o.width = 320;
+    o.height = 240;
+    o.frame_rate = 25;
+    return o;
+  }
+
+  FakeGvCamera camera_;
+
+ private:
+  std::thread watchdog_;
+  std::mutex mutex_;
+  std::condition_variable done_cv_;
+  bool done_ = false;
+};
+
+std::optional<Frame> grab(AravisSource& source, milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    auto f = source.next(milliseconds(200));
+    EXPECT_TRUE(f) << (f ? "" : f.error().message);
+    if (!f) return std::nullopt;
+    if (*f) return std::move(**f);
+  }
+  return std::nullopt;
+}
+
+TEST_F(AravisGv, DiscoversOpensByIdAndStreams) {
+  auto source = AravisSource::open(options());
+  ASSERT_TRUE(source) << source.error().message;
+  EXPECT_EQ((*source)->id(), "gv0");
+  EXPECT_EQ((*source)->config().serial, "GV01");
+  EXPECT_EQ((*source)->config().pixel_format, "BayerRG8");
+  ASSERT_TRUE((*source)->start());
+  uint64_t last_frame = 0;
+  for (int i = 0; i < 10; ++i) {
+    auto f = grab(**source, milliseconds(5000));
+    ASSERT_TRUE(f) << "frame " << i;
+    EXPECT_EQ(f->image.width(), 320);
+    EXPECT_EQ(f->image.height(), 240);
+    EXPECT_GE(f->frame, last_frame);
+    last_frame = f->frame;
+  }
+  EXPECT_EQ((*source)->stats().frames, 10u);
+  EXPECT_TRUE((*source)->stats().connected);
+  auto gain = (*source)->set_feature("Gain", 3);
+  ASSERT_TRUE(gain) << gain.error().message;
+  EXPECT_DOUBLE_EQ(*gain, 3);
+}
+
+TEST_F(AravisGv, SoftwareTriggerGivesOneFramePerTrigger) {
+  AravisOptions o = options();
+  o.trigger = TriggerMode::software;
+  auto source = AravisSource::open(o);
+  ASSERT_TRUE(source) << source.error().message;
+  ASSERT_TRUE((*source)->start());
+  auto idle = (*source)->next(milliseconds(500));
+  ASSERT_TRUE(idle);
+  EXPECT_FALSE(*idle) << "a frame arrived without a trigger";
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE((*source)->software_trigger());
+    ASSERT_TRUE(grab(**source, milliseconds(5000))) << "no frame for trigger " << i;
+    auto extra = (*source)->next(milliseconds(300));
+    ASSERT_TRUE(extra);
+    EXPECT_FALSE(*extra) << "more than one frame for trigger " << i;
+  }
+  EXPECT_EQ((*source)->stats().frames, 3u);
+}
+
+TEST_F(AravisGv, DisappearsRetriesWithBackOffAndResumes) {
+  AravisOptions o = options();
+  o.retry_initial = milliseconds(200);
+  o.retry_max = milliseconds(1000);
+  o.lost_after = milliseconds(1000);
+  std::mutex m;
+  std::vector<bool> transitions;
+  o.on_state = [&](const SourceStats& s) {
+    std::lock_guard lock(m);
+    transitions.push_back(s.connected);
+  };
+  auto source = AravisSource::open(o);
+  ASSERT_TRUE(source) << source.error().message;
+  ASSERT_TRUE((*source)->start());
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(grab(**source, milliseconds(5000)));
+
+  camera_.kill();  // the camera disappears
+  const auto lost_at = Clock::now();
+  while ((*source)->stats().connected && Clock::now() - lost_at < std::chrono::seconds(20)) {
+    auto f = (*source)->next(milliseconds(200));
+    ASSERT_TRUE(f) << "a lost camera is not an error: " << f.error().message;
+  }
+  ASSERT_FALSE((*source)->stats().connected) << "loss not detected within 20 s";
+  const double detect_s = std::chrono::duration<double>(Clock::now() - lost_at).count();
+  // While it is gone: no frames, no errors, retries in the background.
+  const auto gone_until = Clock::now() + milliseconds(2500);
+  while (Clock::now() < gone_until) {
+    auto f = (*source)->next(milliseconds(200));
+    ASSERT_TRUE(f);
+    EXPECT_FALSE(*f);
+  }
+  EXPECT_TRUE((*source)->features().empty());
+  EXPECT_FALSE((*source)->set_feature("Gain", 1));
+
+  camera_.start();  // it comes back
+  const auto back_at = Clock::now();
+  auto resumed = grab(**source, milliseconds(25000));
+  ASSERT_TRUE(resumed) << "frames did not resume";
+  const double resume_s = std::chrono::duration<double>(Clock::now() - back_at).count();
+  EXPECT_EQ(resumed->image.width(), 320);
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(grab(**source, milliseconds(5000)));
+  const SourceStats s = (*source)->stats();
+  EXPECT_TRUE(s.connected);
+  EXPECT_EQ(s.reconnects, 1u);
+  EXPECT_EQ(s.frames, 9u);
+  {
+    std::lock_guard lock(m);
+    EXPECT_EQ(transitions, (std::vector<bool>{false, true}));
+  }
+  std::printf("loss detected after %.2f s, frames resumed %.2f s after the camera restarted\n",
+              detect_s, resume_s);
+}
+
+}  // namespace
+}  // namespace studio::capture
