@@ -1,0 +1,82 @@
+#pragma once
+// A simulated camera behind the FrameSource interface (libcamera's fake camera): one camera of the
+// simulated studio (capture/sim/studio.h), paced by the studio clock (capture/frame_clock.h) in
+// real time like a genlocked camera, with simulated GenICam features.
+//
+// Timing (paced): frame f is exposed at the genlock instant clock.time_of(f) + period/2 and
+// becomes available then; capture_ns is that instant, so every SimFrameSource in every process
+// gives the same instant the same frame number. next() delivers the frame after the previous one,
+// immediately if it is already due: like a streaming camera with `buffer_frames` buffers, a
+// consumer that fell behind by up to buffer_frames frames gets every frame, in order. Beyond that
+// the oldest frames are overwritten: they are skipped and counted as drops. The first frame after
+// start() is the next one to become available. Unpaced: consecutive frames from the
+// current one, as fast as next() is called (tests, offline).
+// The picture of frame f is SimulatedStudio::render(camera, f): frame numbers are the studio's, so
+// all cameras (and processes) show the actor in the same pose at the same frame.
+//
+// Features (GenICam names; set_feature clamps to the range and returns the read-back value):
+//   Gain          dB, 0..24            image *= 10^(Gain/20)
+//   ExposureTime  µs, 20..period       image *= ExposureTime / nominal_exposure_us
+//   Focus         0..1                 box blur of radius round(|Focus - in_focus| * max_blur_px)
+// Brightness is applied through a 256-entry table (saturating), blur as two separable box passes.
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+
+#include "capture/frame_clock.h"
+#include "capture/frame_source.h"
+#include "capture/sim/studio.h"
+
+namespace studio::capture {
+
+struct SimSourceOptions {
+  Camera camera;                 // id, size, intrinsics and pose of the simulated camera
+  sim::StudioOptions studio;     // the scene (actor motion, realism knobs); threads forced to 1
+  FrameClock clock;
+  bool paced = true;
+  int buffer_frames = 4;         // 1 .. 64
+  double gain_db = 0;
+  double exposure_us = 10000;
+  double nominal_exposure_us = 10000;  // exposure at which the image has its natural brightness
+  double focus = 0.5;
+  double in_focus = 0.5;               // the Focus value that gives a sharp image
+  int max_blur_px = 8;
+  Expected<void> validate() const;
+};
+
+class SimFrameSource : public FrameSource {
+ public:
+  static Expected<std::unique_ptr<SimFrameSource>> create(const SimSourceOptions& options);
+
+  const std::string& id() const override { return options_.camera.id; }
+  Expected<void> start() override;
+  void stop() override;
+  Expected<std::optional<Frame>> next(std::chrono::milliseconds timeout) override;
+  std::vector<Feature> features() const override;
+  Expected<double> set_feature(std::string_view name, double value) override;
+  SourceStats stats() const override;
+
+  const sim::SimulatedStudio& studio() const { return studio_; }
+
+ private:
+  SimFrameSource(SimSourceOptions options, sim::SimulatedStudio studio);
+  bool wait_until(int64_t due_ns, std::chrono::steady_clock::time_point deadline);
+  void apply_features(Image<Rgb8>& image);
+
+  SimSourceOptions options_;
+  sim::SimulatedStudio studio_;
+  std::optional<uint64_t> last_frame_;
+  bool started_ = false;
+
+  mutable std::mutex mutex_;  // features, stats, stopping_
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  double gain_db_, exposure_us_, focus_;
+  SourceStats stats_;
+  std::vector<uint16_t> blur_row_;
+};
+
+}  // namespace studio::capture

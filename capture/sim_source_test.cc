@@ -1,0 +1,130 @@
+// The simulated camera: studio frame numbers and genlock capture times, real-time pacing,
+// deterministic pictures shared across instances, simulated features with read-back.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "capture/sim/cameras.h"
+#include "capture/sim_source.h"
+
+namespace studio::capture {
+namespace {
+
+using namespace std::chrono_literals;
+
+SimSourceOptions small_options(bool paced) {
+  sim::RingOptions ring;
+  ring.width = 176;
+  ring.height = 144;
+  ring.focal_px = 140;
+  SimSourceOptions o;
+  o.camera = sim::ring_cameras(ring)[1];
+  o.paced = paced;
+  o.clock.period_ns = 20'000'000;  // 50 fps keeps the test short
+  return o;
+}
+
+double mean_level(const Image<Rgb8>& img) {
+  double s = 0;
+  for (const auto& p : img.pixels()) s += p.r + p.g + p.b;
+  return s / (3.0 * img.pixels().size());
+}
+
+TEST(SimFrameSource, PacedFramesFollowTheStudioClock) {
+  auto src = SimFrameSource::create(small_options(true));
+  ASSERT_TRUE(src) << src.error().message;
+  ASSERT_TRUE((*src)->start());
+  const auto& clock = small_options(true).clock;
+  std::optional<uint64_t> prev, first;
+  for (int i = 0; i < 10; ++i) {
+    auto f = (*src)->next(1s);
+    ASSERT_TRUE(f && *f) << "no frame";
+    const Frame& fr = **f;
+    EXPECT_EQ(clock.frame_at(fr.capture_ns), fr.frame);
+    EXPECT_EQ(fr.capture_ns, clock.time_of(fr.frame) + clock.period_ns / 2);
+    timespec ts{};
+    clock_gettime(CLOCK_REALTIME, &ts);
+    EXPECT_GE(int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec, fr.capture_ns);  // never early
+    if (prev) EXPECT_GT(fr.frame, *prev);
+    if (!first) first = fr.frame;
+    prev = fr.frame;
+    EXPECT_EQ(fr.image.width(), 176);
+  }
+  const auto st = (*src)->stats();
+  EXPECT_EQ(st.frames, 10u);
+  // Frames are consecutive unless the (loaded) machine made us skip; skips are counted.
+  EXPECT_EQ(*prev - *first, 9 + st.drops);
+  (*src)->stop();
+  auto after = (*src)->next(1s);
+  ASSERT_TRUE(after);
+  EXPECT_FALSE(*after);  // stopped: returns promptly with nothing
+}
+
+TEST(SimFrameSource, SameFrameSamePictureAcrossInstances) {
+  auto a = SimFrameSource::create(small_options(false));
+  auto b = SimFrameSource::create(small_options(false));
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE((*a)->start() && (*b)->start());
+  auto fa = (*a)->next(1s).value().value();
+  auto fb = (*b)->next(1s).value().value();
+  auto fa2 = (*a)->next(1s).value().value();
+  EXPECT_EQ(fa2.frame, fa.frame + 1);
+  if (fb.frame == fa.frame) EXPECT_EQ(fa.image.pixels(), fb.image.pixels());
+  else if (fb.frame == fa2.frame) EXPECT_EQ(fa2.image.pixels(), fb.image.pixels());
+}
+
+TEST(SimFrameSource, FeaturesClampReadBackAndChangeThePicture) {
+  auto src = SimFrameSource::create(small_options(false));
+  ASSERT_TRUE(src);
+  ASSERT_TRUE((*src)->start());
+  const double base = mean_level((*src)->next(1s).value()->image);
+  EXPECT_EQ((*src)->set_feature("Gain", 6.0).value(), 6.0);
+  const double gained = mean_level((*src)->next(1s).value()->image);
+  EXPECT_GT(gained, base * 1.5);  // +6 dB doubles unsaturated levels
+  EXPECT_EQ((*src)->set_feature("Gain", 99).value(), 24.0);  // clamped, read back
+  EXPECT_EQ((*src)->set_feature("Gain", 0).value(), 0.0);
+  EXPECT_EQ((*src)->set_feature("ExposureTime", 5000).value(), 5000.0);
+  const double darker = mean_level((*src)->next(1s).value()->image);
+  EXPECT_LT(darker, base * 0.6);
+  EXPECT_EQ((*src)->set_feature("ExposureTime", 1e9).value(), 20000.0);  // frame period
+  EXPECT_EQ((*src)->set_feature("Focus", -3).value(), 0.0);
+  EXPECT_FALSE((*src)->set_feature("Zoom", 1));
+  EXPECT_FALSE((*src)->set_feature("Gain", NAN));
+  bool found = false;
+  for (const auto& f : (*src)->features())
+    if (f.name == "Focus") {
+      found = true;
+      EXPECT_EQ(f.value, 0.0);
+      EXPECT_EQ(f.max, 1.0);
+    }
+  EXPECT_TRUE(found);
+  // Defocus blurs: neighbouring pixels differ less.
+  auto sharp_src = SimFrameSource::create(small_options(false)).value();
+  ASSERT_TRUE(sharp_src->start());
+  ASSERT_TRUE(sharp_src->set_feature("ExposureTime", 20000));
+  ASSERT_TRUE(sharp_src->set_feature("ExposureTime", 10000));
+  auto sharp = sharp_src->next(1s).value()->image;
+  ASSERT_TRUE(sharp_src->set_feature("Focus", 1.0));
+  auto blurred = sharp_src->next(1s).value()->image;
+  auto gradient = [](const Image<Rgb8>& im) {
+    double g = 0;
+    for (int y = 0; y < im.height(); ++y)
+      for (int x = 1; x < im.width(); ++x) g += std::abs(int(im(x, y).b) - int(im(x - 1, y).b));
+    return g;
+  };
+  EXPECT_LT(gradient(blurred), gradient(sharp) * 0.7);
+}
+
+TEST(SimFrameSource, RejectsBadOptions) {
+  auto o = small_options(true);
+  o.gain_db = 30;
+  auto r = SimFrameSource::create(o);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("Gain"), std::string::npos);
+  o = small_options(true);
+  o.camera.id.clear();
+  EXPECT_FALSE(SimFrameSource::create(o));
+}
+
+}  // namespace
+}  // namespace studio::capture

@@ -1,0 +1,223 @@
+#include "capture/sim_source.h"
+
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace studio::capture {
+namespace {
+
+int64_t realtime_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+constexpr double kGainMax = 24.0;
+constexpr double kExposureMin = 20.0;
+
+double exposure_max(const FrameClock& clock) { return double(clock.period_ns) / 1000.0; }
+
+// One box-blur pass of radius r along rows (horizontal) of an RGB image, in place.
+void box_rows(Image<Rgb8>& img, int r, std::vector<uint16_t>& tmp) {
+  const int w = img.width();
+  tmp.resize(std::size_t(w) * 3);
+  for (int y = 0; y < img.height(); ++y) {
+    Rgb8* row = &img(0, y);
+    for (int x = 0; x < w; ++x) {
+      tmp[3 * x] = row[x].r;
+      tmp[3 * x + 1] = row[x].g;
+      tmp[3 * x + 2] = row[x].b;
+    }
+    for (int c = 0; c < 3; ++c) {
+      int sum = 0;
+      for (int k = -r; k <= r; ++k) sum += tmp[3 * std::clamp(k, 0, w - 1) + c];
+      const int n = 2 * r + 1;
+      for (int x = 0; x < w; ++x) {
+        reinterpret_cast<uint8_t*>(&row[x])[c] = uint8_t((sum + n / 2) / n);
+        sum += tmp[3 * std::min(x + r + 1, w - 1) + c] - tmp[3 * std::max(x - r, 0) + c];
+      }
+    }
+  }
+}
+
+// Vertical pass via a transposed walk over columns (kept simple: column buffer).
+void box_cols(Image<Rgb8>& img, int r, std::vector<uint16_t>& tmp) {
+  const int h = img.height();
+  tmp.resize(std::size_t(h) * 3);
+  for (int x = 0; x < img.width(); ++x) {
+    for (int y = 0; y < h; ++y) {
+      tmp[3 * y] = img(x, y).r;
+      tmp[3 * y + 1] = img(x, y).g;
+      tmp[3 * y + 2] = img(x, y).b;
+    }
+    for (int c = 0; c < 3; ++c) {
+      int sum = 0;
+      for (int k = -r; k <= r; ++k) sum += tmp[3 * std::clamp(k, 0, h - 1) + c];
+      const int n = 2 * r + 1;
+      for (int y = 0; y < h; ++y) {
+        reinterpret_cast<uint8_t*>(&img(x, y))[c] = uint8_t((sum + n / 2) / n);
+        sum += tmp[3 * std::min(y + r + 1, h - 1) + c] - tmp[3 * std::max(y - r, 0) + c];
+      }
+    }
+  }
+}
+
+}  // namespace
+
+Expected<void> SimSourceOptions::validate() const {
+  if (camera.id.empty()) return fail("sim source: camera id is empty");
+  if (camera.width <= 0 || camera.height <= 0) return fail("sim source " + camera.id + ": bad size");
+  if (!clock.valid()) return fail("sim source " + camera.id + ": clock period must be > 0");
+  if (!(gain_db >= 0 && gain_db <= kGainMax))
+    return fail("sim source " + camera.id + ": Gain must be in 0..24 dB");
+  if (!(exposure_us >= kExposureMin && exposure_us <= exposure_max(clock)))
+    return fail("sim source " + camera.id + ": ExposureTime must be in 20..frame period us");
+  if (!(nominal_exposure_us > 0)) return fail("sim source " + camera.id + ": bad nominal exposure");
+  if (!(focus >= 0 && focus <= 1) || !(in_focus >= 0 && in_focus <= 1))
+    return fail("sim source " + camera.id + ": Focus must be in 0..1");
+  if (buffer_frames < 1 || buffer_frames > 64)
+    return fail("sim source " + camera.id + ": buffer_frames must be in 1..64");
+  if (max_blur_px < 0 || max_blur_px > 64)
+    return fail("sim source " + camera.id + ": max_blur_px must be in 0..64");
+  return {};
+}
+
+Expected<std::unique_ptr<SimFrameSource>> SimFrameSource::create(const SimSourceOptions& options) {
+  if (auto v = options.validate(); !v) return std::unexpected(v.error());
+  sim::StudioOptions so = options.studio;
+  so.threads = 1;
+  auto studio = sim::SimulatedStudio::create({options.camera}, so);
+  if (!studio) return fail("sim source " + options.camera.id + ": " + studio.error().message);
+  return std::unique_ptr<SimFrameSource>(new SimFrameSource(options, std::move(*studio)));
+}
+
+SimFrameSource::SimFrameSource(SimSourceOptions options, sim::SimulatedStudio studio)
+    : options_(std::move(options)),
+      studio_(std::move(studio)),
+      gain_db_(options_.gain_db),
+      exposure_us_(options_.exposure_us),
+      focus_(options_.focus) {}
+
+Expected<void> SimFrameSource::start() {
+  std::lock_guard lock(mutex_);
+  stopping_ = false;
+  started_ = true;
+  last_frame_.reset();
+  return {};
+}
+
+void SimFrameSource::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+}
+
+bool SimFrameSource::wait_until(int64_t due_ns, std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    if (stopping_) return false;
+    const int64_t now = realtime_ns();
+    if (now >= due_ns) return true;
+    const auto until_due = std::chrono::steady_clock::now() + std::chrono::nanoseconds(due_ns - now);
+    if (deadline <= until_due) {
+      wake_.wait_until(lock, deadline, [&] { return stopping_; });
+      return false;
+    }
+    wake_.wait_until(lock, until_due, [&] { return stopping_; });
+  }
+}
+
+Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds timeout) {
+  if (!started_) return fail("sim source " + id() + ": next() before start()");
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  const FrameClock& clock = options_.clock;
+  const int64_t half = clock.period_ns / 2;
+  const int64_t now = realtime_ns();
+  // Newest frame whose genlock instant has passed.
+  const uint64_t newest = clock.frame_at(now - half);
+  uint64_t f;
+  uint64_t skipped = 0;
+  if (!options_.paced) {
+    f = last_frame_ ? *last_frame_ + 1 : clock.frame_at(now);
+  } else if (!last_frame_) {
+    f = newest + 1;  // the next frame to become available
+  } else {
+    f = *last_frame_ + 1;
+    const uint64_t oldest_kept = newest + 1 >= uint64_t(options_.buffer_frames)
+                                     ? newest + 1 - uint64_t(options_.buffer_frames)
+                                     : 0;
+    if (f < oldest_kept) {  // the camera's buffers overflowed: frames before oldest_kept are gone
+      skipped = oldest_kept - f;
+      f = oldest_kept;
+    }
+  }
+  const int64_t capture_ns = clock.time_of(f) + half;
+  if (options_.paced && !wait_until(capture_ns, deadline)) {
+    std::lock_guard lock(mutex_);
+    stats_.drops += skipped;  // consumed even when the wait ran out
+    if (skipped) last_frame_ = f - 1;
+    return std::optional<Frame>();
+  }
+  Frame frame;
+  frame.frame = f;
+  frame.capture_ns = capture_ns;
+  studio_.render(0, int64_t(f), &frame.image, nullptr);
+  apply_features(frame.image);
+  last_frame_ = f;
+  std::lock_guard lock(mutex_);
+  stats_.frames += 1;
+  stats_.drops += skipped;
+  return std::optional<Frame>(std::move(frame));
+}
+
+void SimFrameSource::apply_features(Image<Rgb8>& image) {
+  double gain, exposure, focus;
+  {
+    std::lock_guard lock(mutex_);
+    gain = gain_db_;
+    exposure = exposure_us_;
+    focus = focus_;
+  }
+  const double k = std::pow(10.0, gain / 20.0) * exposure / options_.nominal_exposure_us;
+  if (std::abs(k - 1.0) > 1e-6) {
+    uint8_t lut[256];
+    for (int i = 0; i < 256; ++i) lut[i] = uint8_t(std::clamp(std::lround(i * k), 0l, 255l));
+    auto* p = reinterpret_cast<uint8_t*>(image.data());
+    const std::size_t n = image.pixels().size() * 3;
+    for (std::size_t i = 0; i < n; ++i) p[i] = lut[p[i]];
+  }
+  const int r = int(std::lround(std::abs(focus - options_.in_focus) * options_.max_blur_px));
+  if (r > 0) {
+    box_rows(image, r, blur_row_);
+    box_cols(image, r, blur_row_);
+  }
+}
+
+std::vector<Feature> SimFrameSource::features() const {
+  std::lock_guard lock(mutex_);
+  return {{"Gain", gain_db_, 0, kGainMax, true},
+          {"ExposureTime", exposure_us_, kExposureMin, exposure_max(options_.clock), true},
+          {"Focus", focus_, 0, 1, true}};
+}
+
+Expected<double> SimFrameSource::set_feature(std::string_view name, double value) {
+  if (!std::isfinite(value))
+    return fail("camera " + id() + ": feature '" + std::string(name) + "': value is not finite");
+  std::lock_guard lock(mutex_);
+  if (name == "Gain") return gain_db_ = std::clamp(value, 0.0, kGainMax);
+  if (name == "ExposureTime")
+    return exposure_us_ = std::clamp(value, kExposureMin, exposure_max(options_.clock));
+  if (name == "Focus") return focus_ = std::clamp(value, 0.0, 1.0);
+  return fail("camera " + id() + ": feature '" + std::string(name) + "' is not available");
+}
+
+SourceStats SimFrameSource::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+}  // namespace studio::capture
