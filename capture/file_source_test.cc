@@ -6,11 +6,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <thread>
+
+#include "capture/take.h"
 
 namespace studio::capture {
 namespace {
@@ -188,6 +191,109 @@ TEST(FileSource, CorruptAndMismatchedFilesAreCountedDrops) {
   auto err = (*bad)->next(milliseconds(100));
   ASSERT_FALSE(err);
   EXPECT_NE(err.error().message.find("none of the 2 images"), std::string::npos);
+}
+
+// Writes one camera's take by the DESIGN §4 format (capture/take.h): frames 100.. with the given
+// payloads; returns the byte offsets.
+std::vector<IndexEntry> write_take(
+    const std::string& dir, const std::vector<std::pair<PixelFormat, std::vector<uint8_t>>>& frames,
+    uint32_t w, uint32_t h) {
+  std::ofstream out(dir + "/" + kFramesFile, std::ios::binary);
+  std::vector<IndexEntry> entries;
+  uint64_t offset = 0;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    FrameHeader header;
+    header.frame = 100 + i;
+    header.capture_ns = int64_t(4'000'000'000 + i * 40'000'000);
+    header.width = w;
+    header.height = h;
+    header.format = frames[i].first;
+    header.payload_size = frames[i].second.size();
+    uint8_t bytes[kFrameHeaderSize];
+    encode_frame_header(header, frames[i].second, bytes);
+    out.write(reinterpret_cast<const char*>(bytes), kFrameHeaderSize);
+    out.write(reinterpret_cast<const char*>(frames[i].second.data()), frames[i].second.size());
+    entries.push_back({header.frame, offset});
+    offset += kFrameHeaderSize + frames[i].second.size();
+  }
+  return entries;
+}
+
+TEST(FileSource, ReplaysARecordedTakeWithCrcChecks) {
+  TempDir dir;
+  const uint32_t w = 4, h = 3;
+  std::vector<std::pair<PixelFormat, std::vector<uint8_t>>> frames;
+  for (int i = 0; i < 3; ++i) {
+    std::vector<uint8_t> rgb(w * h * 3);
+    for (std::size_t k = 0; k < rgb.size(); ++k) rgb[k] = uint8_t(k * 7 + i);
+    frames.emplace_back(PixelFormat::kRgb8, rgb);
+  }
+  frames.emplace_back(PixelFormat::kMono8, std::vector<uint8_t>(w * h, 99));
+  const auto entries = write_take(dir.str(), frames, w, h);
+  ASSERT_TRUE(write_index(dir.str(), entries));
+
+  FileSourceOptions o;
+  o.path = dir.str();
+  o.paced = false;
+  o.start_ns = 1'000'000'000'000;
+  auto source = FileSource::create(o);
+  ASSERT_TRUE(source) << source.error().message;
+  EXPECT_TRUE((*source)->is_take());
+  EXPECT_EQ((*source)->size(), 4u);
+  ASSERT_TRUE((*source)->start());
+  for (int i = 0; i < 4; ++i) {
+    Frame f = next_frame(**source);
+    EXPECT_EQ(f.frame, 25000u + i);  // renumbered: replay is a new capture
+    ASSERT_EQ(f.image.width(), int(w));
+    ASSERT_EQ(f.image.height(), int(h));
+    if (i < 3) {
+      EXPECT_EQ(0, std::memcmp(f.image.data(), frames[i].second.data(), frames[i].second.size()));
+    } else {
+      EXPECT_EQ(f.image(3, 2), (Rgb8{99, 99, 99}));
+    }
+  }
+
+  // A flipped payload byte fails the CRC: with the index, that frame is a counted drop.
+  {
+    std::fstream raw(dir.file(kFramesFile), std::ios::binary | std::ios::in | std::ios::out);
+    raw.seekp(std::streamoff(entries[1].offset + kFrameHeaderSize + 5));
+    raw.put(char(0xEE));
+    raw.seekp(0, std::ios::end);
+    raw.write("STFR\x01", 5);  // and a torn write at the end
+  }
+  auto corrupt = FileSource::create(o);
+  ASSERT_TRUE(corrupt) << corrupt.error().message;
+  ASSERT_TRUE((*corrupt)->start());
+  Frame first = next_frame(**corrupt);
+  Frame third = next_frame(**corrupt);
+  EXPECT_EQ(third.frame, first.frame + 2);  // frame 1's slot was consumed by the drop
+  EXPECT_EQ(0, std::memcmp(third.image.data(), frames[2].second.data(), frames[2].second.size()));
+  next_frame(**corrupt);
+  EXPECT_EQ((*corrupt)->stats().frames, 3u);
+  EXPECT_EQ((*corrupt)->stats().drops, 1u);
+  // Without the index the intact frames are found by scanning frames.raw (the corrupt frame and
+  // the torn tail are skipped by the scan).
+  fs::remove(dir.file(kIndexFile));
+  auto rescanned = FileSource::create(o);
+  ASSERT_TRUE(rescanned) << rescanned.error().message;
+  EXPECT_EQ((*rescanned)->size(), 3u);
+  ASSERT_TRUE((*rescanned)->start());
+  for (int i : {0, 2, 3}) {
+    Frame f = next_frame(**rescanned);
+    if (i < 3) {
+      EXPECT_EQ(0, std::memcmp(f.image.data(), frames[i].second.data(), frames[i].second.size()));
+    } else {
+      EXPECT_EQ(f.image(0, 0), (Rgb8{99, 99, 99}));
+    }
+  }
+
+  // A take folder without any intact frame fails at create() with one line.
+  TempDir empty;
+  std::ofstream(empty.file(kFramesFile)) << "garbage, not a frame";
+  o.path = empty.str();
+  auto none = FileSource::create(o);
+  ASSERT_FALSE(none);
+  EXPECT_NE(none.error().message.find("no intact frames"), std::string::npos);
 }
 
 TEST(FileSource, BadOptionsAndFoldersFailWithOneLine) {

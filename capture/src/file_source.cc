@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "capture/take.h"
 
 namespace studio::capture {
 namespace {
@@ -75,19 +78,67 @@ Expected<std::vector<std::string>> list_image_files(const std::string& folder) {
 
 Expected<std::unique_ptr<FileSource>> FileSource::create(const FileSourceOptions& options) {
   if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
-  auto files = list_image_files(options.path);
-  if (!files) return std::unexpected(files.error());
   std::string id = options.id;
   if (id.empty()) {
     fs::path p(options.path);
     id = (p.has_filename() ? p.filename() : p.parent_path().filename()).string();
   }
-  return std::unique_ptr<FileSource>(new FileSource(options, std::move(id), std::move(*files)));
+  std::error_code ec;
+  if (fs::is_regular_file(fs::path(options.path) / kFramesFile, ec)) {
+    // A take: the index when it is intact, else a scan of frames.raw (after a crash).
+    std::vector<IndexEntry> entries;
+    if (auto index = read_index(options.path); index && !index->empty()) {
+      entries = std::move(*index);
+    } else {
+      auto scan = scan_frames(options.path);
+      if (!scan) return fail("take " + options.path + ": " + scan.error().message);
+      entries = std::move(scan->intact);
+    }
+    if (entries.empty()) return fail("take " + options.path + ": no intact frames in frames.raw");
+    std::vector<std::string> labels;
+    std::vector<std::pair<uint64_t, uint64_t>> take_entries;
+    for (const IndexEntry& e : entries) {
+      labels.push_back(options.path + "#" + std::to_string(e.frame));
+      take_entries.emplace_back(e.frame, e.offset);
+    }
+    return std::unique_ptr<FileSource>(
+        new FileSource(options, std::move(id), std::move(labels), std::move(take_entries)));
+  }
+  auto files = list_image_files(options.path);
+  if (!files) return std::unexpected(files.error());
+  return std::unique_ptr<FileSource>(new FileSource(options, std::move(id), std::move(*files), {}));
 }
 
-FileSource::FileSource(FileSourceOptions options, std::string id, std::vector<std::string> files)
-    : options_(std::move(options)), id_(std::move(id)), files_(std::move(files)) {
+FileSource::FileSource(FileSourceOptions options, std::string id, std::vector<std::string> files,
+                       std::vector<std::pair<uint64_t, uint64_t>> take_entries)
+    : options_(std::move(options)),
+      id_(std::move(id)),
+      files_(std::move(files)),
+      take_(!take_entries.empty()),
+      take_entries_(std::move(take_entries)) {
   period_ns_ = std::max<int64_t>(1, int64_t(std::llround(1e9 / options_.fps)));
+}
+
+Image<Rgb8> FileSource::load(std::size_t item) {
+  if (!take_) return read_rgb(files_[item]);
+  const IndexEntry entry{take_entries_[item].first, take_entries_[item].second};
+  auto header = read_frame(options_.path, entry, take_pixels_);
+  if (!header) return {};
+  const int w = int(header->width), h = int(header->height);
+  if (w <= 0 || h <= 0) return {};
+  const std::size_t n = std::size_t(w) * std::size_t(h);
+  Image<Rgb8> image(w, h);
+  if (header->format == PixelFormat::kRgb8 && take_pixels_.size() >= 3 * n) {
+    std::memcpy(image.data(), take_pixels_.data(), 3 * n);
+  } else if (header->format == PixelFormat::kMono8 && take_pixels_.size() >= n) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const uint8_t v = take_pixels_[i];
+      image.data()[i] = Rgb8{v, v, v};
+    }
+  } else {
+    return {};
+  }
+  return image;
 }
 
 Expected<void> FileSource::start() {
@@ -155,7 +206,7 @@ Expected<std::optional<Frame>> FileSource::next(std::chrono::milliseconds timeou
     Frame frame;
     frame.capture_ns = first_capture_ns_ + offset;
     frame.frame = options_.clock.frame_at(frame.capture_ns);
-    frame.image = read_rgb(files_[file]);
+    frame.image = load(file);
     ++index_;
     const bool end_of_pass = file + 1 == files_.size();
     bool ok = !frame.image.pixels().empty();
@@ -179,7 +230,8 @@ Expected<std::optional<Frame>> FileSource::next(std::chrono::milliseconds timeou
       if (all_failed) {
         finished_ = true;
         return fail("file source " + id_ + ": none of the " + std::to_string(files_.size()) +
-                    " images in " + options_.path + " could be decoded");
+                    (take_ ? " take frames" : " images") + " in " + options_.path +
+                    " could be decoded");
       }
       if (!options_.loop) finished_ = true;
     }

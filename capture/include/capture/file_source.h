@@ -1,7 +1,9 @@
 #pragma once
-// File replay behind the FrameSource interface: an image folder (PNG / JPEG / BMP / TIFF, sorted
-// by file name) played at a set rate, optionally looping. A recorded take (DESIGN §4) is
-// replayed the same way once its reader (capture/take.h) exists.
+// File replay behind the FrameSource interface, at a set rate, optionally looping:
+// - an image folder (PNG / JPEG / BMP / TIFF, sorted by file name), or
+// - one camera's recorded take (DESIGN §4, capture/take.h): a folder holding frames.raw, replayed
+//   in index order (the index, or a scan of frames.raw when the index is missing or damaged);
+//   RGB8 and MONO8 frames, each checked against its CRC.
 //
 // Time and frame numbers (DESIGN §5): frame i of the replay gets
 //   capture_ns = start_ns + i * (1e9 / fps),   frame = clock.frame_at(capture_ns)
@@ -13,7 +15,10 @@
 // CLOCK_REALTIME (capture_ns itself when start_ns = 0, else the time of start() plus
 // i / fps); a late consumer gets frames immediately, none are skipped. With `paced` false frames
 // come as fast as next() is called (offline processing, tests).
-// A file that cannot be decoded, or whose size differs from the first image's, is skipped and
+// The recorded frame numbers and capture times of a take are not reused: replay is a new
+// capture, numbered by the rule above.
+// A file or take frame that cannot be decoded (or fails its CRC), or whose size differs from the
+// first image's, is skipped and
 // counted in stats().drops (its time slot and frame number are consumed, as a camera drop would);
 // if every file of a pass fails, next() returns an Error. After the last file without `loop`,
 // next() waits out its timeout and returns nullopt; finished() is then true.
@@ -25,6 +30,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "capture/frame_clock.h"
@@ -60,17 +66,23 @@ class FileSource : public FrameSource {
   Expected<std::optional<Frame>> next(std::chrono::milliseconds timeout) override;
   SourceStats stats() const override;
 
-  std::size_t size() const { return files_.size(); }  // files per pass
+  std::size_t size() const { return files_.size(); }  // images (or take frames) per pass
+  bool is_take() const { return take_; }
   bool finished() const { return finished_; }
 
  private:
-  FileSource(FileSourceOptions options, std::string id, std::vector<std::string> files);
+  FileSource(FileSourceOptions options, std::string id, std::vector<std::string> files,
+             std::vector<std::pair<uint64_t, uint64_t>> take_entries);
+  Image<Rgb8> load(std::size_t item);
   // Waits until CLOCK_REALTIME reaches due_ns, stop() or the deadline; true when due.
   bool wait_until(int64_t due_ns, std::chrono::steady_clock::time_point deadline);
 
   FileSourceOptions options_;
   std::string id_;
-  std::vector<std::string> files_;
+  std::vector<std::string> files_;  // image paths, or one label per take frame
+  bool take_ = false;
+  std::vector<std::pair<uint64_t, uint64_t>> take_entries_;  // (recorded frame, byte offset)
+  std::vector<uint8_t> take_pixels_;
   int64_t period_ns_ = 0;
   int64_t first_capture_ns_ = 0;
   int64_t first_due_ns_ = 0;
