@@ -5,7 +5,8 @@
 // A mask folder holds <camera_id>.png per camera (one frame) or <frame>/<camera_id>.png (a
 // sequence, printed as {"frames": [{"frame": "<name>", "heads": [...]}, ...]}).
 //
-// The DDS node (studio-tracker --config) is not part of this binary yet.
+// Everything but `locate` (--config FILE, --help) goes to the tracker node's service_main
+// (tracker/node/tracker_node.h).
 
 #include <algorithm>
 #include <cstdio>
@@ -20,6 +21,7 @@
 #include "hull/silhouette_cut.h"
 #include "tracker/head_search.h"
 #include "tracker/segment_raster.h"
+#include "tracker_node.h"
 #include "yaml_io/rig_yaml.h"
 
 namespace fs = std::filesystem;
@@ -34,7 +36,7 @@ constexpr const char* kUsage =
     "  for a sequence) on N x N columns over the box (metres, studio frame) along --axis\n"
     "  (default y), finds the heads (two-box template, TCSVT 2004 §IV-D) and prints JSON:\n"
     "  {\"heads\": [{\"position\": [x, y, z], \"score\": m3, \"confidence\": c}]}.\n"
-    "  The tracker node (studio-tracker --config tracker.yaml) is not available in this build.\n";
+    "  The tracker node: studio-tracker --config tracker.yaml (see studio-tracker --help).\n";
 
 int fail_line(const std::string& message) {
   std::fprintf(stderr, "studio-tracker: %s\n", message.c_str());
@@ -189,12 +191,6 @@ int locate(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-    std::fputs(kUsage, argc < 2 ? stderr : stdout);
-    return argc < 2 ? 2 : 0;
-  }
-  if (!std::strcmp(argv[1], "locate")) return locate(argc - 2, argv + 2);
-  if (!std::strcmp(argv[1], "--config"))
-    return fail_line("the tracker node (--config) is not built yet; use 'locate'");
-  return fail_line(std::string("unknown command '") + argv[1] + "' (see --help)");
+  if (argc >= 2 && !std::strcmp(argv[1], "locate")) return locate(argc - 2, argv + 2);
+  return runtime::service_main(argc, argv, tracker::node::service_definition());
 }

@@ -27,7 +27,8 @@ Expected<hull::SegmentSet> to_core(const studio_SegmentSet& s) {
   const auto start = view(s.interval_start);
   const auto iv = view(s.intervals);
   const std::size_t columns = grid.columns();
-  if (start.size() != columns + 1 || start.front() != 0 || iv.size() != std::size_t(start.back()) * 2)
+  if (start.size() != columns + 1 || start.front() != 0 ||
+      iv.size() != std::size_t(start.back()) * 2)
     return fail(who + ": interval table inconsistent with its " + std::to_string(s.nu) + "x" +
                 std::to_string(s.nv) + " grid");
   const float t_lo = s.box_min[s.axis], t_hi = s.box_max[s.axis];

@@ -4,7 +4,8 @@
 //   studio/actor/segments  studio_SegmentSet <-> hull::SegmentSet   (hull node writes, tracker and
 //                                                                      projector nodes read)
 //   studio/actor/head      studio_HeadPose   <-> tracker::HeadPose  (tracker node writes,
-//                                                                      projector/scene/preview read)
+//                                                                      projector/scene/preview
+//                                                                      read)
 // Library `studio_segments_wire` (links studio_wire, studio_hull, studio_tracker); include as
 // "segments_wire.h". As in wire/convert.h, the key and `frame` are the caller's; these convert the
 // payload (HeadPose's capture_ns is part of the core value and is converted).

@@ -1,0 +1,247 @@
+#include "tracker_node.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/log.h"
+#include "segments_wire.h"
+#include "tracker/segment_raster.h"
+#include "wire/endpoint.h"
+
+namespace studio::tracker::node {
+namespace {
+
+constexpr std::string_view kCategory = "tracker";
+using Clock = std::chrono::steady_clock;
+
+int64_t realtime_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+// Everything the worker thread owns; created by start(), destroyed by stop().
+struct TrackerNode::Worker {
+  enum : dds_attach_t { kData = 1, kStop = 2 };
+
+  const NodeOptions& options;
+  runtime::Metrics& metrics;
+  wire::Topic<studio_SegmentSet> segments_topic;
+  wire::Topic<studio_HeadPose> head_topic;
+  wire::Reader<studio_SegmentSet> reader;
+  wire::Writer<studio_HeadPose> writer;
+  wire::GuardCondition stop_guard;
+  wire::WaitSet waitset;
+  HeadSearch search;
+  HeadTracker tracker;
+
+  runtime::Counter& sets_in;
+  runtime::Counter& heads_out;
+  runtime::Counter& empty_hulls;
+  runtime::Counter& keepalives;
+  runtime::Counter& rejected;
+  uint64_t reader_rejects_seen = 0;
+
+  std::atomic<bool> running{true};
+  std::atomic<uint64_t> last_frame{0};
+  std::atomic<int64_t> last_capture_ns{0};
+  std::atomic<bool> lost{true};
+
+  OccupancyGrid grid{};
+  HeadPose last_pose{};     // last published primary pose (coasted by keep-alives)
+  uint64_t pose_frame = 0;  // source frame of last_pose
+  int64_t source_ns = 0;    // capture_ns of the last real frame
+  Clock::time_point source_arrival = Clock::now();
+  Clock::time_point last_publish = Clock::now();
+  int coasted_ticks = 0;
+  bool have_source = false;
+  wire::Owned<studio_HeadPose> out{};
+
+  void publish(const HeadPose& pose, const std::string& id, uint64_t frame) {
+    wire::set(out->actor_id, id);
+    out->frame = frame;
+    wire::from_core(pose, *out);
+    if (auto r = writer.write(*out); !r) {
+      STUDIO_LOG(warn, kCategory) << r.error().message;
+      return;
+    }
+    heads_out.add();
+  }
+
+  void publish_primary(const HeadPose& pose, uint64_t frame) {
+    last_pose = pose;
+    pose_frame = frame;
+    lost = pose.confidence <= 0;
+    publish(pose, options.actor_id, frame);
+    last_publish = Clock::now();
+  }
+
+  void on_segments(const studio_SegmentSet& s) {
+    sets_in.add();
+    auto set = wire::to_core(s);
+    if (!set) {
+      rejected.add();
+      STUDIO_LOG(warn, kCategory) << set.error().message;
+      return;
+    }
+    // A source clock that jumps back (a replay looping) would freeze the filter: start over.
+    if (have_source && s.capture_ns + int64_t(1'000'000'000) < source_ns) {
+      STUDIO_LOG(info, kCategory) << "capture time went back " << (source_ns - s.capture_ns) * 1e-9
+                                  << " s: tracks reset";
+      tracker = HeadTracker::create(options.filter).value();
+    }
+    std::vector<HeadDetection> heads;
+    if (set->interval_count() == 0) {
+      empty_hulls.add();
+    } else {
+      rasterise(*set, &grid);
+      heads = search.find(grid);
+    }
+    tracker.update(heads, s.capture_ns);
+    have_source = true;
+    source_ns = s.capture_ns;
+    source_arrival = Clock::now();
+    coasted_ticks = 0;
+    last_frame = s.frame;
+    last_capture_ns = s.capture_ns;
+
+    HeadPose primary = tracker.primary();
+    primary.capture_ns = s.capture_ns;
+    publish_primary(primary, s.frame);
+    if (options.publish_tracks)
+      for (const HeadPose& p : tracker.poses())
+        publish(p, options.actor_id + "/" + std::to_string(p.actor_id), s.frame);
+    metrics.latency().record(realtime_ns() - s.capture_ns);
+  }
+
+  void keep_alive() {
+    const double dt = 1.0 / options.publish_rate;
+    HeadPose p = last_pose;
+    ++coasted_ticks;
+    if (coasted_ticks > options.filter.max_missed || p.confidence <= 0) {
+      p.velocity.setZero();
+      p.confidence = 0;
+    } else {
+      p.position += p.velocity * dt;
+      p.velocity *= options.filter.coast_decay;
+      p.confidence *= options.filter.coast_decay;
+    }
+    if (have_source)
+      p.capture_ns = source_ns + std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                     Clock::now() - source_arrival)
+                                     .count();
+    keepalives.add();
+    publish_primary(p, pose_frame);
+  }
+
+  void run() {
+    const auto period = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(1.0 / options.publish_rate));
+    while (running) {
+      const auto wait = std::max(Clock::duration::zero(), last_publish + period - Clock::now());
+      const auto triggered = waitset.wait(wait);
+      if (std::find(triggered.begin(), triggered.end(), dds_attach_t(kStop)) != triggered.end())
+        break;
+      reader.visit([&](const studio_SegmentSet& s, const wire::SampleMeta& meta) {
+        if (meta.valid_data) on_segments(s);
+      });
+      const uint64_t total = reader.rejected().total();
+      if (total > reader_rejects_seen) {
+        rejected.add(total - reader_rejects_seen);
+        reader_rejects_seen = total;
+      }
+      if (Clock::now() >= last_publish + period) keep_alive();
+    }
+  }
+};
+
+TrackerNode::TrackerNode(NodeOptions options, runtime::NodeContext& context)
+    : options_(std::move(options)), participant_(context.participant), metrics_(context.metrics) {
+  // Registered up front so the status shows them at zero.
+  for (const char* name : {"segment_sets_in", "heads_out", "empty_hulls", "keepalives", "rejected"})
+    metrics_.counter(name);
+}
+
+TrackerNode::~TrackerNode() { stop(); }
+
+Expected<void> TrackerNode::start() {
+  if (worker_) return {};
+  auto segments_topic = wire::Topic<studio_SegmentSet>::create(participant_);
+  if (!segments_topic) return std::unexpected(segments_topic.error());
+  auto head_topic = wire::Topic<studio_HeadPose>::create(participant_);
+  if (!head_topic) return std::unexpected(head_topic.error());
+  auto reader = wire::Reader<studio_SegmentSet>::create(participant_, *segments_topic);
+  if (!reader) return std::unexpected(reader.error());
+  auto writer = wire::Writer<studio_HeadPose>::create(participant_, *head_topic);
+  if (!writer) return std::unexpected(writer.error());
+  auto guard = wire::GuardCondition::create(participant_);
+  if (!guard) return std::unexpected(guard.error());
+  auto waitset = wire::WaitSet::create(participant_);
+  if (!waitset) return std::unexpected(waitset.error());
+  if (auto r = waitset->attach(*reader, Worker::kData); !r) return std::unexpected(r.error());
+  if (auto r = waitset->attach(*guard, Worker::kStop); !r) return std::unexpected(r.error());
+  auto search = HeadSearch::create(options_.search);
+  if (!search) return std::unexpected(search.error());
+  auto tracker = HeadTracker::create(options_.filter);
+  if (!tracker) return std::unexpected(tracker.error());
+
+  worker_.reset(new Worker{.options = options_,
+                           .metrics = metrics_,
+                           .segments_topic = std::move(*segments_topic),
+                           .head_topic = std::move(*head_topic),
+                           .reader = std::move(*reader),
+                           .writer = std::move(*writer),
+                           .stop_guard = std::move(*guard),
+                           .waitset = std::move(*waitset),
+                           .search = std::move(*search),
+                           .tracker = std::move(*tracker),
+                           .sets_in = metrics_.counter("segment_sets_in"),
+                           .heads_out = metrics_.counter("heads_out"),
+                           .empty_hulls = metrics_.counter("empty_hulls"),
+                           .keepalives = metrics_.counter("keepalives"),
+                           .rejected = metrics_.counter("rejected")});
+  worker_->last_pose = worker_->tracker.primary();  // rest position, confidence 0
+  thread_ = std::thread([w = worker_.get()] { w->run(); });
+  return {};
+}
+
+void TrackerNode::stop() {
+  if (!worker_) return;
+  worker_->running = false;
+  worker_->stop_guard.trigger();
+  if (thread_.joinable()) thread_.join();
+  worker_.reset();
+}
+
+runtime::NodeHealth TrackerNode::health() {
+  runtime::NodeHealth h;
+  if (!worker_) return h;
+  h.frame = worker_->last_frame;
+  h.capture_ns = worker_->last_capture_ns;
+  h.degraded = worker_->lost;  // running, but no head tracked
+  return h;
+}
+
+runtime::ServiceDefinition service_definition() {
+  runtime::ServiceDefinition d;
+  d.name = "tracker";
+  d.summary =
+      "Head tracker node: studio/actor/segments (SegmentSet) in, studio/actor/head (HeadPose)\n"
+      "out (two-box template search, TCSVT 2004 IV-D, plus Kalman tracks). Offline mode:\n"
+      "  studio-tracker locate --help";
+  d.config_help = kConfigHelp;
+  d.create = [](yaml::MapReader& config,
+                runtime::NodeContext& context) -> Expected<std::unique_ptr<runtime::Node>> {
+    auto options = read_node_options(config);
+    if (!options) return std::unexpected(options.error());
+    return std::make_unique<TrackerNode>(std::move(*options), context);
+  };
+  return d;
+}
+
+}  // namespace studio::tracker::node

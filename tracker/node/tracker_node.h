@@ -1,0 +1,55 @@
+#pragma once
+// The tracker service node (issue 6 item 3): studio/actor/segments (SegmentSet) in,
+// studio/actor/head (HeadPose) out.
+//
+// One worker thread waits on a WaitSet holding the segments reader and a guard condition (stop).
+// For each valid SegmentSet: to_core → rasterise → HeadSearch::find → HeadTracker::update at the
+// sample's capture_ns → the primary head is published under `actor_id` with the source's frame
+// and capture_ns (and, with publish_tracks, every live track as <actor_id>/<track id>). An empty
+// hull (or no head in it) is a frame without detections: the tracker coasts, its confidence
+// decays by coast_decay per frame and reaches 0 once the track is dropped after max_missed frames
+// (the fallback pose: last head position, zero velocity, confidence 0).
+//
+// Keep-alive: when no SegmentSet arrives for 1/publish_rate seconds, the last published pose is
+// published again, coasting: each tick advances the position by the velocity over the tick and
+// multiplies velocity and confidence by coast_decay; after max_missed ticks confidence and
+// velocity are 0 and the position stays. Keep-alive samples carry the source's last frame and
+// capture_ns = last capture_ns + the time elapsed since that sample arrived (the instant the pose
+// is predicted for, on the source's clock). Keep-alives never enter the tracker, so the next real
+// frame is filtered against the last real one.
+//
+// Metrics: counters segment_sets_in, heads_out, empty_hulls, keepalives, rejected (to_core
+// failures plus the reader's validator rejections); latency = publish time − capture_ns of real
+// frames.
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "runtime/service.h"
+#include "tracker_config.h"
+
+namespace studio::tracker::node {
+
+class TrackerNode : public runtime::Node {
+ public:
+  TrackerNode(NodeOptions options, runtime::NodeContext& context);
+  ~TrackerNode() override;
+  Expected<void> start() override;
+  void stop() override;
+  runtime::NodeHealth health() override;
+
+ private:
+  struct Worker;
+  NodeOptions options_;
+  const wire::Participant& participant_;
+  runtime::Metrics& metrics_;
+  std::unique_ptr<Worker> worker_;
+  std::thread thread_;
+};
+
+// service_main's definition of the tracker service (name "tracker").
+runtime::ServiceDefinition service_definition();
+
+}  // namespace studio::tracker::node
