@@ -45,6 +45,22 @@ double Mesh::volume() const {
   return v / 6.0;
 }
 
+void compute_normals(Mesh& mesh) {
+  // Area-weighted vertex normals.
+  std::vector<Eigen::Vector3d> acc(mesh.vertices.size(), Eigen::Vector3d::Zero());
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>();
+    const Eigen::Vector3d n = (mesh.vertices[t[1]].cast<double>() - a)
+                                  .cross(mesh.vertices[t[2]].cast<double>() - a);
+    for (uint32_t k : t) acc[k] += n;
+  }
+  mesh.normals.resize(acc.size());
+  for (std::size_t k = 0; k < acc.size(); ++k) {
+    const double n = acc[k].norm();
+    mesh.normals[k] = n > 0 ? Eigen::Vector3f((acc[k] / n).cast<float>()) : Eigen::Vector3f::Zero();
+  }
+}
+
 Mesh segment_marching_cubes(const SegmentSet& set) {
   const GridSpec& g = set.grid();
   const int nu = g.cells_u, nv = g.cells_v;
@@ -238,19 +254,7 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
     }
   }
 
-  // Area-weighted vertex normals.
-  std::vector<Eigen::Vector3d> acc(mesh.vertices.size(), Eigen::Vector3d::Zero());
-  for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>();
-    const Eigen::Vector3d n = (mesh.vertices[t[1]].cast<double>() - a)
-                                  .cross(mesh.vertices[t[2]].cast<double>() - a);
-    for (uint32_t k : t) acc[k] += n;
-  }
-  mesh.normals.resize(acc.size());
-  for (std::size_t k = 0; k < acc.size(); ++k) {
-    const double n = acc[k].norm();
-    mesh.normals[k] = n > 0 ? Eigen::Vector3f((acc[k] / n).cast<float>()) : Eigen::Vector3f::Zero();
-  }
+  compute_normals(mesh);
   return mesh;
 }
 

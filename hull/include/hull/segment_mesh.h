@@ -35,6 +35,9 @@ struct Mesh {
 
 Mesh segment_marching_cubes(const SegmentSet& set);
 
+// (Re)computes mesh.normals: unit area-weighted vertex normals (zero for isolated vertices).
+void compute_normals(Mesh& mesh);
+
 // Topology report for tests and tools.
 struct MeshTopology {
   std::size_t edges = 0;

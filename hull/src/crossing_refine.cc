@@ -1,0 +1,108 @@
+#include "hull/crossing_refine.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace studio::hull {
+namespace {
+
+// Whether the column holds t just below (below = true) or just above t (intervals half-open).
+bool occupied(std::span<const Interval> col, float t, bool below) {
+  for (const Interval& iv : col) {
+    if (below ? (iv.lo < t && t <= iv.hi) : (iv.lo <= t && t < iv.hi)) return true;
+  }
+  return false;
+}
+
+// The largest end point of either column strictly below t (or above, for below = false).
+double neighbour_event(std::span<const Interval> a, std::span<const Interval> b, float t,
+                       bool below, double fallback) {
+  double best = fallback;
+  for (auto col : {a, b}) {
+    for (const Interval& iv : col) {
+      for (const float e : {iv.lo, iv.hi}) {
+        if (below && e < t) best = std::max(best, double(e));
+        if (!below && e > t) best = std::min(best, double(e));
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<const View> views,
+                                const CutOptions& options) {
+  if (auto ok = options.validate(); !ok) return ok;
+  const GridSpec& g = set.grid();
+  const int ua = g.u(), va = g.v(), aa = g.a();
+  const double du = g.du(), dv = g.dv();
+  const Eigen::AlignedBox3d domain(g.box_min, g.box_max);
+  // Lines along e_u and along e_v: two pencils through points at infinity.
+  std::vector<PreparedView> along[2];
+  for (int k = 0; k < 2; ++k) {
+    Eigen::Vector4d X = Eigen::Vector4d::Zero();
+    X[k == 0 ? ua : va] = 1;
+    for (const View& v : views) {
+      auto p = PreparedView::create(*v.camera, *v.mask, X, options, &domain);
+      if (!p) return std::unexpected(p.error());
+      along[k].push_back(std::move(*p));
+    }
+  }
+  const auto column = [&](int i, int j) -> std::span<const Interval> {
+    if (i < 0 || j < 0 || i >= g.cells_u || j >= g.cells_v) return {};
+    return set.column(i, j);
+  };
+  std::vector<Interval> a, b;
+  CutScratch scratch;
+  for (Eigen::Vector3f& p : mesh.vertices) {
+    // Lattice line in doubled coordinates (see segment_mesh.cc): column (i, j) is (2i+2, 2j+2).
+    const int x2 = int(std::lround((p[ua] - g.box_min[ua]) / du * 2 + 1));
+    const int y2 = int(std::lround((p[va] - g.box_min[va]) / dv * 2 + 1));
+    const bool odd_x = (x2 & 1) != 0, odd_y = (y2 & 1) != 0;
+    if (odd_x == odd_y) continue;  // a column or a cell centre
+    const int k = odd_x ? 0 : 1;   // edge along u or along v
+    const int i0 = odd_x ? (x2 - 3) / 2 : (x2 - 2) / 2;
+    const int j0 = odd_x ? (y2 - 2) / 2 : (y2 - 3) / 2;
+    const int i1 = i0 + (odd_x ? 1 : 0), j1 = j0 + (odd_x ? 0 : 1);
+    const auto c0 = column(i0, j0), c1 = column(i1, j1);
+    const float t = p[aa];
+    const bool b0 = occupied(c0, t, true), b1 = occupied(c1, t, true);
+    const bool a0 = occupied(c0, t, false), a1 = occupied(c1, t, false);
+    double te;
+    bool first_inside;
+    if (b0 != b1 && a0 != a1 && b0 == a0) {
+      te = t, first_inside = b0;
+    } else if (b0 != b1) {
+      const double prev = neighbour_event(c0, c1, t, true, g.t_min());
+      te = t - std::min(1e-3, 0.5 * (t - prev)), first_inside = b0;
+    } else if (a0 != a1) {
+      const double next = neighbour_event(c0, c1, t, false, g.t_max());
+      te = t + std::min(1e-3, 0.5 * (next - t)), first_inside = a0;
+    } else {
+      continue;
+    }
+    // From the inside column towards the outside one.
+    const double step = k == 0 ? du : dv;
+    const Eigen::Vector3d from = g.point(first_inside ? i0 : i1, first_inside ? j0 : j1, te);
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    d[k == 0 ? ua : va] = first_inside ? 1 : -1;
+    a.assign(1, Interval{0.f, float(step)});
+    for (const PreparedView& view : along[k]) {
+      b.clear();
+      view.cut_line(from, d, a, &b, &scratch);
+      std::swap(a, b);
+      if (a.empty()) break;
+    }
+    // The surviving piece at the inside column; the half-cell guess when quantisation lost it.
+    double s = 0.5 * step;
+    if (!a.empty() && a.front().lo <= 0.02 * step) s = a.front().hi;
+    s = std::clamp(s, 0.02 * step, 0.98 * step);
+    const double at = from[k == 0 ? ua : va] + (first_inside ? s : -s);
+    p[k == 0 ? ua : va] = float(at);
+  }
+  compute_normals(mesh);
+  return {};
+}
+
+}  // namespace studio::hull
