@@ -1,0 +1,91 @@
+#include "convert.h"
+
+#include <algorithm>
+#include <span>
+
+namespace studio::capture::node {
+
+void from_core(const std::string& camera_id, uint64_t frame, int64_t capture_ns,
+               const std::vector<uint8_t>& codec_bytes, int width, int height,
+               wire::Owned<studio_AlphaMask>& out) {
+  wire::set(out->camera_id, camera_id);
+  out->frame = frame;
+  out->capture_ns = capture_ns;
+  out->width = uint32_t(width);
+  out->height = uint32_t(height);
+  out->encoding = studio_MASK_CODEC;
+  wire::resize(out->row_start, 0);
+  wire::resize(out->runs, 0);
+  wire::assign(out->data, codec_bytes);
+}
+
+void from_core(const Camera& camera, uint64_t frame, int64_t capture_ns, bool tracked,
+               wire::Owned<studio_CameraCalibration>& out) {
+  wire::set(out->camera_id, camera.id);
+  out->frame = frame;
+  out->capture_ns = capture_ns;
+  out->width = uint32_t(camera.width);
+  out->height = uint32_t(camera.height);
+  const Eigen::Matrix3d K = camera.intrinsics.K();
+  const Eigen::Matrix3d R = camera.cam_from_world.R();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      out->K[3 * r + c] = K(r, c);
+      out->R[3 * r + c] = R(r, c);
+    }
+  for (int i = 0; i < 3; ++i) out->t[i] = camera.cam_from_world.translation[i];
+  const auto& d = camera.distortion;
+  out->rd3 = d.model == Distortion::Model::radial ? d.rd3 : d.model == Distortion::Model::opencv ? d.k1 : 0;
+  out->rd5 = d.model == Distortion::Model::radial ? d.rd5 : d.model == Distortion::Model::opencv ? d.k2 : 0;
+  out->tracked = tracked;
+}
+
+void from_core(const std::string& camera_id, uint64_t frame, int64_t capture_ns, int width,
+               int height, bool jpeg, const std::vector<uint8_t>& data,
+               wire::Owned<studio_CameraImage>& out) {
+  wire::set(out->camera_id, camera_id);
+  out->frame = frame;
+  out->capture_ns = capture_ns;
+  out->width = uint32_t(width);
+  out->height = uint32_t(height);
+  out->format = jpeg ? studio_IMAGE_JPEG : studio_IMAGE_RGB8;
+  wire::assign(out->data, data);
+}
+
+void from_core(const CameraStateCore& s, wire::Owned<studio_CameraState>& out) {
+  wire::set(out->camera_id, s.camera_id);
+  out->frame = s.frame;
+  out->capture_ns = s.capture_ns;
+  std::vector<studio_CameraFeature> features;
+  for (const auto& f : s.features) {
+    if (features.size() == 64) break;  // IDL bound
+    studio_CameraFeature cf{};
+    wire::set(cf.name, f.name.substr(0, sizeof cf.name - 1));
+    cf.value = f.value;
+    cf.min = f.min;
+    cf.max = f.max;
+    features.push_back(cf);
+  }
+  wire::assign(out->features, features);
+  out->fps = s.fps;
+  out->drops = s.drops;
+  out->recording = s.recording;
+  wire::set(out->take, s.take.substr(0, sizeof out->take - 1));
+  switch (s.state) {
+    case CameraStateCore::Run::kStopped: out->state = studio_CAMERA_STOPPED; break;
+    case CameraStateCore::Run::kStreaming: out->state = studio_CAMERA_STREAMING; break;
+    case CameraStateCore::Run::kRecording: out->state = studio_CAMERA_RECORDING; break;
+    case CameraStateCore::Run::kError: out->state = studio_CAMERA_ERROR; break;
+  }
+  wire::set(out->error, s.error.substr(0, sizeof out->error - 1));
+}
+
+CaptureCommandCore to_core(const studio_CaptureCommand& c) {
+  return {std::string(wire::str(c.take)), c.action == studio_CAPTURE_START, c.at_frame};
+}
+
+CameraControlCore to_core(const studio_CameraControl& c) {
+  return {std::string(wire::str(c.camera_id)), std::string(wire::str(c.feature)), c.value};
+}
+
+}  // namespace studio::capture::node
