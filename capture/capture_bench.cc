@@ -101,8 +101,8 @@ void BM_RecorderTake(benchmark::State& state) {
   fs::remove_all(dir);
   const double n = double(written);
   state.counters["fps"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
-  state.counters["MBps"] =
-      benchmark::Counter(n * (double(kW) * kH * 3 + kFrameHeaderSize) / 1e6, benchmark::Counter::kIsRate);
+  state.counters["MBps"] = benchmark::Counter(n * (double(kW) * kH * 3 + kFrameHeaderSize) / 1e6,
+                                              benchmark::Counter::kIsRate);
   // Rates are divided by wall time after the run; headroom / x_plain need the same division, so
   // they are computed from fps below via kIsRate counters scaled by constants.
   state.counters["headroom"] = benchmark::Counter(n / 25.0, benchmark::Counter::kIsRate);
@@ -114,9 +114,10 @@ void BM_Crc32(benchmark::State& state) {
   const auto img = frame_image();
   const std::size_t bytes = img.pixels().size() * 3;
   for (auto _ : state) benchmark::DoNotOptimize(crc32_update(0, img.data(), bytes));
-  state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
-  state.counters["MBps"] =
-      benchmark::Counter(double(state.iterations()) * double(bytes) / 1e6, benchmark::Counter::kIsRate);
+  state.counters["fps"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["MBps"] = benchmark::Counter(double(state.iterations()) * double(bytes) / 1e6,
+                                              benchmark::Counter::kIsRate);
 }
 
 }  // namespace

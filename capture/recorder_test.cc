@@ -1,6 +1,8 @@
 // Recorder: full takes are intact and indexed; a full queue drops and counts; a disk that fills
 // (a file size limit, or a small tmpfs in a private mount namespace) stops the take cleanly with
 // an error state, every earlier frame intact and no torn frame left.
+#include "capture/recorder.h"
+
 #include <gtest/gtest.h>
 #include <sched.h>
 #include <signal.h>
@@ -12,8 +14,6 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-
-#include "capture/recorder.h"
 
 namespace studio::capture {
 namespace {
@@ -91,7 +91,8 @@ TEST(Recorder, WritesEveryFrameIntactWithIndexAndTakeYaml) {
   const std::string yaml = slurp(dir + "/take.yaml");
   EXPECT_NE(yaml.find("status: complete"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("first_frame: 1000\nlast_frame: 1039\nframes: 40\ndrops: 2\n"),
-            std::string::npos) << yaml;
+            std::string::npos)
+      << yaml;
   EXPECT_NE(yaml.find("stop_frame: 1040"), std::string::npos) << yaml;
 
   // A take is never overwritten.
@@ -199,11 +200,12 @@ void check_disk_full(const std::string& report, bool exact_ten, const char* what
   EXPECT_GT(written, 0u) << report;
   EXPECT_EQ(intact, written) << report;  // every frame written before the error is intact
   EXPECT_EQ(corrupt, 0u) << report;
-  EXPECT_EQ(torn, 0u) << report;         // the torn frame was cut off
+  EXPECT_EQ(torn, 0u) << report;  // the torn frame was cut off
   EXPECT_EQ(error_state, 1) << report;
   EXPECT_EQ(yaml_error, 1) << report;
   if (exact_ten) EXPECT_EQ(written, 10u) << report;
-  std::printf("%s: %llu frames intact, error:%s\n", what, (unsigned long long)written, message.c_str());
+  std::printf("%s: %llu frames intact, error:%s\n", what, (unsigned long long)written,
+              message.c_str());
 }
 
 TEST(Recorder, FileSizeLimitStopsTakeCleanly) {

@@ -1,11 +1,12 @@
 // The simulated camera: studio frame numbers and genlock capture times, real-time pacing,
 // deterministic pictures shared across instances, simulated features with read-back.
+#include "capture/sim_source.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "capture/sim/cameras.h"
-#include "capture/sim_source.h"
 
 namespace studio::capture {
 namespace {
@@ -69,8 +70,10 @@ TEST(SimFrameSource, SameFrameSamePictureAcrossInstances) {
   auto fb = (*b)->next(1s).value().value();
   auto fa2 = (*a)->next(1s).value().value();
   EXPECT_EQ(fa2.frame, fa.frame + 1);
-  if (fb.frame == fa.frame) EXPECT_EQ(fa.image.pixels(), fb.image.pixels());
-  else if (fb.frame == fa2.frame) EXPECT_EQ(fa2.image.pixels(), fb.image.pixels());
+  if (fb.frame == fa.frame)
+    EXPECT_EQ(fa.image.pixels(), fb.image.pixels());
+  else if (fb.frame == fa2.frame)
+    EXPECT_EQ(fa2.image.pixels(), fb.image.pixels());
 }
 
 TEST(SimFrameSource, FeaturesClampReadBackAndChangeThePicture) {
@@ -80,7 +83,7 @@ TEST(SimFrameSource, FeaturesClampReadBackAndChangeThePicture) {
   const double base = mean_level((*src)->next(1s).value()->image);
   EXPECT_EQ((*src)->set_feature("Gain", 6.0).value(), 6.0);
   const double gained = mean_level((*src)->next(1s).value()->image);
-  EXPECT_GT(gained, base * 1.5);  // +6 dB doubles unsaturated levels
+  EXPECT_GT(gained, base * 1.5);                             // +6 dB doubles unsaturated levels
   EXPECT_EQ((*src)->set_feature("Gain", 99).value(), 24.0);  // clamped, read back
   EXPECT_EQ((*src)->set_feature("Gain", 0).value(), 0.0);
   EXPECT_EQ((*src)->set_feature("ExposureTime", 5000).value(), 5000.0);

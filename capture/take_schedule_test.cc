@@ -1,8 +1,8 @@
 // Frame-accurate take control: takes record exactly [start, stop), late commands are refused or
 // clamped, dropped start frames are reported.
-#include <gtest/gtest.h>
-
 #include "capture/take_schedule.h"
+
+#include <gtest/gtest.h>
 
 namespace studio::capture {
 namespace {

@@ -1,5 +1,7 @@
 // Take format: CRC-32 check value, header round trip, scanning intact / corrupt / torn frames,
 // index round trip, take.yaml text.
+#include "capture/take.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -8,7 +10,6 @@
 #include <fstream>
 
 #include "capture/crc32.h"
-#include "capture/take.h"
 
 namespace studio::capture {
 namespace {
@@ -24,8 +25,11 @@ std::string temp_dir(const std::string& name) {
 std::vector<uint8_t> frame_bytes(uint64_t frame, int w, int h) {
   std::vector<uint8_t> payload(std::size_t(w) * h * 3);
   for (std::size_t i = 0; i < payload.size(); ++i) payload[i] = uint8_t(i * 7 + frame);
-  FrameHeader hd{.frame = frame, .capture_ns = int64_t(frame) * 40, .width = uint32_t(w),
-                 .height = uint32_t(h), .format = PixelFormat::kRgb8,
+  FrameHeader hd{.frame = frame,
+                 .capture_ns = int64_t(frame) * 40,
+                 .width = uint32_t(w),
+                 .height = uint32_t(h),
+                 .format = PixelFormat::kRgb8,
                  .payload_size = payload.size()};
   uint8_t header[kFrameHeaderSize];
   encode_frame_header(hd, payload, header);
@@ -35,7 +39,8 @@ std::vector<uint8_t> frame_bytes(uint64_t frame, int w, int h) {
 }
 
 void write_file(const std::string& path, const std::vector<uint8_t>& bytes) {
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), bytes.size());
 }
 
 TEST(Crc32, CheckValueAndIncremental) {

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "../../keyer/cli/keyer_yaml.h"
+#include "capture/aravis_source.h"
 #include "capture/file_source.h"
 #include "capture/sim/cameras.h"
 #include "capture/sim_source.h"
@@ -21,7 +22,10 @@ const char kConfigHelp[] =
     "  cameras:                          one entry per camera:\n"
     "    - id: cam0\n"
     "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true}\n"
-    "      source: {type: files, path: DIR, fps: 25, loop: false, paced: true}\n";
+    "      source: {type: files, path: DIR, fps: 25, loop: false, paced: true}\n"
+    "      source: {type: aravis, device: ID, pixel_format: BayerRG8, width: W, height: H,\n"
+    "               fps: 25, trigger: free_run|software|line, line: Line0, buffers: 8,\n"
+    "               interfaces: [GigEVision, USB3Vision]}\n";
 
 namespace {
 
@@ -66,8 +70,8 @@ Expected<void> string(yaml::MapReader& m, std::string_view key, std::string& out
   return {};
 }
 
-#define TRY(expr)                          \
-  do {                                     \
+#define TRY(expr)                                       \
+  do {                                                  \
     if (auto _r = (expr); !_r) return Fail(_r.error()); \
   } while (0)
 
@@ -125,8 +129,47 @@ Expected<CameraSetup> read_camera(const yaml::Node& node, const CaptureNodeOptio
     auto src = FileSource::create(fo);
     if (!src) return src_node->fail(src.error().message);
     setup.source = std::move(*src);
+  } else if (*type == "aravis") {
+    AravisOptions ao;
+    ao.camera_id = setup.id;
+    ao.clock = o.clock;
+    std::string pixel_format, trigger = "free_run";
+    TRY(string(*s, "device", ao.device_id, false));
+    TRY(string(*s, "pixel_format", pixel_format, false));
+    TRY(number(*s, "width", ao.width, 0, 32768, as_int));
+    TRY(number(*s, "height", ao.height, 0, 32768, as_int));
+    TRY(number(*s, "fps", ao.frame_rate, 0, 1000, as_double));
+    TRY(string(*s, "trigger", trigger, false));
+    TRY(string(*s, "line", ao.trigger_line, false));
+    TRY(number(*s, "buffers", ao.buffers, 2, 256, as_int));
+    if (auto n = s->optional("interfaces")) {
+      auto v = n->elements();
+      if (!v) return Fail(v.error());
+      for (const auto& e : *v) {
+        auto name = e.as_string();
+        if (!name) return Fail(name.error());
+        ao.interfaces.push_back(*name);
+      }
+    }
+    TRY(s->finish());
+    if (!pixel_format.empty()) {
+      auto pf = parse_pixel_format(pixel_format);
+      if (!pf) return src_node->fail(pf.error().message);
+      ao.pixel_format = *pf;
+    }
+    if (trigger == "free_run")
+      ao.trigger = TriggerMode::free_run;
+    else if (trigger == "software")
+      ao.trigger = TriggerMode::software;
+    else if (trigger == "line")
+      ao.trigger = TriggerMode::line;
+    else
+      return src_node->fail("trigger: expected free_run, software or line");
+    auto src = AravisSource::open(ao);
+    if (!src) return src_node->fail(src.error().message);
+    setup.source = std::move(*src);
   } else {
-    return type_node->fail("unknown source type '" + *type + "' (expected sim or files)");
+    return type_node->fail("unknown source type '" + *type + "' (expected sim, files or aravis)");
   }
   TRY(m->finish());
   return setup;

@@ -13,6 +13,8 @@
 //       source: {type: sim, ring: 6, index: 0, width: 704, height: 576}   # simulated ring camera
 //     - id: cam1
 //       source: {type: files, path: DIR, fps: 25, loop: true}            # image folder replay
+//     - id: cam2
+//       source: {type: aravis, device: ID, pixel_format: BayerRG8, fps: 25, trigger: line}
 //
 // Errors are one line "file:line: field: problem".
 

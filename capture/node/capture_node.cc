@@ -1,11 +1,10 @@
 #include "capture_node.h"
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "convert.h"
 #include "core/log.h"
@@ -65,8 +64,8 @@ struct CaptureNode::Camera {
   std::vector<std::unique_ptr<Recorder>> finishing;
   uint64_t source_drops_at_begin = 0;
   uint64_t recorder_drops = 0;  // queue drops of finished takes
-  bool error_state = false;   // a take failed (disk full, ...): stays until restart
-  bool source_error = false;  // the source fails now
+  bool error_state = false;     // a take failed (disk full, ...): stays until restart
+  bool source_error = false;    // the source fails now
   std::string error;
   uint64_t last_frame = 0;
   int64_t last_capture_ns = 0;
@@ -125,10 +124,10 @@ Expected<void> CaptureNode::start() {
   auto qr = wire::Reader<studio_CaptureCommand>::create(p, *qt);
   auto guard = wire::GuardCondition::create(p);
   auto ws = wire::WaitSet::create(p);
-  for (const Error* e : {mw ? nullptr : &mw.error(), iw ? nullptr : &iw.error(),
-                         sw ? nullptr : &sw.error(), cw ? nullptr : &cw.error(),
-                         rr ? nullptr : &rr.error(), qr ? nullptr : &qr.error(),
-                         guard ? nullptr : &guard.error(), ws ? nullptr : &ws.error()})
+  for (const Error* e :
+       {mw ? nullptr : &mw.error(), iw ? nullptr : &iw.error(), sw ? nullptr : &sw.error(),
+        cw ? nullptr : &cw.error(), rr ? nullptr : &rr.error(), qr ? nullptr : &qr.error(),
+        guard ? nullptr : &guard.error(), ws ? nullptr : &ws.error()})
     if (e) return fail_with(*e);
   wire_.reset(new Wire{std::move(*mt), std::move(*it), std::move(*st), std::move(*ct),
                        std::move(*rt), std::move(*qt), std::move(*mw), std::move(*iw),
@@ -147,7 +146,8 @@ Expected<void> CaptureNode::start() {
       from_core(*cam->calibration, 0, realtime_ns(), false, c);
       if (auto w = wire_->calibrations.write(*c); !w) return fail_with(w.error());
     }
-    if (auto s = cam->source->start(); !s) return fail("camera " + cam->id + ": " + s.error().message);
+    if (auto s = cam->source->start(); !s)
+      return fail("camera " + cam->id + ": " + s.error().message);
   }
   running_ = true;
   for (auto& cam : cameras_) {
@@ -206,7 +206,8 @@ void CaptureNode::publish_state(Camera& cam) {
   const auto source_stats = cam.source->stats();
   {
     std::lock_guard lock(cam.mutex);
-    s.features.push_back({"ImageRate", cam.image_rate, 0, 1e9 / double(options_.clock.period_ns), true});
+    s.features.push_back(
+        {"ImageRate", cam.image_rate, 0, 1e9 / double(options_.clock.period_ns), true});
     s.features.push_back({"ImageRaw", cam.image_raw ? 1.0 : 0.0, 0, 1, true});
     s.frame = cam.last_frame;
     s.capture_ns = cam.last_capture_ns;
@@ -219,9 +220,9 @@ void CaptureNode::publish_state(Camera& cam) {
     else if (cam.schedule.pending())
       s.take = cam.schedule.pending()->name;
     s.state = cam.error_state || cam.source_error ? CameraStateCore::Run::kError
-              : !running_              ? CameraStateCore::Run::kStopped
-              : s.recording            ? CameraStateCore::Run::kRecording
-                                       : CameraStateCore::Run::kStreaming;
+              : !running_                         ? CameraStateCore::Run::kStopped
+              : s.recording                       ? CameraStateCore::Run::kRecording
+                                                  : CameraStateCore::Run::kStreaming;
     s.error = cam.error;
     cam.dirty = false;
     cam.last_state = Clock::now();
@@ -328,8 +329,9 @@ void CaptureNode::capture_loop(Camera& cam) {
             auto result = (*it)->wait();
             cam.recorder_drops += (*it)->stats().queue_drops;
             if (result) {
-              STUDIO_LOG(info, kLog) << cam.id << ": take " << result->take << " complete: "
-                                     << result->frames << " frames, " << result->drops << " drops";
+              STUDIO_LOG(info, kLog)
+                  << cam.id << ": take " << result->take << " complete: " << result->frames
+                  << " frames, " << result->drops << " drops";
             } else if (!cam.error_state) {
               cam.error_state = true;
               cam.error = result.error().message;
@@ -422,12 +424,14 @@ void CaptureNode::handle_control(const CameraControlCore& c) {
     cam->image_raw = c.value != 0;
   } else if (std::find(std::begin(kCameraFeatures), std::end(kCameraFeatures), c.feature) ==
              std::end(kCameraFeatures)) {
-    problem = "camera " + cam->id + ": feature '" + c.feature + "' is not allowed (allowed: Gain, "
+    problem = "camera " + cam->id + ": feature '" + c.feature +
+              "' is not allowed (allowed: Gain, "
               "ExposureTime, Focus, Zoom, Iris, ImageRate, ImageRaw)";
   } else if (auto v = cam->source->set_feature(c.feature, c.value); !v) {
     problem = v.error().message;
   } else {
-    STUDIO_LOG(info, kLog) << cam->id << ": " << c.feature << " = " << *v << " (asked " << c.value << ")";
+    STUDIO_LOG(info, kLog) << cam->id << ": " << c.feature << " = " << *v << " (asked " << c.value
+                           << ")";
   }
   {
     std::lock_guard lock(cam->mutex);
@@ -461,8 +465,10 @@ void CaptureNode::handle_command(const CaptureCommandCore& c) {
         problem = "take " + c.take + ": stop frame " + std::to_string(c.at_frame) +
                   " had passed; stopping at " + std::to_string(*r);
       }
-      if (!problem.empty()) cam->error = problem;
-      else if (!cam->error_state) cam->error.clear();
+      if (!problem.empty())
+        cam->error = problem;
+      else if (!cam->error_state)
+        cam->error.clear();
     }
     if (!problem.empty()) {
       commands_rejected_.add();

@@ -45,7 +45,7 @@ struct CaptureNodeOptions {
   std::size_t queue_frames = 50;
   keyer::KeyerOptions keyer;
   MaskCoding coding = MaskCoding::kRowDelta;
-  double image_rate = 5;   // Hz, 0 = no images
+  double image_rate = 5;  // Hz, 0 = no images
   int jpeg_quality = 85;
   bool image_raw = false;
   double state_period = 1.0;  // seconds

@@ -58,11 +58,12 @@ class CaptureNodeTest : public testing::ProcessTest {
 
   static std::string sim_config(const std::vector<int>& indices, int w, int h,
                                 const std::string& extra = "") {
-    std::string s = "clock: {fps: 25}\ntakes_dir: takes\nstate_period: 0.2\n" + extra + "cameras:\n";
+    std::string s =
+        "clock: {fps: 25}\ntakes_dir: takes\nstate_period: 0.2\n" + extra + "cameras:\n";
     for (int i : indices)
-      s += "  - id: cam" + std::to_string(i) + "\n    source: {type: sim, ring: 6, index: " +
-           std::to_string(i) + ", width: " + std::to_string(w) + ", height: " + std::to_string(h) +
-           "}\n";
+      s += "  - id: cam" + std::to_string(i) +
+           "\n    source: {type: sim, ring: 6, index: " + std::to_string(i) +
+           ", width: " + std::to_string(w) + ", height: " + std::to_string(h) + "}\n";
     return s;
   }
 
@@ -85,7 +86,8 @@ class CaptureNodeTest : public testing::ProcessTest {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < deadline) {
       for (auto& s : r.take())
-        if (s.meta.valid_data) states[std::string(wire::str(s.data->camera_id))] = std::move(s.data);
+        if (s.meta.valid_data)
+          states[std::string(wire::str(s.data->camera_id))] = std::move(s.data);
       if (pred(states)) return true;
       std::this_thread::sleep_for(20ms);
     }
@@ -117,7 +119,8 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
     std::string yaml, expect;
   } cases[] = {
       {"cameras: []\n", "cameras: expected at least one camera"},
-      {"cameras:\n  - id: a\n    source: {type: sim, index: 7, ring: 6}\n", "source: index: must be below ring"},
+      {"cameras:\n  - id: a\n    source: {type: sim, index: 7, ring: 6}\n",
+       "source: index: must be below ring"},
       {"cameras:\n  - id: a\n    source: {type: tape}\n", "unknown source type 'tape'"},
       {"cameras:\n  - id: a\n    source: {type: sim, colour: red}\n", "colour: unknown key"},
       {"image: {rate: fast}\ncameras:\n  - id: a\n    source: {type: sim}\n", "image.rate"},
@@ -125,7 +128,8 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
       {"clock: {fps: 25, period_ns: 40000000}\ncameras: []\n", "not both"},
   };
   for (const auto& c : cases) {
-    auto& p = spawn("capture", "capture/studio-capture", {"--config", write_config("bad.yaml", c.yaml)});
+    auto& p =
+        spawn("capture", "capture/studio-capture", {"--config", write_config("bad.yaml", c.yaml)});
     auto rc = p.wait_exit(20s);
     ASSERT_TRUE(rc.has_value()) << c.yaml;
     EXPECT_EQ(*rc, 1) << c.yaml << p.log();
@@ -141,8 +145,9 @@ TEST_F(CaptureNodeTest, PublishesMasksImagesStateAndAppliesControl) {
   auto states = reader<studio_CameraState>();
   auto calibrations = reader<studio_CameraCalibration>();
   auto control = writer<studio_CameraControl>();
-  auto& p = spawn("capture", "capture/studio-capture",
-                  {"--config", write_config("cap.yaml", sim_config({0}, 176, 144, "image: {rate: 10}\n"))});
+  auto& p = spawn(
+      "capture", "capture/studio-capture",
+      {"--config", write_config("cap.yaml", sim_config({0}, 176, 144, "image: {rate: 10}\n"))});
   ASSERT_TRUE(p.wait_ready(30s)) << p.log();
 
   // Masks: decodable, the camera's size, an actor in view; frame numbers increase.
@@ -185,9 +190,10 @@ TEST_F(CaptureNodeTest, PublishesMasksImagesStateAndAppliesControl) {
   EXPECT_GT(cal[0].data->K[0], 100.0);
 
   std::map<std::string, wire::Owned<studio_CameraState>> st;
-  ASSERT_TRUE(wait_states(states, st, [](auto& s) {
-    return s.count("cam0") && s.at("cam0")->state == studio_CAMERA_STREAMING;
-  }, 10s));
+  ASSERT_TRUE(wait_states(
+      states, st,
+      [](auto& s) { return s.count("cam0") && s.at("cam0")->state == studio_CAMERA_STREAMING; },
+      10s));
   EXPECT_EQ(feature(*st["cam0"], "Gain"), 0.0);
 
   auto set = [&](const std::string& feature, double value) {
@@ -199,21 +205,30 @@ TEST_F(CaptureNodeTest, PublishesMasksImagesStateAndAppliesControl) {
   };
   ASSERT_TRUE(control.wait_for_readers(1, 10s));
   set("Gain", 6.0);
-  EXPECT_TRUE(wait_states(states, st, [&](auto& s) { return feature(*s.at("cam0"), "Gain") == 6.0; }, 10s));
+  EXPECT_TRUE(wait_states(
+      states, st, [&](auto& s) { return feature(*s.at("cam0"), "Gain") == 6.0; }, 10s));
   set("Gain", 100.0);  // clamped by the camera: the read-back says so
-  EXPECT_TRUE(wait_states(states, st, [&](auto& s) { return feature(*s.at("cam0"), "Gain") == 24.0; }, 10s));
+  EXPECT_TRUE(wait_states(
+      states, st, [&](auto& s) { return feature(*s.at("cam0"), "Gain") == 24.0; }, 10s));
   set("ExposureTime", 5000);
-  EXPECT_TRUE(wait_states(states, st, [&](auto& s) {
-    return feature(*s.at("cam0"), "ExposureTime") == 5000.0;
-  }, 10s));
+  EXPECT_TRUE(wait_states(
+      states, st, [&](auto& s) { return feature(*s.at("cam0"), "ExposureTime") == 5000.0; }, 10s));
   set("Bogus", 1);
-  EXPECT_TRUE(wait_states(states, st, [&](auto& s) {
-    return std::string(wire::str(s.at("cam0")->error)).find("'Bogus' is not allowed") != std::string::npos;
-  }, 10s));
+  EXPECT_TRUE(wait_states(
+      states, st,
+      [&](auto& s) {
+        return std::string(wire::str(s.at("cam0")->error)).find("'Bogus' is not allowed") !=
+               std::string::npos;
+      },
+      10s));
   set("Zoom", 2);  // allow-listed, but the simulated camera has no zoom
-  EXPECT_TRUE(wait_states(states, st, [&](auto& s) {
-    return std::string(wire::str(s.at("cam0")->error)).find("'Zoom' is not available") != std::string::npos;
-  }, 10s));
+  EXPECT_TRUE(wait_states(
+      states, st,
+      [&](auto& s) {
+        return std::string(wire::str(s.at("cam0")->error)).find("'Zoom' is not available") !=
+               std::string::npos;
+      },
+      10s));
 
   // Raw on request.
   set("ImageRaw", 1);
@@ -231,43 +246,91 @@ TEST_F(CaptureNodeTest, PublishesMasksImagesStateAndAppliesControl) {
   EXPECT_EQ(p.stop(), 0) << p.log();
 }
 
+// A GenICam camera through Aravis (its in-process fake camera, interface "Fake" only): the same
+// node publishes its masks and applies Gain with the device's read-back.
+TEST_F(CaptureNodeTest, AravisFakeCameraPublishesMasksAndAppliesGain) {
+  auto masks = reader<studio_AlphaMask>();
+  auto states = reader<studio_CameraState>();
+  auto control = writer<studio_CameraControl>();
+  auto& p =
+      spawn("capture", "capture/studio-capture",
+            {"--config", write_config("cap.yaml",
+                                      "state_period: 0.2\ncameras:\n  - id: gv0\n    source: "
+                                      "{type: aravis, device: Fake_1, interfaces: [Fake], "
+                                      "pixel_format: RGB8, width: 320, height: 240, fps: 25}\n")});
+  ASSERT_TRUE(p.wait_ready(30s)) << p.log();
+  int n = 0;
+  const auto deadline = std::chrono::steady_clock::now() + 15s;
+  while (n < 5 && std::chrono::steady_clock::now() < deadline) {
+    for (auto& m : masks.take())
+      if (m.meta.valid_data && wire::str(m.data->camera_id) == "gv0") {
+        EXPECT_EQ(m.data->width, 320u);
+        EXPECT_TRUE(decode_mask(wire::view(m.data->data)).has_value());
+        ++n;
+      }
+    std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_GE(n, 5);
+  std::map<std::string, wire::Owned<studio_CameraState>> st;
+  ASSERT_TRUE(wait_states(
+      states, st, [](auto& s) { return s.count("gv0") > 0; }, 10s));
+  ASSERT_FALSE(std::isnan(feature(*st["gv0"], "Gain")));
+  ASSERT_TRUE(control.wait_for_readers(1, 10s));
+  wire::Owned<studio_CameraControl> c;
+  wire::set(c->camera_id, "gv0");
+  wire::set(c->feature, "Gain");
+  c->value = 3.0;
+  ASSERT_TRUE(control.write(*c));
+  EXPECT_TRUE(wait_states(
+      states, st, [&](auto& s) { return std::abs(feature(*s.at("gv0"), "Gain") - 3.0) < 0.5; },
+      10s))
+      << feature(*st["gv0"], "Gain");
+  EXPECT_EQ(p.stop(), 0) << p.log();
+}
+
 TEST_F(CaptureNodeTest, SixProcessesStartAndStopAtTheSameFrame) {
   auto states = reader<studio_CameraState>();
   auto commands = writer<studio_CaptureCommand>();
   std::vector<testing::Process*> procs;
   for (int i = 0; i < 6; ++i) {
-    const std::string cfg =
-        write_config("cap" + std::to_string(i) + ".yaml",
-                     "instance: capture" + std::to_string(i) + "\n" +
-                         sim_config({i}, 176, 144, "image: {rate: 1}\n"));
-    procs.push_back(&spawn("capture" + std::to_string(i), "capture/studio-capture", {"--config", cfg}));
+    const std::string cfg = write_config("cap" + std::to_string(i) + ".yaml",
+                                         "instance: capture" + std::to_string(i) + "\n" +
+                                             sim_config({i}, 176, 144, "image: {rate: 1}\n"));
+    procs.push_back(
+        &spawn("capture" + std::to_string(i), "capture/studio-capture", {"--config", cfg}));
   }
   for (auto* p : procs) ASSERT_TRUE(p->wait_ready(40s)) << p->log();
   ASSERT_TRUE(commands.wait_for_readers(6, 20s));
 
   const uint64_t start = clock_.frame_at(realtime_ns()) + 40;  // 1.6 s ahead
-  const uint64_t stop = start + 50;                             // 2 s take
+  const uint64_t stop = start + 50;                            // 2 s take
   send_command(commands, "take1", true, start);
   std::map<std::string, wire::Owned<studio_CameraState>> st;
-  ASSERT_TRUE(wait_states(states, st, [](auto& s) {
-    if (s.size() < 6) return false;
-    for (auto& [id, v] : s)
-      if (wire::str(v->take) != "take1") return false;
-    return true;
-  }, 10s)) << "not every server acknowledged the take";
-  EXPECT_LT(clock_.frame_at(realtime_ns()), start) << "the start frame passed before all servers had it";
+  ASSERT_TRUE(wait_states(
+      states, st,
+      [](auto& s) {
+        if (s.size() < 6) return false;
+        for (auto& [id, v] : s)
+          if (wire::str(v->take) != "take1") return false;
+        return true;
+      },
+      10s))
+      << "not every server acknowledged the take";
+  EXPECT_LT(clock_.frame_at(realtime_ns()), start)
+      << "the start frame passed before all servers had it";
   send_command(commands, "take1", false, stop);
 
   // Wait until every take.yaml says complete.
   const auto deadline = std::chrono::steady_clock::now() + 30s;
   auto all_complete = [&] {
     for (int i = 0; i < 6; ++i)
-      if (slurp(dir_ / "takes/take1" / ("cam" + std::to_string(i)) / kTakeFile).find("status: complete") ==
-          std::string::npos)
+      if (slurp(dir_ / "takes/take1" / ("cam" + std::to_string(i)) / kTakeFile)
+              .find("status: complete") == std::string::npos)
         return false;
     return true;
   };
-  while (!all_complete() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(100ms);
+  while (!all_complete() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(100ms);
   ASSERT_TRUE(all_complete());
 
   for (int i = 0; i < 6; ++i) {
@@ -316,7 +379,8 @@ TEST_F(CaptureNodeTest, KillNineMidTakeKeepsEveryCompleteFrame) {
 
   // Damage the index the way a crash can (short), then let verify-take rebuild it.
   fs::resize_file(cam_dir / kIndexFile, 8 + 16 * 3);
-  auto& v = spawn("verify", "capture/studio-capture", {"verify-take", (dir_ / "takes/crash").string()});
+  auto& v =
+      spawn("verify", "capture/studio-capture", {"verify-take", (dir_ / "takes/crash").string()});
   ASSERT_EQ(v.wait_exit(30s), 0) << v.log();
   const std::string report = v.log();
 
@@ -331,7 +395,8 @@ TEST_F(CaptureNodeTest, KillNineMidTakeKeepsEveryCompleteFrame) {
   auto index = read_index(cam_dir.string());
   ASSERT_TRUE(index) << index.error().message;
   EXPECT_EQ(*index, scan->intact);  // rebuilt
-  EXPECT_NE(report.find("\"frames\": " + std::to_string(scan->intact.size())), std::string::npos) << report;
+  EXPECT_NE(report.find("\"frames\": " + std::to_string(scan->intact.size())), std::string::npos)
+      << report;
   EXPECT_NE(report.find("\"corrupt\": 0"), std::string::npos) << report;
   EXPECT_NE(report.find("\"status\": \"recording\""), std::string::npos) << report;
   std::printf("kill -9 after %zu frames; tail: %s\n", scan->intact.size(), scan->tail.c_str());
@@ -345,7 +410,8 @@ TEST_F(CaptureNodeTest, KillNineMidTakeKeepsEveryCompleteFrame) {
   auto& bad = spawn("verify2", "capture/studio-capture", {"verify-take", cam_dir.string()});
   EXPECT_EQ(bad.wait_exit(30s), 1) << bad.log();
   EXPECT_NE(bad.log().find("\"corrupt\": 1"), std::string::npos) << bad.log();
-  auto& none = spawn("verify3", "capture/studio-capture", {"verify-take", (dir_ / "nothing").string()});
+  auto& none =
+      spawn("verify3", "capture/studio-capture", {"verify-take", (dir_ / "nothing").string()});
   EXPECT_EQ(none.wait_exit(30s), 1);
   const std::string none_log = none.log();
   EXPECT_EQ(std::count(none_log.begin(), none_log.end(), '\n'), 1) << none_log;
@@ -360,8 +426,9 @@ TEST_F(CaptureNodeTest, DiskFullStopsTheTakeWithAnErrorState) {
   auto opts = testing::Process::Options{
       .name = "capture",
       .binary = "/usr/bin/prlimit",
-      .args = {"--fsize=" + std::to_string(cap), testing::built_binary("capture/studio-capture").string(),
-               "--config", write_config("cap.yaml", sim_config({0}, 176, 144))},
+      .args = {"--fsize=" + std::to_string(cap),
+               testing::built_binary("capture/studio-capture").string(), "--config",
+               write_config("cap.yaml", sim_config({0}, 176, 144))},
       .env = dds_.env(),
       .dir = dir_};
   auto started = testing::Process::start(opts);
@@ -373,9 +440,10 @@ TEST_F(CaptureNodeTest, DiskFullStopsTheTakeWithAnErrorState) {
   send_command(commands, "full", true, clock_.frame_at(realtime_ns()) + 10);
 
   std::map<std::string, wire::Owned<studio_CameraState>> st;
-  ASSERT_TRUE(wait_states(states, st, [](auto& s) {
-    return s.count("cam0") && s.at("cam0")->state == studio_CAMERA_ERROR;
-  }, 20s)) << p.log();
+  ASSERT_TRUE(wait_states(
+      states, st,
+      [](auto& s) { return s.count("cam0") && s.at("cam0")->state == studio_CAMERA_ERROR; }, 20s))
+      << p.log();
   const std::string error(wire::str(st["cam0"]->error));
   EXPECT_NE(error.find("File too large"), std::string::npos) << error;
   EXPECT_FALSE(st["cam0"]->recording);
@@ -422,13 +490,15 @@ TEST_F(CaptureNodeTest, SixCamerasWhileRecordingRate) {
   while (std::chrono::steady_clock::now() - t0 < 8s) {
     drain();
     for (auto& m : masks.take(256))
-      if (m.meta.valid_data && m.data->frame >= f0) frames[std::string(wire::str(m.data->camera_id))].insert(m.data->frame);
+      if (m.meta.valid_data && m.data->frame >= f0)
+        frames[std::string(wire::str(m.data->camera_id))].insert(m.data->frame);
     std::this_thread::sleep_for(5ms);
   }
   const uint64_t f1 = clock_.frame_at(realtime_ns());
   const double seconds = double(f1 - f0) * 0.04;
   std::map<std::string, wire::Owned<studio_CameraState>> st;
-  wait_states(states, st, [](auto& s) { return s.size() == 6; }, 5s);
+  wait_states(
+      states, st, [](auto& s) { return s.size() == 6; }, 5s);
   double load[3] = {0, 0, 0};
   getloadavg(load, 3);
   std::printf("6 cameras 704x576 recording, load %.1f: masks/s per camera:", load[0]);
@@ -437,7 +507,8 @@ TEST_F(CaptureNodeTest, SixCamerasWhileRecordingRate) {
     const std::string id = "cam" + std::to_string(i);
     const double rate = double(frames[id].size()) / seconds;
     min_rate = std::min(min_rate, rate);
-    std::printf(" %s %.1f (fps %.1f, drops %llu)", id.c_str(), rate, st.count(id) ? st[id]->fps : 0.0,
+    std::printf(" %s %.1f (fps %.1f, drops %llu)", id.c_str(), rate,
+                st.count(id) ? st[id]->fps : 0.0,
                 st.count(id) ? (unsigned long long)st[id]->drops : 0ull);
     EXPECT_GT(frames[id].size(), 0u) << id;
   }
@@ -446,8 +517,8 @@ TEST_F(CaptureNodeTest, SixCamerasWhileRecordingRate) {
   const auto deadline = std::chrono::steady_clock::now() + 30s;
   auto complete = [&] {
     for (int i = 0; i < 6; ++i)
-      if (slurp(dir_ / "takes/rate" / ("cam" + std::to_string(i)) / kTakeFile).find("status: complete") ==
-          std::string::npos)
+      if (slurp(dir_ / "takes/rate" / ("cam" + std::to_string(i)) / kTakeFile)
+              .find("status: complete") == std::string::npos)
         return false;
     return true;
   };

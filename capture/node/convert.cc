@@ -35,8 +35,12 @@ void from_core(const Camera& camera, uint64_t frame, int64_t capture_ns, bool tr
     }
   for (int i = 0; i < 3; ++i) out->t[i] = camera.cam_from_world.translation[i];
   const auto& d = camera.distortion;
-  out->rd3 = d.model == Distortion::Model::radial ? d.rd3 : d.model == Distortion::Model::opencv ? d.k1 : 0;
-  out->rd5 = d.model == Distortion::Model::radial ? d.rd5 : d.model == Distortion::Model::opencv ? d.k2 : 0;
+  out->rd3 = d.model == Distortion::Model::radial   ? d.rd3
+             : d.model == Distortion::Model::opencv ? d.k1
+                                                    : 0;
+  out->rd5 = d.model == Distortion::Model::radial   ? d.rd5
+             : d.model == Distortion::Model::opencv ? d.k2
+                                                    : 0;
   out->tracked = tracked;
 }
 
@@ -72,10 +76,18 @@ void from_core(const CameraStateCore& s, wire::Owned<studio_CameraState>& out) {
   out->recording = s.recording;
   wire::set(out->take, s.take.substr(0, sizeof out->take - 1));
   switch (s.state) {
-    case CameraStateCore::Run::kStopped: out->state = studio_CAMERA_STOPPED; break;
-    case CameraStateCore::Run::kStreaming: out->state = studio_CAMERA_STREAMING; break;
-    case CameraStateCore::Run::kRecording: out->state = studio_CAMERA_RECORDING; break;
-    case CameraStateCore::Run::kError: out->state = studio_CAMERA_ERROR; break;
+    case CameraStateCore::Run::kStopped:
+      out->state = studio_CAMERA_STOPPED;
+      break;
+    case CameraStateCore::Run::kStreaming:
+      out->state = studio_CAMERA_STREAMING;
+      break;
+    case CameraStateCore::Run::kRecording:
+      out->state = studio_CAMERA_RECORDING;
+      break;
+    case CameraStateCore::Run::kError:
+      out->state = studio_CAMERA_ERROR;
+      break;
   }
   wire::set(out->error, s.error.substr(0, sizeof out->error - 1));
 }

@@ -22,8 +22,8 @@ int main(int argc, char** argv) {
       "Capture server: per camera publishes alpha masks, images and state, applies camera "
       "control and records takes on command. Also: studio-capture verify-take DIR.";
   d.config_help = capture::node::kConfigHelp;
-  d.create = [](yaml::MapReader& config, runtime::NodeContext& ctx)
-      -> Expected<std::unique_ptr<runtime::Node>> {
+  d.create = [](yaml::MapReader& config,
+                runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto options = capture::node::read_capture_config(config);
     if (!options) return std::unexpected(options.error());
     return std::make_unique<capture::node::CaptureNode>(std::move(*options), ctx);

@@ -49,7 +49,8 @@ int verify_take_main(int argc, char** argv) {
         "usage: studio-capture verify-take DIR\n"
         "Checks every frame of a recorded take (header + CRC-32), rebuilds its index from\n"
         "frames.raw and prints a JSON report. DIR: takes/<take>/<camera> or takes/<take>.\n"
-        "Exit 0 when every complete frame is intact, 1 on corrupt frames or no take, 2 on usage.\n");
+        "Exit 0 when every complete frame is intact, 1 on corrupt frames or no take, 2 on "
+        "usage.\n");
     return 0;
   }
   if (argc != 3) {
@@ -90,7 +91,8 @@ int verify_take_main(int argc, char** argv) {
     json << (i ? ", " : "") << "{\"dir\": " << json_string(dir)
          << ", \"frames\": " << scan->intact.size() << ", \"corrupt\": " << scan->corrupt;
     if (scan->first_frame)
-      json << ", \"first_frame\": " << *scan->first_frame << ", \"last_frame\": " << *scan->last_frame;
+      json << ", \"first_frame\": " << *scan->first_frame
+           << ", \"last_frame\": " << *scan->last_frame;
     json << ", \"width\": " << scan->width << ", \"height\": " << scan->height
          << ", \"bytes\": " << scan->file_bytes << ", \"valid_bytes\": " << scan->valid_bytes
          << ", \"tail\": " << json_string(scan->tail) << ", \"index_rebuilt\": true"

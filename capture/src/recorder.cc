@@ -61,7 +61,10 @@ Expected<std::unique_ptr<Recorder>> Recorder::start(const RecorderOptions& optio
 }
 
 Recorder::Recorder(RecorderOptions options, TakeInfo info, int frames_fd, int index_fd)
-    : options_(std::move(options)), info_(std::move(info)), frames_fd_(frames_fd), index_fd_(index_fd) {}
+    : options_(std::move(options)),
+      info_(std::move(info)),
+      frames_fd_(frames_fd),
+      index_fd_(index_fd) {}
 
 Recorder::~Recorder() {
   stop();

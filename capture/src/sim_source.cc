@@ -68,7 +68,8 @@ void box_cols(Image<Rgb8>& img, int r, std::vector<uint16_t>& tmp) {
 
 Expected<void> SimSourceOptions::validate() const {
   if (camera.id.empty()) return fail("sim source: camera id is empty");
-  if (camera.width <= 0 || camera.height <= 0) return fail("sim source " + camera.id + ": bad size");
+  if (camera.width <= 0 || camera.height <= 0)
+    return fail("sim source " + camera.id + ": bad size");
   if (!clock.valid()) return fail("sim source " + camera.id + ": clock period must be > 0");
   if (!(gain_db >= 0 && gain_db <= kGainMax))
     return fail("sim source " + camera.id + ": Gain must be in 0..24 dB");
@@ -122,7 +123,8 @@ bool SimFrameSource::wait_until(int64_t due_ns, std::chrono::steady_clock::time_
     if (stopping_) return false;
     const int64_t now = realtime_ns();
     if (now >= due_ns) return true;
-    const auto until_due = std::chrono::steady_clock::now() + std::chrono::nanoseconds(due_ns - now);
+    const auto until_due =
+        std::chrono::steady_clock::now() + std::chrono::nanoseconds(due_ns - now);
     if (deadline <= until_due) {
       wake_.wait_until(lock, deadline, [&] { return stopping_; });
       return false;

@@ -94,8 +94,10 @@ Expected<void> write_atomic(const std::string& dir, const std::string& name,
 
 const char* pixel_format_name(PixelFormat format) {
   switch (format) {
-    case PixelFormat::kRgb8: return "rgb8";
-    case PixelFormat::kMono8: return "mono8";
+    case PixelFormat::kRgb8:
+      return "rgb8";
+    case PixelFormat::kMono8:
+      return "mono8";
   }
   return "unknown";
 }
@@ -139,7 +141,8 @@ Expected<FrameHeader> decode_frame_header(std::span<const uint8_t> b) {
     return fail("bad frame size " + std::to_string(h.width) + "x" + std::to_string(h.height));
   if (h.payload_size != uint64_t(h.width) * h.height * uint64_t(bytes_per_pixel(h.format)) ||
       h.payload_size > kMaxFramePayload)
-    return fail("payload size " + std::to_string(h.payload_size) + " does not match the frame size");
+    return fail("payload size " + std::to_string(h.payload_size) +
+                " does not match the frame size");
   if (get<uint32_t>(b.data() + 44) != 0) return fail("reserved header field is not zero");
   return h;
 }
@@ -230,7 +233,8 @@ Expected<std::vector<IndexEntry>> read_index(const std::string& dir) {
   if ((bytes.size() - 8) % 16 != 0) return fail(path + ": partial index entry at the end");
   std::vector<IndexEntry> entries((bytes.size() - 8) / 16);
   for (std::size_t i = 0; i < entries.size(); ++i)
-    entries[i] = {get<uint64_t>(bytes.data() + 8 + 16 * i), get<uint64_t>(bytes.data() + 16 + 16 * i)};
+    entries[i] = {get<uint64_t>(bytes.data() + 8 + 16 * i),
+                  get<uint64_t>(bytes.data() + 16 + 16 * i)};
   return entries;
 }
 

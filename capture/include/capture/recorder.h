@@ -37,8 +37,8 @@
 namespace studio::capture {
 
 struct RecorderOptions {
-  std::string dir;               // takes/<take>/<camera_id>; created with its parents; must not
-                                 // already hold a frames.raw (a take is never overwritten)
+  std::string dir;                // takes/<take>/<camera_id>; created with its parents; must not
+                                  // already hold a frames.raw (a take is never overwritten)
   std::size_t queue_frames = 50;  // 2 s at 25 fps; 1 .. 10000
   Expected<void> validate() const;
 };
@@ -48,10 +48,10 @@ enum class RecorderState { kRecording, kStopping, kFinished, kError };
 struct RecorderStats {
   uint64_t frames_written = 0;
   uint64_t bytes_written = 0;
-  uint64_t queue_drops = 0;     // frames refused because the queue was full
-  uint64_t other_drops = 0;     // reported by the caller (add_drops)
+  uint64_t queue_drops = 0;  // frames refused because the queue was full
+  uint64_t other_drops = 0;  // reported by the caller (add_drops)
   std::size_t max_queue_depth = 0;
-  double write_ms_total = 0;    // writer thread time in CRC + writev, for the headroom figure
+  double write_ms_total = 0;  // writer thread time in CRC + writev, for the headroom figure
 };
 
 class Recorder {

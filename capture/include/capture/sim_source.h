@@ -33,16 +33,16 @@
 namespace studio::capture {
 
 struct SimSourceOptions {
-  Camera camera;                 // id, size, intrinsics and pose of the simulated camera
-  sim::StudioOptions studio;     // the scene (actor motion, realism knobs); threads forced to 1
+  Camera camera;              // id, size, intrinsics and pose of the simulated camera
+  sim::StudioOptions studio;  // the scene (actor motion, realism knobs); threads forced to 1
   FrameClock clock;
   bool paced = true;
-  int buffer_frames = 4;         // 1 .. 64
+  int buffer_frames = 4;  // 1 .. 64
   double gain_db = 0;
   double exposure_us = 10000;
   double nominal_exposure_us = 10000;  // exposure at which the image has its natural brightness
   double focus = 0.5;
-  double in_focus = 0.5;               // the Focus value that gives a sharp image
+  double in_focus = 0.5;  // the Focus value that gives a sharp image
   int max_blur_px = 8;
   Expected<void> validate() const;
 };

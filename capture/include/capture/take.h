@@ -78,8 +78,8 @@ struct ScanReport {
   std::vector<IndexEntry> intact;  // intact frames in file order
   uint64_t corrupt = 0;            // complete frames whose CRC does not match (skipped)
   uint64_t file_bytes = 0;
-  uint64_t valid_bytes = 0;        // offset just past the last well-formed frame
-  std::string tail;                // why the scan stopped before file_bytes ("" = clean end)
+  uint64_t valid_bytes = 0;  // offset just past the last well-formed frame
+  std::string tail;          // why the scan stopped before file_bytes ("" = clean end)
   std::optional<uint64_t> first_frame, last_frame;
   uint32_t width = 0, height = 0;  // of the first intact frame
   PixelFormat format = PixelFormat::kRgb8;
@@ -106,15 +106,15 @@ struct TakeInfo {
   std::string camera_id;
   PixelFormat format = PixelFormat::kRgb8;
   uint32_t width = 0, height = 0;
-  int64_t period_ns = 0;          // studio frame period
-  uint64_t start_frame = 0;       // requested first frame
-  std::optional<uint64_t> stop_frame;  // requested end (exclusive), if known
+  int64_t period_ns = 0;                            // studio frame period
+  uint64_t start_frame = 0;                         // requested first frame
+  std::optional<uint64_t> stop_frame;               // requested end (exclusive), if known
   std::optional<uint64_t> first_frame, last_frame;  // recorded
-  uint64_t frames = 0;            // recorded frames
-  uint64_t drops = 0;             // frames not recorded (source drops + queue overflow)
+  uint64_t frames = 0;                              // recorded frames
+  uint64_t drops = 0;                // frames not recorded (source drops + queue overflow)
   std::string status = "recording";  // recording | complete | error
-  std::string error;              // when status == error
-  std::string calibration_yaml;   // mapping body lines, each indented by 2 spaces
+  std::string error;                 // when status == error
+  std::string calibration_yaml;      // mapping body lines, each indented by 2 spaces
 };
 
 std::string format_take_yaml(const TakeInfo& info);
