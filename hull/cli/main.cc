@@ -1,5 +1,5 @@
-// studio-hull: the visual hull service's command line (DESIGN §6). This build offers the offline
-// mode; the DDS node mode (--config) comes with the service runtime.
+// studio-hull: the visual hull service's command line (DESIGN §6): the DDS node (--config, see
+// node/hull_node.h) and the offline mode.
 //
 //   studio-hull offline --rig rig.yaml --masks DIR --box X0,Y0,Z0,X1,Y1,Z1 --grid N
 //                       [--axis x|y|z] [--frames A:B] --out FILE|DIR [--format ply|obj|glb]
@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "hull/mesh_io.h"
+#include "hull_node.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
 #include "yaml_io/rig_yaml.h"
@@ -30,7 +31,8 @@ using namespace studio::hull;
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: studio-hull offline --rig rig.yaml --masks DIR --box X0,Y0,Z0,X1,Y1,Z1 --grid N
+constexpr const char* kUsage = R"(usage: studio-hull --config hull.yaml      the real-time DDS service (keys below)
+       studio-hull offline --rig rig.yaml --masks DIR --box X0,Y0,Z0,X1,Y1,Z1 --grid N
                            [--axis x|y|z] [--frames A:B] --out FILE|DIR [--format ply|obj|glb]
                            [--outside keep|cut] [--threads N] [--timing]
 
@@ -308,8 +310,14 @@ int run_offline(int argc, char** argv) {
 int main(int argc, char** argv) {
   const std::string verb = argc > 1 ? argv[1] : "";
   if (verb == "-h" || verb == "--help" || verb == "help") {
-    std::cout << kUsage;
+    const auto service = hull_service_definition();
+    std::cout << kUsage << "\nService config (studio-hull --config FILE): " << service.summary << "\n"
+              << service.config_help
+              << "  plus the common service keys: instance, domain, dds_config, status_period, log\n";
     return 0;
+  }
+  if (verb == "--config" || verb.starts_with("--config=")) {
+    return studio::runtime::service_main(argc, argv, hull_service_definition());
   }
   if (verb == "offline") {
     for (int k = 2; k < argc; ++k) {

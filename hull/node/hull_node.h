@@ -1,0 +1,56 @@
+#pragma once
+// The hull service (issue 5 item 5): subscribes the masks of every camera of the rig on
+// studio/camera/mask, assembles one frame (waiting at most `deadline_ms` after its first mask;
+// late or missing cameras are counted and reported), cuts the line-segment visual hull, splits it
+// into actors (connected components) and publishes, per actor, studio/actor/segments and
+// studio/actor/mesh stamped with the frame and the masks' capture_ns. Cameras start from the rig
+// file and follow studio/camera/calibration (tracked cameras send one per frame).
+//
+// Config (the `hull:` section of the service config; see hull_service_definition()):
+//   rig: rig.yaml             cameras (required; relative to the config file)
+//   box: [x0,y0,z0,x1,y1,z1]  the reconstruction volume, studio frame, metres (required)
+//   grid: 128                 columns per side (8..2048)
+//   axis: y                   continuous axis of the segments (x|y|z)
+//   deadline_ms: 40           wait for a frame's missing masks at most this long
+//   min_cameras: 2            fewer masks than this at the deadline: the frame is dropped
+//   outside: keep             a column part outside an image is kept or cut (keep|cut)
+//   threads: 2                cut threads (columns are independent)
+//   mesh: true                publish studio/actor/mesh (segment marching cubes)
+//   min_actor_volume: 0.01    components smaller than this (m^3) are noise, not actors
+//   actor_prefix: actor       actor ids are <prefix>0, <prefix>1, ... largest first
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hull/segment_set.h"
+#include "hull/silhouette_cut.h"
+#include "runtime/service.h"
+
+namespace studio::hull {
+
+struct HullNodeOptions {
+  std::string rig;
+  std::vector<double> box;
+  int grid = 128;
+  Axis axis = Axis::y;
+  double deadline_ms = 40;
+  int min_cameras = 2;
+  Outside outside = Outside::keep;
+  int threads = 2;
+  bool mesh = true;
+  double min_actor_volume = 0.01;
+  std::string actor_prefix = "actor";
+
+  Expected<void> validate() const;
+  GridSpec grid_spec() const;
+};
+
+runtime::ServiceDefinition hull_service_definition();
+
+// Builds the node (rig already read) — exposed for tests that host nodes in-process.
+Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& options,
+                                                        std::vector<Camera> cameras,
+                                                        runtime::NodeContext& context);
+
+}  // namespace studio::hull
