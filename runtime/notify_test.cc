@@ -58,6 +58,15 @@ TEST(Notify, SendsToAbstractSocket) {
   EXPECT_EQ(manager.receive(), "STOPPING=1");
 }
 
+TEST(Notify, NeverBlocksWhenTheReceiverStopsReading) {
+  FakeManager manager(true);
+  // Nobody reads: the datagram queue fills (a few hundred entries at most) and notify() must
+  // report failure instead of blocking the service's main loop.
+  int failures = 0;
+  for (int i = 0; i < 5000 && failures == 0; ++i) failures += !notify("WATCHDOG=1");
+  EXPECT_GT(failures, 0);
+}
+
 TEST(Notify, WithoutSocketReturnsFalse) {
   ::unsetenv("NOTIFY_SOCKET");
   EXPECT_FALSE(notify("READY=1"));

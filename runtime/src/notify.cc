@@ -22,11 +22,12 @@ bool notify(std::string_view state) {
   if (addr.sun_path[0] == '@') addr.sun_path[0] = '\0';  // abstract namespace
   const socklen_t addr_len = socklen_t(offsetof(sockaddr_un, sun_path) + len);
 
-  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  // Non-blocking: a manager (or test harness) that stops reading must never stall the service.
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
   if (fd < 0) return false;
   ssize_t sent;
   do {
-    sent = ::sendto(fd, state.data(), state.size(), MSG_NOSIGNAL, reinterpret_cast<sockaddr*>(&addr), addr_len);
+    sent = ::sendto(fd, state.data(), state.size(), MSG_NOSIGNAL | MSG_DONTWAIT, reinterpret_cast<sockaddr*>(&addr), addr_len);
   } while (sent < 0 && errno == EINTR);
   ::close(fd);
   return sent == ssize_t(state.size());

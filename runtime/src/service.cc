@@ -135,7 +135,8 @@ int service_main(int argc, char** argv, const ServiceDefinition& definition) {
   using namespace std::chrono;
   const auto status_period = duration_cast<milliseconds>(duration<double>(common->status_period_s));
   auto period = status_period;
-  if (auto wd = watchdog_interval()) period = std::min(period, duration_cast<milliseconds>(*wd / 2));
+  const bool watchdog = watchdog_interval().has_value();
+  if (watchdog) period = std::min(period, duration_cast<milliseconds>(*watchdog_interval() / 2));
   auto next_status = steady_clock::now();
   int signo = 0;
   while (true) {
@@ -146,7 +147,7 @@ int service_main(int argc, char** argv, const ServiceDefinition& definition) {
         STUDIO_LOG(warn, kCategory) << "status: " << r.error().message;
       next_status = now + status_period;
     }
-    notify("WATCHDOG=1");
+    if (watchdog) notify("WATCHDOG=1");
     const auto wait = std::min(period, duration_cast<milliseconds>(next_status - steady_clock::now()));
     if (auto s = signals.wait(std::max(wait, milliseconds(1)))) {
       signo = *s;

@@ -11,8 +11,8 @@
 
 namespace studio::runtime {
 
-// Sends `state` to $NOTIFY_SOCKET. Returns false when the variable is unset or the send fails
-// (a service must keep running either way).
+// Sends `state` to $NOTIFY_SOCKET without blocking. Returns false when the variable is unset or
+// the send fails, e.g. because the receiver's queue is full (a service keeps running either way).
 bool notify(std::string_view state);
 
 // The watchdog interval requested by the service manager ($WATCHDOG_USEC, honouring
