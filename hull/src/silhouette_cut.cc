@@ -100,8 +100,8 @@ void emit(const std::vector<Range>& keep, std::vector<Interval>* out, std::size_
 
 // Calls f(a, b) for every maximal range of A \ B (A, B sorted disjoint half-open int ranges).
 template <class F>
-void difference(const std::vector<std::pair<int, int>>& A, const std::vector<std::pair<int, int>>& B,
-                F&& f) {
+void difference(const std::vector<std::pair<int, int>>& A,
+                const std::vector<std::pair<int, int>>& B, F&& f) {
   std::size_t j = 0;
   for (const auto& [a0, a1] : A) {
     int x = a0;
@@ -139,7 +139,8 @@ Eigen::Vector2d observed_to_ideal(const Camera& c, const Eigen::Vector2d& obs) {
 }  // namespace
 
 Expected<void> CutOptions::validate() const {
-  if (threads < 1 || threads > 64) return fail("threads: " + std::to_string(threads) + " (need 1..64)");
+  if (threads < 1 || threads > 64)
+    return fail("threads: " + std::to_string(threads) + " (need 1..64)");
   return {};
 }
 
@@ -219,7 +220,8 @@ void PreparedView::Impl::build_pencil(const Eigen::Vector4d& X) {
       }
     }
     const float edge = float(y - 0.5);
-    difference(cur, prev, [&](int a, int b) { std::fill(open.begin() + a, open.begin() + b, edge); });
+    difference(cur, prev,
+               [&](int a, int b) { std::fill(open.begin() + a, open.begin() + b, edge); });
     difference(prev, cur, [&](int a, int b) {
       for (int k = a; k < b; ++k) emitted.push_back({k, open[k], edge});
     });
@@ -354,8 +356,8 @@ Expected<PreparedView> PreparedView::create(const Camera& camera, const RunMask&
                                             const Eigen::AlignedBox3d* domain) {
   if (mask.width() != camera.width || mask.height() != camera.height) {
     return fail("camera " + camera.id + ": mask is " + std::to_string(mask.width()) + "x" +
-                std::to_string(mask.height()) + ", camera is " + std::to_string(camera.width) + "x" +
-                std::to_string(camera.height));
+                std::to_string(mask.height()) + ", camera is " + std::to_string(camera.width) +
+                "x" + std::to_string(camera.height));
   }
   if (camera.width <= 0 || camera.height <= 0) {
     return fail("camera " + camera.id + ": empty image size");
@@ -375,9 +377,8 @@ Expected<PreparedView> PreparedView::create(const Camera& camera, const RunMask&
     double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
     for (int k = 0; k <= 64; ++k) {
       const double fu = -0.5 + W * k / 64.0, fv = -0.5 + H * k / 64.0;
-      for (const Eigen::Vector2d& p :
-           {Eigen::Vector2d(fu, -0.5), Eigen::Vector2d(fu, H - 0.5), Eigen::Vector2d(-0.5, fv),
-            Eigen::Vector2d(W - 0.5, fv)}) {
+      for (const Eigen::Vector2d& p : {Eigen::Vector2d(fu, -0.5), Eigen::Vector2d(fu, H - 0.5),
+                                       Eigen::Vector2d(-0.5, fv), Eigen::Vector2d(W - 0.5, fv)}) {
         const Eigen::Vector2d q = observed_to_ideal(camera, p);
         u0 = std::min(u0, q.x()), u1 = std::max(u1, q.x());
         v0 = std::min(v0, q.y()), v1 = std::max(v1, q.y());
@@ -399,6 +400,29 @@ Expected<PreparedView> PreparedView::create(const Camera& camera, const RunMask&
     }
   }
   return view;
+}
+
+bool PreparedView::misses(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double lo,
+                          double hi) const {
+  const Impl& m = *impl_;
+  if (!m.pencil || !m.all_inside) return false;
+  // The same arithmetic as cut_line + cut_pencil up to the bin, so the answers agree exactly.
+  const double* P = m.P.data();
+  const Vec3 A(P[0] * o[0] + P[3] * o[1] + P[6] * o[2] + P[9],
+               P[1] * o[0] + P[4] * o[1] + P[7] * o[2] + P[10],
+               P[2] * o[0] + P[5] * o[1] + P[8] * o[2] + P[11]);
+  const Vec3 B(P[0] * d[0] + P[3] * d[1] + P[6] * d[2], P[1] * d[0] + P[4] * d[1] + P[7] * d[2],
+               P[2] * d[0] + P[5] * d[1] + P[8] * d[2]);
+  const double tm = 0.5 * (lo + hi);
+  const double x0 = A[0] + tm * B[0], x1 = A[1] + tm * B[1], x2 = A[2] + tm * B[2];
+  const Vec3& V = m.V;
+  const double e0 = V[0] * x2 - V[2] * x0, e1 = V[1] * x2 - V[2] * x1;
+  const double s = (x0 * e1 + e0 * (m.vref * x2 - x1)) / (x2 * e1);
+  // floor(x) in [0, nbins) <=> x in [0, nbins); truncation is floor for x >= 0.
+  const double x = (s - m.smin) * m.inv_ds;
+  if (!(x >= 0 && x < m.nbins)) return true;
+  const int k = int(x);
+  return m.bin_start[k] == m.bin_start[k + 1];
 }
 
 bool PreparedView::uses_pencil() const { return impl_->pencil; }
@@ -432,7 +456,8 @@ void PreparedView::cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
   for (const Interval& iv : in) {
     while (p < keep.size() && keep[p].hi <= iv.lo) ++p;
     for (std::size_t q = p; q < keep.size() && keep[q].lo < iv.hi; ++q) {
-      const double lo = std::max<double>(iv.lo, keep[q].lo), hi = std::min<double>(iv.hi, keep[q].hi);
+      const double lo = std::max<double>(iv.lo, keep[q].lo),
+                   hi = std::min<double>(iv.hi, keep[q].hi);
       if (lo < hi) result.push_back({lo, hi});
     }
   }
@@ -455,7 +480,8 @@ Expected<void> cut(SegmentSet& set, std::span<const View> views, const CutOption
   Vec3 d = Vec3::Zero();
   d[g.a()] = 1;
   const std::size_t columns = g.columns();
-  const int T = int(std::min<std::size_t>(std::size_t(options.threads), std::max<std::size_t>(columns / 256, 1)));
+  const int T = int(
+      std::min<std::size_t>(std::size_t(options.threads), std::max<std::size_t>(columns / 256, 1)));
   std::vector<std::vector<Interval>> chunk_iv(T);
   std::vector<std::vector<uint32_t>> chunk_count(T);
   const auto work = [&](int chunk) {
@@ -476,14 +502,21 @@ Expected<void> cut(SegmentSet& set, std::span<const View> views, const CutOption
         o[g.u()] = g.box_min[g.u()] + (i + 0.5) * du;
         o[g.v()] = g.box_min[g.v()] + (j + 0.5) * dv;
         o[g.a()] = 0;
-        a.assign(col.begin(), col.end());
+        // Most columns die at the first camera or two: test the pencil bin before cutting, and
+        // cut straight from the set's storage (no per-column copy).
+        std::span<const Interval> cur = col;
         for (const PreparedView& view : prepared) {
+          if (view.misses(o, d, cur.front().lo, cur.back().hi)) {
+            cur = {};
+            break;
+          }
           b.clear();
-          view.cut_line(o, d, a, &b, &scratch);
+          view.cut_line(o, d, cur, &b, &scratch);
           std::swap(a, b);
-          if (a.empty()) break;
+          cur = a;
+          if (cur.empty()) break;
         }
-        out.insert(out.end(), a.begin(), a.end());
+        out.insert(out.end(), cur.begin(), cur.end());
       }
       count[c - c0] = uint32_t(out.size() - before);
     }

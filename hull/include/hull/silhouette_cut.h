@@ -60,7 +60,8 @@ class PreparedView {
   // every interval that will be cut; if it projects entirely inside the image (in front of the
   // camera) the per-line in-image test is skipped.
   static Expected<PreparedView> create(const Camera& camera, const RunMask& mask,
-                                       const Eigen::Vector4d& pencil_point, const CutOptions& options,
+                                       const Eigen::Vector4d& pencil_point,
+                                       const CutOptions& options,
                                        const Eigen::AlignedBox3d* domain = nullptr);
   PreparedView(PreparedView&&) noexcept;
   PreparedView& operator=(PreparedView&&) noexcept;
@@ -72,6 +73,10 @@ class PreparedView {
   // disjoint) to *out. `scratch` is reused between calls (one per thread).
   void cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d, std::span<const Interval> in,
                 std::vector<Interval>* out, CutScratch* scratch) const;
+  // Cheap early out, exact with respect to cut_line: true when cutting intervals spanning
+  // [lo, hi] of the line would certainly leave nothing (pencil path, domain inside the image, and
+  // the line's pencil bin holds no silhouette). False means "cut to find out".
+  bool misses(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double lo, double hi) const;
 
  private:
   PreparedView();
