@@ -1,3 +1,4 @@
+#include "capture/pacing.h"
 #include "capture/file_source.h"
 
 #include <algorithm>
@@ -16,12 +17,6 @@ namespace studio::capture {
 namespace {
 
 namespace fs = std::filesystem;
-
-int64_t realtime_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 bool has_image_extension(const fs::path& path) {
   std::string ext = path.extension().string();
@@ -172,18 +167,7 @@ void FileSource::stop() {
 
 bool FileSource::wait_until(int64_t due_ns, std::chrono::steady_clock::time_point deadline) {
   std::unique_lock lock(mutex_);
-  for (;;) {
-    if (stopping_) return false;
-    const int64_t now = realtime_ns();
-    if (now >= due_ns) return true;
-    const auto until_due =
-        std::chrono::steady_clock::now() + std::chrono::nanoseconds(due_ns - now);
-    if (deadline <= until_due) {
-      wake_.wait_until(lock, deadline, [&] { return stopping_; });
-      return false;
-    }
-    wake_.wait_until(lock, until_due, [&] { return stopping_; });
-  }
+  return wait_until_realtime(lock, wake_, stopping_, due_ns, deadline);
 }
 
 Expected<std::optional<Frame>> FileSource::next(std::chrono::milliseconds timeout) {

@@ -1,3 +1,4 @@
+#include "capture/pacing.h"
 #include "capture/sim_source.h"
 
 #include <time.h>
@@ -7,12 +8,6 @@
 
 namespace studio::capture {
 namespace {
-
-int64_t realtime_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 constexpr double kGainMax = 24.0;
 constexpr double kExposureMin = 20.0;
@@ -119,18 +114,7 @@ void SimFrameSource::stop() {
 
 bool SimFrameSource::wait_until(int64_t due_ns, std::chrono::steady_clock::time_point deadline) {
   std::unique_lock lock(mutex_);
-  for (;;) {
-    if (stopping_) return false;
-    const int64_t now = realtime_ns();
-    if (now >= due_ns) return true;
-    const auto until_due =
-        std::chrono::steady_clock::now() + std::chrono::nanoseconds(due_ns - now);
-    if (deadline <= until_due) {
-      wake_.wait_until(lock, deadline, [&] { return stopping_; });
-      return false;
-    }
-    wake_.wait_until(lock, until_due, [&] { return stopping_; });
-  }
+  return wait_until_realtime(lock, wake_, stopping_, due_ns, deadline);
 }
 
 Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds timeout) {
