@@ -1,3 +1,4 @@
+#include "core/clock.h"
 #include "capture_node.h"
 
 #include <algorithm>
@@ -19,11 +20,6 @@ using Clock = std::chrono::steady_clock;
 constexpr const char* kLog = "capture";
 constexpr std::string_view kCameraFeatures[] = {"Gain", "ExposureTime", "Focus", "Zoom", "Iris"};
 
-int64_t realtime_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 bool valid_take_name(const std::string& s) {
   if (s.empty() || s == "." || s == ".." || s.size() > 63) return false;

@@ -1,3 +1,4 @@
+#include "core/clock.h"
 #include "capture/aravis_source.h"
 
 #include <arv.h>
@@ -18,11 +19,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 
-int64_t realtime_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 // Takes ownership of a GError: its message, and clears it.
 std::string take_error(GError*& error) {

@@ -1,3 +1,4 @@
+#include "core/clock.h"
 #include "capture/freed_listener.h"
 
 #include <arpa/inet.h>
@@ -18,11 +19,6 @@
 namespace studio::capture {
 namespace {
 
-int64_t realtime_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 std::string errno_text() { return std::strerror(errno); }
 

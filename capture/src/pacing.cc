@@ -2,10 +2,6 @@
 
 namespace studio::capture {
 
-int64_t realtime_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 bool wait_until_realtime(std::unique_lock<std::mutex>& lock, std::condition_variable& wake, const bool& stopping,
                          int64_t due_ns, std::chrono::steady_clock::time_point deadline) {

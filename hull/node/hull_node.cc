@@ -1,3 +1,4 @@
+#include "core/clock.h"
 #include "hull_node.h"
 
 #include <atomic>
@@ -21,10 +22,6 @@ namespace {
 constexpr const char* kLog = "hull";
 using SteadyClock = std::chrono::steady_clock;
 
-int64_t realtime_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 void mesh_to_wire(const Mesh& mesh, studio_ActorMesh& s) {
   std::vector<float> v, n;

@@ -1,3 +1,4 @@
+#include "core/clock.h"
 #include "tracker_node.h"
 
 #include <algorithm>
@@ -17,11 +18,6 @@ namespace {
 constexpr std::string_view kCategory = "tracker";
 using Clock = std::chrono::steady_clock;
 
-int64_t realtime_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 }  // namespace
 

@@ -7,10 +7,9 @@
 #include <cstdint>
 #include <mutex>
 
-namespace studio::capture {
+#include "core/clock.h"
 
-// CLOCK_REALTIME in nanoseconds (the clock of capture_ns, DESIGN §5).
-int64_t realtime_ns();
+namespace studio::capture {
 
 // Waits, holding `lock` on the mutex that guards `stopping`, until CLOCK_REALTIME reaches
 // `due_ns` (true), or `stopping` is set and `wake` notified, or the steady `deadline` passes
