@@ -19,9 +19,9 @@ struct Lattice {
 // Marching-squares pieces of a cell: T_k = (m_{k-1}, c_k, m_k) (bits 0-3), D_k = (o, m_{k-1},
 // m_k) (bits 4-7), both counter-clockwise. Corners c0..c3 = (i,j), (i+1,j), (i+1,j+1), (i,j+1);
 // m_k is the midpoint of c_k c_{k+1}; o the centre.
-uint8_t pieces(unsigned config) {
+constexpr uint8_t pieces(unsigned config) {
   uint8_t p = uint8_t(config & 15u);
-  const int n = __builtin_popcount(config);
+  const int n = int(((config >> 0) & 1) + ((config >> 1) & 1) + ((config >> 2) & 1) + ((config >> 3) & 1));
   if (n >= 3) {
     p |= 0xF0;
   } else if (n == 2) {
@@ -32,6 +32,30 @@ uint8_t pieces(unsigned config) {
   }
   return p;
 }
+
+// Internal piece edges q = 0..3: T_q | D_q; q = 4..7: D_{q-4} | D_{q-3}. +1 when the first piece
+// is inside and the second not, -1 for the reverse, 0 when the edge is no contour edge.
+constexpr int contour(uint8_t p, int q) {
+  const bool x = (p >> q) & 1;
+  const bool y = q < 4 ? (p >> (4 + q)) & 1 : (p >> (4 + ((q - 3) & 3))) & 1;
+  return x == y ? 0 : (x ? 1 : -1);
+}
+
+// Per corner configuration: its pieces and contour directions (tables instead of bit fiddling
+// at every event).
+struct Tables {
+  uint8_t pieces[16];
+  int8_t dir[16][8];
+};
+constexpr Tables make_tables() {
+  Tables t{};
+  for (unsigned c = 0; c < 16; ++c) {
+    t.pieces[c] = pieces(c);
+    for (int q = 0; q < 8; ++q) t.dir[c][q] = int8_t(contour(t.pieces[c], q));
+  }
+  return t;
+}
+constexpr Tables kTables = make_tables();
 
 }  // namespace
 
@@ -46,18 +70,20 @@ double Mesh::volume() const {
 }
 
 void compute_normals(Mesh& mesh) {
-  // Area-weighted vertex normals.
-  std::vector<Eigen::Vector3d> acc(mesh.vertices.size(), Eigen::Vector3d::Zero());
+  // Area-weighted vertex normals (float: the cells are centimetres, the sums stay well scaled).
+  std::vector<Eigen::Vector3f>& acc = mesh.normals;
+  acc.assign(mesh.vertices.size(), Eigen::Vector3f::Zero());
+  const Eigen::Vector3f* v = mesh.vertices.data();
   for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>();
-    const Eigen::Vector3d n = (mesh.vertices[t[1]].cast<double>() - a)
-                                  .cross(mesh.vertices[t[2]].cast<double>() - a);
-    for (uint32_t k : t) acc[k] += n;
+    const Eigen::Vector3f a = v[t[0]];
+    const Eigen::Vector3f n = (v[t[1]] - a).cross(v[t[2]] - a);
+    acc[t[0]] += n;
+    acc[t[1]] += n;
+    acc[t[2]] += n;
   }
-  mesh.normals.resize(acc.size());
-  for (std::size_t k = 0; k < acc.size(); ++k) {
-    const double n = acc[k].norm();
-    mesh.normals[k] = n > 0 ? Eigen::Vector3f((acc[k] / n).cast<float>()) : Eigen::Vector3f::Zero();
+  for (Eigen::Vector3f& n : acc) {
+    const float len = n.norm();
+    n = len > 0 ? Eigen::Vector3f(n / len) : Eigen::Vector3f::Zero();
   }
 }
 
@@ -83,10 +109,16 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
     for (int di : {-1, 1})
       for (int dj : {-1, 1}) f(L.line(x + di, y + dj));  // cell centres
   };
+  // Occupancy of the columns with the empty ring, (i + 1) + (j + 1) * (nu + 2): empty cells are
+  // skipped with four byte loads.
+  const std::size_t ow = std::size_t(nu) + 2;
+  std::vector<uint8_t> occupied(ow * (std::size_t(nv) + 2), 0);
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
       const uint32_t n = uint32_t(2 * set.column(i, j).size());
-      if (n) for_lines_of_column(i, j, [&](std::size_t l) { offset[l + 1] += n; });
+      if (!n) continue;
+      occupied[std::size_t(i + 1) + std::size_t(j + 1) * ow] = 1;
+      for_lines_of_column(i, j, [&](std::size_t l) { offset[l + 1] += n; });
     }
   for (std::size_t l = 0; l < lines; ++l) offset[l + 1] += offset[l];
   std::vector<float> heights(offset.back());
@@ -107,19 +139,30 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
     float* b = heights.data() + offset[l];
     float* e = heights.data() + offset[l + 1];
     if (b == e) continue;
-    std::sort(b, e);
+    if (e - b <= 24) {  // a handful of end points: insertion sort
+      for (float* p = b + 1; p < e; ++p) {
+        const float x = *p;
+        float* q = p;
+        for (; q > b && q[-1] > x; --q) *q = q[-1];
+        *q = x;
+      }
+    } else {
+      std::sort(b, e);
+    }
     count[l] = uint32_t(std::unique(b, e) - b);
   }
   std::vector<int32_t> vertex_of(heights.size(), -1);
 
   Mesh mesh;
+  mesh.vertices.reserve(heights.size() / 2);
+  mesh.triangles.reserve(heights.size() + heights.size() / 2);
   const double du = g.du(), dv = g.dv();
   const int ua = g.u(), va = g.v(), aa = g.a();
-  const auto vertex = [&](std::size_t l, float t) -> uint32_t {
-    const float* b = heights.data() + offset[l];
-    const std::size_t slot = offset[l] + std::size_t(std::lower_bound(b, b + count[l], t) - b);
+  // The vertex at heights[slot] of line l (created on first use).
+  const auto vertex_at = [&](std::size_t l, std::size_t slot) -> uint32_t {
     int32_t& id = vertex_of[slot];
     if (id < 0) {
+      const float t = heights[slot];
       id = int32_t(mesh.vertices.size());
       const int x2 = int(l % std::size_t(L.X)), y2 = int(l / std::size_t(L.X));
       Eigen::Vector3d p;
@@ -130,6 +173,17 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
     }
     return uint32_t(id);
   };
+  const auto vertex = [&](std::size_t l, float t) -> uint32_t {
+    const float* b = heights.data() + offset[l];
+    const uint32_t n = count[l];
+    uint32_t k = 0;
+    if (n <= 16) {
+      while (k < n && b[k] < t) ++k;
+    } else {
+      k = uint32_t(std::lower_bound(b, b + n, t) - b);
+    }
+    return vertex_at(l, offset[l] + k);
+  };
 
   // Per cell: lattice lines of corners, mid-edges and centre (doubled offsets from c0).
   static constexpr int kCorner[4][2] = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
@@ -137,7 +191,10 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
   std::vector<float> events;
   std::vector<uint32_t> side_a, side_b;
   for (int cj = -1; cj < nv; ++cj) {
+    const uint8_t* occ0 = occupied.data() + std::size_t(cj + 1) * ow;
+    const uint8_t* occ1 = occ0 + ow;
     for (int ci = -1; ci < nu; ++ci) {
+      if (!(occ0[ci + 1] | occ0[ci + 2] | occ1[ci + 1] | occ1[ci + 2])) continue;
       const std::span<const Interval> cols[4] = {column(ci, cj), column(ci + 1, cj),
                                                  column(ci + 1, cj + 1), column(ci, cj + 1)};
       if (cols[0].empty() && cols[1].empty() && cols[2].empty() && cols[3].empty()) continue;
@@ -167,11 +224,6 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
         }
         if (dir > 0) *a = p0, *b = p1; else *a = p1, *b = p0;
       };
-      const auto contour = [](uint8_t p, int q) -> int {
-        const bool x = q < 4 ? (p >> q) & 1 : (p >> q) & 1;
-        const bool y = q < 4 ? (p >> (4 + q)) & 1 : (p >> (4 + ((q - 3) & 3))) & 1;
-        return x == y ? 0 : (x ? 1 : -1);
-      };
       const auto emit_wall = [&](int q, int dir, float t0, float t1) {
         std::size_t a, b;
         edge_lines(q, dir, &a, &b);
@@ -180,7 +232,7 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
           const float* h = heights.data() + offset[l];
           const float* lo = std::lower_bound(h, h + count[l], t0);
           const float* hi = std::upper_bound(h, h + count[l], t1);
-          for (const float* p = lo; p < hi; ++p) out.push_back(vertex(l, *p));
+          for (const float* p = lo; p < hi; ++p) out.push_back(vertex_at(l, std::size_t(p - heights.data())));
         };
         collect(a, side_a);
         collect(b, side_b);
@@ -238,13 +290,15 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
             next ^= 1u << k;
           }
         }
-        const uint8_t before = pieces(config), after = pieces(next);
-        const uint8_t change = before ^ after;
-        for (int p = 0; p < 8; ++p) {
-          if ((change >> p) & 1) emit_piece(p, e, (before >> p) & 1);
+        const uint8_t before = kTables.pieces[config], after = kTables.pieces[next];
+        for (unsigned change = before ^ after; change != 0; change &= change - 1) {
+          const int p = __builtin_ctz(change);
+          emit_piece(p, e, (before >> p) & 1);
         }
+        const int8_t* dir0 = kTables.dir[config];
+        const int8_t* dir1 = kTables.dir[next];
         for (int q = 0; q < 8; ++q) {
-          const int d0 = contour(before, q), d1 = contour(after, q);
+          const int d0 = dir0[q], d1 = dir1[q];
           if (d0 == d1) continue;
           if (d0 != 0) emit_wall(q, d0, wall_start[q], e);
           if (d1 != 0) wall_start[q] = e;

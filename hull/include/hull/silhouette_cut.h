@@ -80,6 +80,7 @@ class PreparedView {
 
  private:
   PreparedView();
+  friend struct GridCutAccess;  // the grid fast path of cut() reads the pencil bins
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
