@@ -1,11 +1,24 @@
 // Accuracy of the keyer on the simulated studio (capture/sim): 6 cameras at 704x576, every
 // realism knob on (sensor noise, cloth fall-off and seams, blue spill, the cameras' blue ring
-// light on the actor, soft floor shadows, anti-aliased edges, motion blur, a projected picture on
-// the back wall), scored against the exact true masks.
+// light on the actor, soft floor shadows, a projected picture on the back wall, and either motion
+// blur or anti-aliased edges: the simulator renders one or the other), scored against the exact
+// true masks (pixel CENTRE hit by the actor at the frame's instant).
+//
+// What bounds the score. The simulator mixes each edge pixel from 4 sub-samples: 4 instants of
+// the shutter (motion blur) or a 2x2 grid at +-0.25 px (anti-aliasing). A pixel with 2 of 4
+// sub-samples on the actor is then ambiguous: its centre (or centre instant) lies between the
+// samples, on either side. Even the exact sub-sample coverage, cut per pixel, does not beat
+// IoU ~0.986 against the centre truth (KeyerSim.NearThePerPixelInformationLimit computes it from
+// finer renders); the keyer's per-pixel cut is checked to be within 0.002 of that limit. Getting
+// past it needs sub-pixel reasoning across neighbours (a symmetric 3x3 filter of the EXACT
+// coverage reaches 0.991) and an alpha that matches coverage, which blue spill (a mix of the
+// backing into the actor's grazing edge, indistinguishable per pixel from partial coverage) and
+// non-grey clothes prevent; see BENCHMARKS.md ("Keyer and mask codec") for the measurements.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 #include "capture/sim/cameras.h"
 #include "capture/sim/studio.h"
@@ -16,11 +29,15 @@
 namespace studio::keyer {
 namespace {
 
-sim::StudioOptions all_knobs_on() {
+sim::StudioOptions all_knobs_on(bool motion_blur) {
   sim::StudioOptions o;
-  o.motion_blur = true;
+  o.motion_blur = motion_blur;  // the simulator anti-aliases edges when blur is off
   o.projected_image = true;
   return o;
+}
+
+bool empty(const Mask& m) {
+  return std::all_of(m.pixels().begin(), m.pixels().end(), [](uint8_t p) { return p == 0; });
 }
 
 // Truth pixels whose 5x5 neighbourhood is entirely actor (away from the silhouette edge).
@@ -33,110 +50,215 @@ bool deep_inside(const Mask& m, int x, int y) {
   return true;
 }
 
+// The frames every test here scores: 8 poses (frames 0, 25, ..., 175) x 6 cameras, skipping
+// cameras that do not see the actor.
+constexpr int64_t kFrameStep = 25, kFrameEnd = 200;
+
+struct Score {
+  int masks = 0;
+  double iou_sum = 0, boundary_sum = 0, bytes_sum = 0, worst_iou = 1;
+  long false_pos = 0, false_neg = 0;
+  long dark_pixels = 0, dark_lost = 0, interior_lost = 0;
+  double mean_iou() const { return iou_sum / masks; }
+  double mean_boundary() const { return boundary_sum / masks; }
+};
+
+Score score_keyer(bool motion_blur) {
+  Score s;
+  auto studio = sim::SimulatedStudio::create(sim::ring_cameras(), all_knobs_on(motion_blur));
+  EXPECT_TRUE(studio) << studio.error().message;
+  auto keyer = Keyer::create({});
+  EXPECT_TRUE(keyer);
+  if (!studio || !keyer) return s;
+  std::vector<Image<Rgb8>> images;
+  std::vector<Mask> truths;
+  RunMask mask;
+  for (int64_t frame = 0; frame < kFrameEnd; frame += kFrameStep) {
+    studio->render_all(frame, &images, &truths);
+    for (int c = 0; c < studio->camera_count(); ++c) {
+      if (empty(truths[c])) continue;  // actor out of view
+      EXPECT_TRUE(keyer->key(images[c].view(), mask));
+      const Mask got = mask.to_mask();
+      const double i = testing::iou(got, truths[c]);
+      s.iou_sum += i;
+      s.worst_iou = std::min(s.worst_iou, i);
+      s.boundary_sum += testing::boundary_error(got, truths[c]);
+      s.bytes_sum += double(encode_mask(mask).size());
+      ++s.masks;
+      for (int y = 0; y < got.height(); ++y)
+        for (int x = 0; x < got.width(); ++x) {
+          const bool g = got(x, y) != 0, t = truths[c](x, y) != 0;
+          s.false_pos += g && !t;
+          s.false_neg += t && !g;
+          // No false holes inside the actor, in particular where the clothes are dark.
+          if (!deep_inside(truths[c], x, y)) continue;
+          const Rgb8 p = images[c](x, y);
+          const bool dark = std::max({p.r, p.g, p.b}) < 60;
+          s.dark_pixels += dark;
+          if (!g) {
+            ++s.interior_lost;
+            s.dark_lost += dark;
+          }
+        }
+    }
+  }
+  std::printf("sim keyer (%s): %d masks, mean IoU %.4f (worst %.4f), mean boundary error %.3f px, "
+              "false pos %ld / neg %ld px, mean encoded mask %.0f bytes; interior pixels lost %ld "
+              "(dark: %ld of %ld)\n",
+              motion_blur ? "motion blur" : "anti-aliased", s.masks, s.mean_iou(), s.worst_iou,
+              s.mean_boundary(), s.false_pos, s.false_neg, s.bytes_sum / s.masks, s.interior_lost,
+              s.dark_lost, s.dark_pixels);
+  return s;
+}
+
+void expect_accurate(const Score& s, double min_mean_iou) {
+  ASSERT_GT(s.masks, 40);
+  EXPECT_GE(s.mean_iou(), min_mean_iou);
+  EXPECT_GE(s.worst_iou, 0.96);
+  EXPECT_LE(s.mean_boundary(), 1.0);  // the issue's bound; measured ~0.25 px
+  EXPECT_EQ(s.dark_lost, 0);          // no false holes where the clothes are dark
+  EXPECT_LE(s.interior_lost, 10);
+  EXPECT_LE(s.bytes_sum / s.masks, 1500);
+}
+
+// The issue's scene: every knob on, motion blur included. Measured: mean IoU 0.9847.
 TEST(KeyerSim, AccurateOnSimulatedStudioWithAllRealismKnobs) {
-  auto studio = sim::SimulatedStudio::create(sim::ring_cameras(), all_knobs_on());
-  ASSERT_TRUE(studio) << studio.error().message;
+  expect_accurate(score_keyer(true), 0.984);
+}
+
+// The same poses rendered with anti-aliased (2x2 supersampled) edges instead of motion blur.
+// Measured: mean IoU 0.9829.
+TEST(KeyerSim, AccurateWithAntiAliasedEdges) { expect_accurate(score_keyer(false), 0.982); }
+
+// The best any per-pixel binary cut can do on these frames: the true masks of the simulator's
+// own sub-samples (rendered exactly: the shutter instants at 16x the frame rate, the 2x2 grid as
+// a 2x camera whose pixel centres are the sub-sample positions), counted per pixel and cut at
+// 2 of 4. The keyer must come within 0.002 of it. Also prints what a symmetric 3x3 filter of the
+// exact counts would reach (sub-pixel localisation; not achievable without exact coverage).
+struct Limit {
+  double per_pixel = 0, filtered = 0;
+};
+
+Limit coverage_limit(bool motion_blur) {
+  const std::vector<Camera> cams = sim::ring_cameras();
+  auto opts = all_knobs_on(motion_blur);
+  auto studio = sim::SimulatedStudio::create(cams, opts);
+  std::vector<Camera> fine_cams = cams;
+  auto fine_opts = opts;
+  const int64_t fps_factor = 16;  // shutter 0.5 of 1/25 s, 4 samples: offsets +-1, +-3 at 400 fps
+  if (motion_blur) {
+    EXPECT_EQ(opts.blur_samples, 4);
+    EXPECT_DOUBLE_EQ(opts.shutter, 0.5);
+    fine_opts.fps = opts.fps * double(fps_factor);
+    fine_opts.motion_blur = false;
+  } else {
+    for (Camera& c : fine_cams) {  // pixel U of the 2x camera = sub-sample U/2 - 0.25
+      c.width *= 2;
+      c.height *= 2;
+      c.intrinsics.fx *= 2;
+      c.intrinsics.fy *= 2;
+      c.intrinsics.cx = 2 * c.intrinsics.cx + 0.5;
+      c.intrinsics.cy = 2 * c.intrinsics.cy + 0.5;
+    }
+  }
+  auto fine = sim::SimulatedStudio::create(fine_cams, fine_opts);
+  EXPECT_TRUE(studio && fine);
+  Limit limit;
+  if (!studio || !fine) return limit;
+  std::vector<Mask> truths, sub[4];
+  int n = 0;
+  for (int64_t frame = 0; frame < kFrameEnd; frame += kFrameStep) {
+    studio->render_all(frame, nullptr, &truths);
+    if (motion_blur) {
+      const int64_t offsets[4] = {-3, -1, 1, 3};
+      for (int k = 0; k < 4; ++k) fine->render_all(fps_factor * frame + offsets[k], nullptr, &sub[k]);
+    } else {
+      fine->render_all(frame, nullptr, &sub[0]);
+    }
+    for (int c = 0; c < studio->camera_count(); ++c) {
+      const Mask& truth = truths[c];
+      if (empty(truth)) continue;
+      const int w = truth.width(), h = truth.height();
+      Image<int> count(w, h, 0);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          int k = 0;
+          if (motion_blur) {
+            for (const auto& s : sub) k += s[c](x, y) != 0;
+          } else {
+            const Mask& f = sub[0][c];
+            k = (f(2 * x, 2 * y) != 0) + (f(2 * x + 1, 2 * y) != 0) + (f(2 * x, 2 * y + 1) != 0) +
+                (f(2 * x + 1, 2 * y + 1) != 0);
+          }
+          count(x, y) = k;
+        }
+      Mask cut(w, h, 0), filtered(w, h, 0);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          cut(x, y) = count(x, y) >= 2 ? 255 : 0;
+          if (x == 0 || y == 0 || x + 1 == w || y + 1 == h) continue;
+          int sum = 0;
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) sum += count(x + dx, y + dy);
+          filtered(x, y) = sum > 18 || (sum == 18 && count(x, y) >= 2) ? 255 : 0;
+        }
+      limit.per_pixel += testing::iou(cut, truth);
+      limit.filtered += testing::iou(filtered, truth);
+      ++n;
+    }
+  }
+  limit.per_pixel /= n;
+  limit.filtered /= n;
+  std::printf("coverage limit (%s): per-pixel cut at 2/4 IoU %.4f, 3x3-filtered exact coverage "
+              "%.4f (%d masks)\n",
+              motion_blur ? "motion blur" : "anti-aliased", limit.per_pixel, limit.filtered, n);
+  return limit;
+}
+
+TEST(KeyerSim, NearThePerPixelInformationLimit) {
+  for (bool blur : {true, false}) {
+    const Limit limit = coverage_limit(blur);
+    const Score s = score_keyer(blur);
+    ASSERT_GT(s.masks, 40);
+    EXPECT_GE(s.mean_iou(), limit.per_pixel - 0.002) << (blur ? "motion blur" : "anti-aliased");
+    EXPECT_LT(limit.per_pixel, 0.99);  // why the issue's 0.99 is out of reach for a per-pixel cut
+  }
+}
+
+// Analysis aid (not run by default): per mask, false positives / negatives near the true
+// outline (within 2 px) and away from it, for the default keyer.
+TEST(KeyerSim, DISABLED_ErrorsPerCamera) {
+  const bool blur = std::getenv("NOBLUR") == nullptr;
+  auto studio = sim::SimulatedStudio::create(sim::ring_cameras(), all_knobs_on(blur));
+  ASSERT_TRUE(studio);
   auto keyer = Keyer::create({});
   ASSERT_TRUE(keyer);
   std::vector<Image<Rgb8>> images;
   std::vector<Mask> truths;
   RunMask mask;
-  double iou_sum = 0, boundary_sum = 0, bytes_sum = 0, worst_iou = 1;
-  long dark_pixels = 0, dark_lost = 0, interior_lost = 0;
-  int n = 0;
-  for (int64_t frame = 0; frame < 200; frame += 25) {
+  for (int64_t frame = 0; frame < kFrameEnd; frame += kFrameStep) {
     studio->render_all(frame, &images, &truths);
     for (int c = 0; c < studio->camera_count(); ++c) {
-      if (std::all_of(truths[c].pixels().begin(), truths[c].pixels().end(), [](uint8_t p) { return p == 0; }))
-        continue;  // actor out of view
+      const Mask& truth = truths[c];
+      if (empty(truth)) continue;
       ASSERT_TRUE(keyer->key(images[c].view(), mask));
       const Mask got = mask.to_mask();
-      const double i = testing::iou(got, truths[c]);
-      iou_sum += i;
-      worst_iou = std::min(worst_iou, i);
-      boundary_sum += testing::boundary_error(got, truths[c]);
-      bytes_sum += double(encode_mask(mask).size());
-      ++n;
-      // No false holes inside the actor, in particular where the clothes are dark.
+      long fp_near = 0, fp_far = 0, fn_near = 0, fn_far = 0, area = 0;
       for (int y = 0; y < got.height(); ++y)
         for (int x = 0; x < got.width(); ++x) {
-          if (!deep_inside(truths[c], x, y)) continue;
-          const Rgb8 p = images[c](x, y);
-          const bool dark = std::max({p.r, p.g, p.b}) < 60;
-          dark_pixels += dark;
-          if (!got(x, y)) {
-            ++interior_lost;
-            dark_lost += dark;
-          }
+          area += truth(x, y) != 0;
+          if (bool(got(x, y)) == bool(truth(x, y))) continue;
+          bool near = false;
+          for (int dy = -2; dy <= 2 && !near; ++dy)
+            for (int dx = -2; dx <= 2 && !near; ++dx) {
+              const int u = x + dx, v = y + dy;
+              near = u >= 0 && v >= 0 && u < got.width() && v < got.height() &&
+                     bool(truth(u, v)) != bool(truth(x, y));
+            }
+          if (got(x, y)) (near ? fp_near : fp_far)++; else (near ? fn_near : fn_far)++;
         }
-    }
-  }
-  ASSERT_GT(n, 20);
-  std::printf("sim keyer: %d masks, mean IoU %.4f (worst %.4f), mean boundary error %.3f px, "
-              "mean encoded mask %.0f bytes; interior pixels lost %ld (dark: %ld of %ld)\n",
-              n, iou_sum / n, worst_iou, boundary_sum / n, bytes_sum / n, interior_lost, dark_lost,
-              dark_pixels);
-  // The issue asks for mean IoU >= 0.99; measured 0.985 (the errors sit within 2 px of the true
-  // edge: spill and anti-aliasing on small silhouettes). This bound guards what is reached.
-  EXPECT_GE(iou_sum / n, 0.98);
-  EXPECT_LE(boundary_sum / n, 1.0);
-  EXPECT_EQ(dark_lost, 0);
-  EXPECT_LE(interior_lost, 10);
-  EXPECT_LE(bytes_sum / n, 1500);
-}
-
-}  // namespace
-}  // namespace studio::keyer
-
-namespace studio::keyer {
-namespace {
-
-// Tuning aid (not run by default): sweep the clips over the simulated frames and print where
-// the errors are: near the true boundary (<= 2 px) or away from it (shadows, holes).
-TEST(KeyerSim, DISABLED_SweepClips) {
-  for (bool blur : {true, false}) {
-  auto so = all_knobs_on();
-  so.motion_blur = blur;
-  auto studio = sim::SimulatedStudio::create(sim::ring_cameras(), so);
-  ASSERT_TRUE(studio);
-  std::vector<Image<Rgb8>> images;
-  std::vector<Mask> truths;
-  std::vector<std::pair<Image<Rgb8>, Mask>> data;
-  for (int64_t frame = 0; frame < 200; frame += 25) {
-    studio->render_all(frame, &images, &truths);
-    for (int c = 0; c < studio->camera_count(); ++c) data.push_back({images[c], truths[c]});
-  }
-  std::printf("motion blur %s\n", blur ? "on" : "off");
-  for (float black : {10.f, 20.f})
-    for (float white : {60.f, 100.f, 120.f}) {
-      KeyerOptions o;
-      o.clip_black = black;
-      o.clip_white = white;
-      auto keyer = Keyer::create(o);
-      RunMask mask;
-      double iou = 0, be = 0;
-      long fp_near = 0, fp_far = 0, fn_near = 0, fn_far = 0;
-      for (auto& [im, truth] : data) {
-        ASSERT_TRUE(keyer->key(im.view(), mask));
-        const Mask got = mask.to_mask();
-        iou += testing::iou(got, truth);
-        be += testing::boundary_error(got, truth);
-        for (int y = 0; y < got.height(); ++y)
-          for (int x = 0; x < got.width(); ++x) {
-            if (bool(got(x, y)) == bool(truth(x, y))) continue;
-            bool near = false;
-            for (int dy = -2; dy <= 2 && !near; ++dy)
-              for (int dx = -2; dx <= 2 && !near; ++dx) {
-                const int u = x + dx, v = y + dy;
-                if (u >= 0 && v >= 0 && u < got.width() && v < got.height() &&
-                    bool(truth(u, v)) != bool(truth(x, y)))
-                  near = true;
-              }
-            if (got(x, y)) (near ? fp_near : fp_far)++; else (near ? fn_near : fn_far)++;
-          }
-      }
-      std::printf("black %3.0f white %3.0f: IoU %.4f boundary %.3f  FP near %ld far %ld  FN near %ld far %ld\n",
-                  black, white, iou / data.size(), be / data.size(), fp_near, fp_far, fn_near, fn_far);
+      std::printf("frame %3d cam%d area %6ld IoU %.4f  FP near %4ld far %3ld  FN near %4ld far %3ld\n",
+                  int(frame), c, area, testing::iou(got, truth), fp_near, fp_far, fn_near, fn_far);
     }
   }
 }
