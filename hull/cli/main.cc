@@ -1,10 +1,9 @@
 // studio-hull: the visual hull service's command line (DESIGN §6): the DDS node (--config, see
-// node/hull_node.h) and the offline mode.
-//
-//   studio-hull offline --rig rig.yaml --masks DIR --box X0,Y0,Z0,X1,Y1,Z1 --grid N
-//                       [--axis x|y|z] [--frames A:B] --out FILE|DIR [--format ply|obj|glb]
-//                       [--outside keep|cut] [--threads N] [--timing]
-#include <opencv2/imgcodecs.hpp>
+// node/hull_node.h) and the offline mode, from a mask folder or a recorded take keyed on the fly
+// (cli/frame_input.h). Per frame: load (+ key) -> cut -> segment marching cubes -> exact crossings
+// (hull/crossing_refine.h; --no-refine skips them) -> mesh file. Frames run in parallel on the
+// worker threads; a single frame uses them inside the cut.
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -19,10 +18,13 @@
 #include <thread>
 #include <vector>
 
+#include "frame_input.h"
+#include "hull/crossing_refine.h"
 #include "hull/mesh_io.h"
-#include "hull_node.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
+#include "hull_node.h"
+#include "keyer_yaml.h"
 #include "yaml_io/rig_yaml.h"
 
 namespace fs = std::filesystem;
@@ -32,36 +34,51 @@ using namespace studio::hull;
 namespace {
 
 constexpr const char* kUsage = R"(usage: studio-hull --config hull.yaml      the real-time DDS service (keys below)
-       studio-hull offline --rig rig.yaml --masks DIR --box X0,Y0,Z0,X1,Y1,Z1 --grid N
-                           [--axis x|y|z] [--frames A:B] --out FILE|DIR [--format ply|obj|glb]
-                           [--outside keep|cut] [--threads N] [--timing]
+       studio-hull offline --rig rig.yaml (--masks DIR | --take DIR) --box X0,Y0,Z0,X1,Y1,Z1
+                           --grid N [--axis x|y|z] [--frames A:B] --out FILE|DIR
+                           [--format ply|obj|glb] [--keyer keyer.yaml | --key blue|green]
+                           [--outside keep|cut] [--no-refine] [--threads N] [--timing]
+                           [--progress | --quiet]
 
-Offline visual hull (line-segment representation, segment marching cubes) from silhouette masks.
+Offline visual hull (line-segment representation, segment marching cubes) from silhouettes.
   --rig FILE        rig.yaml with the calibrated cameras
   --masks DIR       DIR/<camera_id>.png (one frame) or DIR/<frame>/<camera_id>.png (a sequence);
                     0 = background, non-zero = actor; every camera of the rig needs its mask
+  --take DIR        a recorded take, takes/<take>/ holding <camera_id>/frames.raw (+ index) for
+                    every camera of the rig; frames are matched by frame number and keyed on the
+                    fly (RGB8 frames)
+  --keyer FILE      keyer.yaml for --take (keys of keyer/keyer.example.yaml; blue or green key)
+  --key K           blue (default) or green: the keyer's defaults for that backing, for --take
   --box ...         the reconstruction box in the studio frame (metres)
   --grid N          N x N columns (e.g. 512)
   --axis A          continuous axis of the line segments (default y, the studio's up)
-  --frames A:B      only frames A..B inclusive of a sequence (share a long take between PCs)
-  --out PATH        mesh file for one frame (.ply/.obj/.glb), a folder for a sequence
-                    (<frame>.<format>)
+  --frames A:B      only frames A..B inclusive of a sequence or take (share a long take
+                    between PCs)
+  --out PATH        mesh file for one frame (.ply/.obj/.glb), else a folder (<frame>.<format>)
   --format F        mesh format in a folder (default ply)
   --outside M       keep (default) or cut the parts of a column that leave a camera's image
-  --threads N       worker threads (default: all cores; frames run in parallel)
-  --timing          print per-stage milliseconds (load, cut, mesh, write) as JSON on stdout
+  --no-refine       skip the exact crossings (vertices between an inside and an outside column
+                    stay at half a cell, which re-projects about half a cell too wide)
+  --threads N       worker threads (default: all cores; frames run in parallel, a single frame
+                    cuts its columns in parallel)
+  --timing          print JSON on stdout: milliseconds per frame of each stage (load, key, cut,
+                    mesh, refine, write) and the wall time
+  --progress        progress bar on stderr even when it is not a terminal (default: only on a
+                    terminal, for more than one frame); --quiet: never
 )";
 
 struct Args {
-  std::string rig, masks, out, format = "ply";
+  std::string rig, masks, take, keyer_file, out, format = "ply";
+  std::optional<keyer::KeyMode> key;
   std::optional<std::string> box_text;
   Eigen::Vector3d box_min, box_max;
   int grid = 0;
   Axis axis = Axis::y;
-  std::optional<std::pair<long, long>> frames;
+  std::optional<cli::FrameRange> frames;
   Outside outside = Outside::keep;
   int threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  bool timing = false;
+  bool timing = false, refine = true;
+  std::optional<bool> progress;
 };
 
 Expected<Args> parse(int argc, char** argv) {
@@ -76,11 +93,27 @@ Expected<Args> parse(int argc, char** argv) {
       a.timing = true;
       continue;
     }
+    if (opt == "--no-refine") {
+      a.refine = false;
+      continue;
+    }
+    if (opt == "--progress" || opt == "--quiet") {
+      a.progress = opt == "--progress";
+      continue;
+    }
     auto v = value();
     if (!v) return std::unexpected(v.error());
     if (opt == "--rig") a.rig = *v;
     else if (opt == "--masks") a.masks = *v;
-    else if (opt == "--out") a.out = *v;
+    else if (opt == "--take") a.take = *v;
+    else if (opt == "--keyer") a.keyer_file = *v;
+    else if (opt == "--key") {
+      auto m = keyer::parse_key_mode(*v);
+      if (!m || *m == keyer::KeyMode::kDifference) {
+        return fail("--key: '" + *v + "': expected blue or green");
+      }
+      a.key = *m;
+    } else if (opt == "--out") a.out = *v;
     else if (opt == "--format") a.format = *v;
     else if (opt == "--box") {
       std::vector<double> n;
@@ -117,10 +150,10 @@ Expected<Args> parse(int argc, char** argv) {
       long lo = 0, hi = 0;
       char c = 0;
       std::stringstream ss(*v);
-      if (!(ss >> lo >> c >> hi) || c != ':' || !ss.eof() || hi < lo) {
-        return fail("--frames: '" + *v + "': expected A:B with A <= B");
+      if (!(ss >> lo >> c >> hi) || c != ':' || !ss.eof() || lo < 0 || hi < lo) {
+        return fail("--frames: '" + *v + "': expected A:B with 0 <= A <= B");
       }
-      a.frames = {lo, hi};
+      a.frames = cli::FrameRange{lo, hi};
     } else if (opt == "--outside") {
       if (*v == "keep") a.outside = Outside::keep;
       else if (*v == "cut") a.outside = Outside::cut;
@@ -130,7 +163,11 @@ Expected<Args> parse(int argc, char** argv) {
     }
   }
   if (a.rig.empty()) return fail("--rig is required");
-  if (a.masks.empty()) return fail("--masks is required");
+  if (a.masks.empty() == a.take.empty()) return fail("give exactly one of --masks DIR or --take DIR");
+  if (!a.keyer_file.empty() && a.key) return fail("give --keyer FILE or --key, not both");
+  if (a.take.empty() && (!a.keyer_file.empty() || a.key)) {
+    return fail("--keyer/--key only apply to --take (masks are already keyed)");
+  }
   if (!a.box_text) return fail("--box is required");
   if (a.grid <= 0) return fail("--grid N is required (N >= 1)");
   if (a.out.empty()) return fail("--out is required");
@@ -141,28 +178,12 @@ Expected<Args> parse(int argc, char** argv) {
   return a;
 }
 
-struct Frame {
-  std::string name;  // "" for a single frame
-  fs::path dir;
-};
-
-Expected<RunMask> load_mask(const fs::path& path, const Camera& cam) {
-  if (!fs::exists(path)) return fail(path.string() + ": missing mask for camera " + cam.id);
-  const cv::Mat m = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
-  if (m.empty()) return fail(path.string() + ": not a readable image");
-  if (m.cols != cam.width || m.rows != cam.height) {
-    return fail(path.string() + ": mask is " + std::to_string(m.cols) + "x" + std::to_string(m.rows) +
-                ", camera " + cam.id + " is " + std::to_string(cam.width) + "x" +
-                std::to_string(cam.height));
-  }
-  return RunMask::from_mask(MaskView(m.ptr<uint8_t>(), m.cols, m.rows, std::ptrdiff_t(m.step)));
-}
-
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 int run_offline(int argc, char** argv) {
+  const auto wall0 = std::chrono::steady_clock::now();
   auto args = parse(argc, argv);
   if (!args) {
     std::cerr << "studio-hull: " << args.error().message << "\n";
@@ -186,121 +207,127 @@ int run_offline(int argc, char** argv) {
     std::cerr << "studio-hull: " << args->rig << ": no cameras\n";
     return 2;
   }
-  if (!fs::is_directory(args->masks)) {
-    std::cerr << "studio-hull: " << args->masks << ": not a folder\n";
+  const std::vector<Camera>& cameras = rig->cameras;
+
+  // Where the silhouettes come from. Slots: one keyer set per worker thread.
+  Expected<std::unique_ptr<cli::FrameInput>> input = fail("no input");
+  if (!args->masks.empty()) {
+    input = cli::open_mask_folder(args->masks, cameras, args->frames);
+  } else {
+    keyer::KeyerOptions key;
+    if (!args->keyer_file.empty()) {
+      auto loaded = keyer::load_keyer_options(args->keyer_file);
+      if (!loaded) {
+        std::cerr << "studio-hull: " << loaded.error().message << "\n";
+        return 2;
+      }
+      key = *loaded;
+    } else if (args->key) {
+      key.mode = *args->key;
+    }
+    input = cli::open_take(args->take, cameras, args->frames, key, args->threads);
+  }
+  if (!input) {
+    std::cerr << "studio-hull: " << input.error().message << "\n";
     return 2;
   }
-  // One frame (DIR/<camera>.png) or a sequence (DIR/<frame>/<camera>.png).
-  std::vector<Frame> frames;
-  bool single = false;
-  for (const Camera& c : rig->cameras) single |= fs::exists(fs::path(args->masks) / (c.id + ".png"));
-  if (single) {
-    frames.push_back({"", args->masks});
-  } else {
-    std::vector<std::pair<long, fs::path>> found;
-    for (const auto& e : fs::directory_iterator(args->masks)) {
-      if (!e.is_directory()) continue;
-      const std::string n = e.path().filename().string();
-      if (n.empty() || !std::all_of(n.begin(), n.end(), ::isdigit)) continue;
-      const long f = std::stol(n);
-      if (args->frames && (f < args->frames->first || f > args->frames->second)) continue;
-      found.emplace_back(f, e.path());
-    }
-    std::sort(found.begin(), found.end());
-    for (const auto& [f, p] : found) frames.push_back({p.filename().string(), p});
-    if (frames.empty()) {
-      std::cerr << "studio-hull: " << args->masks << ": no masks (" << rig->cameras[0].id
-                << ".png) and no frame folders" << (args->frames ? " in --frames" : "") << "\n";
-      return 2;
-    }
+  cli::FrameInput& in = **input;
+  const std::vector<std::string>& frames = in.frames();
+
+  // One mesh file for one frame (always for a one-frame mask folder; for a single selected frame
+  // of a sequence or take when --out names a mesh file), a folder otherwise.
+  const bool one_file =
+      frames.size() == 1 && (frames[0].empty() || mesh_format_from_path(args->out).has_value());
+  if (!one_file) {
     std::error_code ec;
     fs::create_directories(args->out, ec);
     if (ec || !fs::is_directory(args->out)) {
       std::cerr << "studio-hull: " << args->out << ": cannot create output folder\n";
       return 2;
     }
+  } else if (auto f = mesh_format_from_path(args->out); !f) {
+    std::cerr << "studio-hull: --out " << f.error().message << "\n";
+    return 2;
   }
 
-  // Frames in parallel; a single frame uses the threads inside the cut.
   const int workers = std::min<int>(args->threads, int(frames.size()));
   CutOptions cut_options;
   cut_options.outside = args->outside;
   cut_options.threads = frames.size() == 1 ? args->threads : 1;
+  const bool progress = frames.size() > 1 && args->progress.value_or(::isatty(2) != 0);
   std::atomic<std::size_t> next{0}, done{0};
   std::atomic<bool> failed{false};
   std::mutex lock;
   std::string error;
-  double t_load = 0, t_cut = 0, t_mesh = 0, t_write = 0;
-  const bool progress = frames.size() > 1;
-  const auto work = [&] {
+  bool bar_drawn = false;
+  cli::LoadTimes t_load;
+  double t_cut = 0, t_mesh = 0, t_refine = 0, t_write = 0;
+  const auto work = [&](int slot) {
+    std::vector<RunMask> masks;
+    std::vector<View> views;
+    const auto give_up = [&](const std::string& message) {
+      std::lock_guard g(lock);
+      if (!failed.exchange(true)) error = message;
+    };
     while (!failed) {
       const std::size_t k = next++;
       if (k >= frames.size()) return;
-      const Frame& fr = frames[k];
+      cli::LoadTimes load;
+      if (auto ok = in.load(k, slot, masks, load); !ok) return give_up(ok.error().message);
       auto t0 = std::chrono::steady_clock::now();
-      std::vector<RunMask> masks;
-      for (const Camera& c : rig->cameras) {
-        auto m = load_mask(fr.dir / (c.id + ".png"), c);
-        if (!m) {
-          std::lock_guard g(lock);
-          if (!failed.exchange(true)) error = m.error().message;
-          return;
-        }
-        masks.push_back(std::move(*m));
-      }
-      const double load = ms_since(t0);
-      t0 = std::chrono::steady_clock::now();
-      std::vector<View> views;
-      for (std::size_t c = 0; c < masks.size(); ++c) views.push_back({&rig->cameras[c], &masks[c]});
+      views.clear();
+      for (std::size_t c = 0; c < masks.size(); ++c) views.push_back({&cameras[c], &masks[c]});
       auto hull = visual_hull(grid, views, cut_options);
-      if (!hull) {
-        std::lock_guard g(lock);
-        if (!failed.exchange(true)) error = hull.error().message;
-        return;
-      }
+      if (!hull) return give_up(hull.error().message);
       const double cut = ms_since(t0);
       t0 = std::chrono::steady_clock::now();
-      const Mesh mesh = segment_marching_cubes(*hull);
+      Mesh mesh = segment_marching_cubes(*hull);
       const double mesh_ms = ms_since(t0);
       t0 = std::chrono::steady_clock::now();
-      const std::string out = fr.name.empty()
-                                  ? args->out
-                                  : (fs::path(args->out) / (fr.name + "." + args->format)).string();
-      auto w = write_mesh(mesh, out);
-      if (!w) {
-        std::lock_guard g(lock);
-        if (!failed.exchange(true)) error = w.error().message;
-        return;
+      if (args->refine) {
+        if (auto ok = refine_crossings(mesh, *hull, views, cut_options); !ok) {
+          return give_up(ok.error().message);
+        }
       }
+      const double refine = ms_since(t0);
+      t0 = std::chrono::steady_clock::now();
+      const std::string out =
+          one_file ? args->out
+                   : (fs::path(args->out) / (frames[k] + "." + args->format)).string();
+      if (auto w = write_mesh(mesh, out); !w) return give_up(w.error().message);
       const double write = ms_since(t0);
       std::lock_guard g(lock);
-      t_load += load, t_cut += cut, t_mesh += mesh_ms, t_write += write;
+      t_load.read += load.read, t_load.key += load.key;
+      t_cut += cut, t_mesh += mesh_ms, t_refine += refine, t_write += write;
       const std::size_t n = ++done;
-      if (progress) {
+      if (progress && !failed) {
         const int width = 40, filled = int(width * n / frames.size());
         std::fprintf(stderr, "\r[%s%s] %zu/%zu frames", std::string(filled, '#').c_str(),
                      std::string(width - filled, ' ').c_str(), n, frames.size());
         if (n == frames.size()) std::fprintf(stderr, "\n");
+        bar_drawn = n < frames.size();
       }
     }
   };
   {
     std::vector<std::jthread> pool;
-    for (int k = 1; k < workers; ++k) pool.emplace_back(work);
-    work();
+    for (int k = 1; k < workers; ++k) pool.emplace_back(work, k);
+    work(0);
   }
   if (failed) {
-    if (progress) std::fprintf(stderr, "\n");
+    if (bar_drawn) std::fprintf(stderr, "\n");
     std::cerr << "studio-hull: " << error << "\n";
     return 1;
   }
   if (args->timing) {
     const double n = double(frames.size());
     std::printf(
-        "{\"frames\": %zu, \"grid\": %d, \"cameras\": %zu, \"load\": %.3f, \"cut\": %.3f, "
-        "\"mesh\": %.3f, \"write\": %.3f, \"unit\": \"ms per frame\"}\n",
-        frames.size(), args->grid, rig->cameras.size(), t_load / n, t_cut / n, t_mesh / n,
-        t_write / n);
+        "{\"input\": \"%s\", \"frames\": %zu, \"grid\": %d, \"cameras\": %zu, \"threads\": %d, "
+        "\"exact_crossings\": %s, \"load\": %.3f, \"key\": %.3f, \"cut\": %.3f, \"mesh\": %.3f, "
+        "\"refine\": %.3f, \"write\": %.3f, \"unit\": \"ms per frame\", \"wall_ms\": %.3f}\n",
+        in.keyed() ? "take" : "masks", frames.size(), args->grid, cameras.size(), workers,
+        args->refine ? "true" : "false", t_load.read / n, t_load.key / n, t_cut / n, t_mesh / n,
+        t_refine / n, t_write / n, ms_since(wall0));
   }
   return 0;
 }

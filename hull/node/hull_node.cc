@@ -8,6 +8,7 @@
 
 #include "core/frame_assembler.h"
 #include "core/log.h"
+#include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "segments_wire.h"
 #include "wire/convert.h"
@@ -194,7 +195,8 @@ class HullNode : public runtime::Node {
       return;
     }
     const std::vector<SegmentSet> actors = connected_components(*hull, options_.min_actor_volume);
-    for (std::size_t k = 0; k < actors.size(); ++k) publish(actors[k], options_.actor_prefix + std::to_string(k), frame);
+    for (std::size_t k = 0; k < actors.size(); ++k)
+      publish(actors[k], options_.actor_prefix + std::to_string(k), frame, views, cut);
     for (std::size_t k = actors.size(); k < published_actors_; ++k) dispose(options_.actor_prefix + std::to_string(k));
     published_actors_ = actors.size();
     metrics_.latency().record(realtime_ns() - frame.capture_ns);
@@ -203,7 +205,8 @@ class HullNode : public runtime::Node {
     last_partial_ = views.size() < cameras_.size();
   }
 
-  void publish(const SegmentSet& set, const std::string& actor_id, const FrameAssembler<RunMask>::Frame& frame) {
+  void publish(const SegmentSet& set, const std::string& actor_id, const FrameAssembler<RunMask>::Frame& frame,
+               std::span<const View> views, const CutOptions& cut) {
     wire::Owned<studio_SegmentSet> s;
     wire::set(s->actor_id, actor_id);
     s->frame = frame.frame;
@@ -216,7 +219,14 @@ class HullNode : public runtime::Node {
     m->frame = frame.frame;
     m->capture_ns = frame.capture_ns;
     m->source_frame = frame.frame;
-    mesh_to_wire(segment_marching_cubes(set), *m);
+    Mesh mesh = segment_marching_cubes(set);
+    if (options_.refine) {
+      // Only fails on a mask of the wrong size, which the frame's cut already rejected.
+      if (auto ok = refine_crossings(mesh, set, views, cut); !ok) {
+        STUDIO_LOG(warn, kLog) << "frame " << frame.frame << ": " << ok.error().message;
+      }
+    }
+    mesh_to_wire(mesh, *m);
     if (auto r = io_->meshes.write(*m); r) meshes_out_.add();
   }
 
@@ -305,6 +315,7 @@ runtime::ServiceDefinition hull_service_definition() {
       "    outside: keep           column parts outside an image: keep|cut\n"
       "    threads: 2              cut threads\n"
       "    mesh: true              publish studio/actor/mesh\n"
+      "    refine: true            exact crossings on the mesh (else half-cell vertices)\n"
       "    min_actor_volume: 0.01  smaller components (m^3) are noise\n"
       "    actor_prefix: actor     actor ids <prefix>0, <prefix>1, ... largest first\n";
   d.create = [](yaml::MapReader& config, runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
@@ -320,6 +331,7 @@ runtime::ServiceDefinition hull_service_definition() {
         yaml::enum_field("outside", &HullNodeOptions::outside, {{"keep", Outside::keep}, {"cut", Outside::cut}}),
         yaml::field("threads", &HullNodeOptions::threads).range(1, 64),
         yaml::field("mesh", &HullNodeOptions::mesh),
+        yaml::field("refine", &HullNodeOptions::refine),
         yaml::field("min_actor_volume", &HullNodeOptions::min_actor_volume).min(0),
         yaml::field("actor_prefix", &HullNodeOptions::actor_prefix),
     };

@@ -16,6 +16,9 @@
 //   outside: keep             a column part outside an image is kept or cut (keep|cut)
 //   threads: 2                cut threads (columns are independent)
 //   mesh: true                publish studio/actor/mesh (segment marching cubes)
+//   refine: true              exact crossings on the mesh (hull/crossing_refine.h): vertices
+//                             between an inside and an outside column move to where the hull
+//                             really ends instead of half a cell
 //   min_actor_volume: 0.01    components smaller than this (m^3) are noise, not actors
 //   actor_prefix: actor       actor ids are <prefix>0, <prefix>1, ... largest first
 
@@ -39,6 +42,7 @@ struct HullNodeOptions {
   Outside outside = Outside::keep;
   int threads = 2;
   bool mesh = true;
+  bool refine = true;
   double min_actor_volume = 0.01;
   std::string actor_prefix = "actor";
 

@@ -2,6 +2,8 @@
 // segments and a watertight mesh out, stamped with the masks' frame and capture time; a missing
 // camera is waited for until the deadline and then the frame goes out without it; bad config is
 // one line.
+#include "hull_node.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -10,7 +12,9 @@
 #include "capture/sim/cameras.h"
 #include "capture/sim/studio.h"
 #include "harness/fixture.h"
+#include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
+#include "hull/silhouette_cut.h"
 #include "segments_wire.h"
 #include "wire/convert.h"
 #include "wire/endpoint.h"
@@ -41,7 +45,8 @@ class HullNodeTest : public testing::ProcessTest {
 
   std::string write_config(const std::string& hull_section) {
     const auto path = dir_ / "hull.yaml";
-    std::ofstream(path) << "instance: hull-test\nstatus_period: 0.5\nhull:\n  rig: rig.yaml\n" << hull_section;
+    std::ofstream(path) << "instance: hull-test\nstatus_period: 0.5\nhull:\n  rig: rig.yaml\n"
+                        << hull_section;
     return path.string();
   }
 
@@ -60,6 +65,28 @@ class HullNodeTest : public testing::ProcessTest {
     }
   }
 
+  // The actor0 mesh the node should publish for `frame` with every camera's true mask: segment
+  // marching cubes of the largest component, half-cell (plain) and with exact crossings.
+  std::pair<Mesh, Mesh> local_meshes(int64_t frame, const HullNodeOptions& o) {
+    std::vector<RunMask> runs(cameras_.size());
+    std::vector<View> views;
+    for (std::size_t c = 0; c < cameras_.size(); ++c) {
+      Mask truth;
+      studio_->render(int(c), frame, nullptr, &truth);
+      runs[c] = RunMask::from_mask(truth.view());
+      views.push_back({&cameras_[c], &runs[c]});
+    }
+    auto local = visual_hull(o.grid_spec(), views);
+    EXPECT_TRUE(local.has_value());
+    if (!local) return {};
+    const auto actors = connected_components(*local, o.min_actor_volume);
+    if (actors.empty()) return {};
+    std::pair<Mesh, Mesh> out{segment_marching_cubes(actors[0]), Mesh{}};
+    out.second = out.first;
+    EXPECT_TRUE(refine_crossings(out.second, actors[0], views).has_value());
+    return out;
+  }
+
   std::vector<Camera> cameras_;
   std::optional<sim::SimulatedStudio> studio_;
 };
@@ -73,11 +100,16 @@ TEST_F(HullNodeTest, MasksInSegmentsAndMeshOut) {
   auto mesh_topic = wire::Topic<studio_ActorMesh>::create(p).value();
   auto meshes = wire::Reader<studio_ActorMesh>::create(p, mesh_topic).value();
 
-  auto& hull = spawn("hull", "hull/studio-hull",
-                     {"--config", write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 96\n  deadline_ms: 200\n")});
+  auto& hull = spawn(
+      "hull", "hull/studio-hull",
+      {"--config",
+       write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 96\n  deadline_ms: 200\n")});
   ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
   ASSERT_TRUE(masks.wait_for_readers(1, 10s));
 
+  HullNodeOptions options;
+  options.box = {-1.5, 0, -1.5, 1.5, 2.2, 1.5};
+  options.grid = 96;
   std::vector<int> all(cameras_.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
   const int64_t frame = 40, capture_ns = 1'700'000'000'000'000'000;
@@ -95,8 +127,13 @@ TEST_F(HullNodeTest, MasksInSegmentsAndMeshOut) {
           ASSERT_TRUE(core.has_value()) << core.error().message;
           set = std::move(*core);
         }
+      // Only a mesh made from every camera's mask (a best-effort mask may be lost, and a frame
+      // then goes out without it at the deadline): its vertex count is that of the local mesh.
       for (auto& m : meshes.take())
-        if (m.meta.valid_data) mesh = std::move(m.data);
+        if (m.meta.valid_data &&
+            wire::view(m.data->vertices).size() ==
+                3 * local_meshes(int64_t(m.data->frame), options).second.vertices.size())
+          mesh = std::move(m.data);
       std::this_thread::sleep_for(20ms);
     }
   }
@@ -113,12 +150,26 @@ TEST_F(HullNodeTest, MasksInSegmentsAndMeshOut) {
   auto v = wire::view((*mesh)->vertices);
   auto t = wire::view((*mesh)->triangles);
   ASSERT_GT(t.size(), 300u);
-  for (std::size_t i = 0; i + 2 < v.size(); i += 3) m.vertices.emplace_back(v[i], v[i + 1], v[i + 2]);
-  for (std::size_t i = 0; i + 2 < t.size(); i += 3) m.triangles.push_back({t[i], t[i + 1], t[i + 2]});
+  for (std::size_t i = 0; i + 2 < v.size(); i += 3)
+    m.vertices.emplace_back(v[i], v[i + 1], v[i + 2]);
+  for (std::size_t i = 0; i + 2 < t.size(); i += 3)
+    m.triangles.push_back({t[i], t[i + 1], t[i + 2]});
   const auto topo = hull::check_topology(m);
   EXPECT_TRUE(topo.watertight());
   EXPECT_TRUE(topo.oriented());
   EXPECT_EQ((*mesh)->source_frame, (*mesh)->frame);
+
+  // refine: true (the default): the published mesh is the actor's segment marching cubes mesh
+  // with exact crossings, not the half-cell one.
+  const auto [plain, exact] = local_meshes(int64_t((*mesh)->frame), options);
+  ASSERT_EQ(m.vertices.size(), exact.vertices.size());
+  float off_exact = 0, off_plain = 0;
+  for (std::size_t k = 0; k < m.vertices.size(); ++k) {
+    off_exact = std::max(off_exact, (m.vertices[k] - exact.vertices[k]).norm());
+    off_plain = std::max(off_plain, (m.vertices[k] - plain.vertices[k]).norm());
+  }
+  EXPECT_LT(off_exact, 1e-5f);
+  EXPECT_GT(off_plain, 0.2f * float(options.grid_spec().du()));
   EXPECT_EQ(hull.stop(), 0) << hull.log();
 }
 
@@ -131,9 +182,11 @@ TEST_F(HullNodeTest, MissingCameraWaitsForTheDeadlineThenGoesWithout) {
   auto status_topic = wire::Topic<studio_ServiceStatus>::create(p).value();
   auto status = wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
 
-  auto& hull = spawn("hull", "hull/studio-hull",
-                     {"--config", write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 64\n  deadline_ms: 300\n"
-                                               "  mesh: false\n")});
+  auto& hull =
+      spawn("hull", "hull/studio-hull",
+            {"--config",
+             write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 64\n  deadline_ms: 300\n"
+                          "  mesh: false\n")});
   ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
   ASSERT_TRUE(masks.wait_for_readers(1, 10s));
   std::vector<int> without_last(cameras_.size() - 1);
@@ -182,6 +235,7 @@ TEST_F(HullNodeTest, BadConfigIsOneLine) {
       {"  box: [0, 0, 0, 0, 1, 1]\n", "box"},
       {"  box: [0, 0, 0, 1, 1, 1]\n  colour: red\n", "colour: unknown key"},
       {"  box: [0, 0, 0, 1, 1, 1]\n  min_cameras: 9\n", "min_cameras"},
+      {"  box: [0, 0, 0, 1, 1, 1]\n  refine: maybe\n", "refine"},
   };
   for (const auto& c : cases) {
     auto& p = spawn("hull", "hull/studio-hull", {"--config", write_config(c.section)});

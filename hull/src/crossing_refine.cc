@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
+#include <vector>
 
 namespace studio::hull {
 namespace {
@@ -53,53 +55,66 @@ Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<con
     if (i < 0 || j < 0 || i >= g.cells_u || j >= g.cells_v) return {};
     return set.column(i, j);
   };
-  std::vector<Interval> a, b;
-  CutScratch scratch;
-  for (Eigen::Vector3f& p : mesh.vertices) {
-    // Lattice line in doubled coordinates (see segment_mesh.cc): column (i, j) is (2i+2, 2j+2).
-    const int x2 = int(std::lround((p[ua] - g.box_min[ua]) / du * 2 + 1));
-    const int y2 = int(std::lround((p[va] - g.box_min[va]) / dv * 2 + 1));
-    const bool odd_x = (x2 & 1) != 0, odd_y = (y2 & 1) != 0;
-    if (odd_x == odd_y) continue;  // a column or a cell centre
-    const int k = odd_x ? 0 : 1;   // edge along u or along v
-    const int i0 = odd_x ? (x2 - 3) / 2 : (x2 - 2) / 2;
-    const int j0 = odd_x ? (y2 - 2) / 2 : (y2 - 3) / 2;
-    const int i1 = i0 + (odd_x ? 1 : 0), j1 = j0 + (odd_x ? 0 : 1);
-    const auto c0 = column(i0, j0), c1 = column(i1, j1);
-    const float t = p[aa];
-    const bool b0 = occupied(c0, t, true), b1 = occupied(c1, t, true);
-    const bool a0 = occupied(c0, t, false), a1 = occupied(c1, t, false);
-    double te;
-    bool first_inside;
-    if (b0 != b1 && a0 != a1 && b0 == a0) {
-      te = t, first_inside = b0;
-    } else if (b0 != b1) {
-      const double prev = neighbour_event(c0, c1, t, true, g.t_min());
-      te = t - std::min(1e-3, 0.5 * (t - prev)), first_inside = b0;
-    } else if (a0 != a1) {
-      const double next = neighbour_event(c0, c1, t, false, g.t_max());
-      te = t + std::min(1e-3, 0.5 * (next - t)), first_inside = a0;
-    } else {
-      continue;
+  // Vertices are independent: split them over options.threads workers.
+  const auto refine_range = [&](std::size_t first, std::size_t last) {
+    std::vector<Interval> a, b;
+    CutScratch scratch;
+    for (std::size_t vi = first; vi < last; ++vi) {
+      Eigen::Vector3f& p = mesh.vertices[vi];
+      // Lattice line in doubled coordinates (see segment_mesh.cc): column (i, j) is (2i+2, 2j+2).
+      const int x2 = int(std::lround((p[ua] - g.box_min[ua]) / du * 2 + 1));
+      const int y2 = int(std::lround((p[va] - g.box_min[va]) / dv * 2 + 1));
+      const bool odd_x = (x2 & 1) != 0, odd_y = (y2 & 1) != 0;
+      if (odd_x == odd_y) continue;  // a column or a cell centre
+      const int k = odd_x ? 0 : 1;   // edge along u or along v
+      const int i0 = odd_x ? (x2 - 3) / 2 : (x2 - 2) / 2;
+      const int j0 = odd_x ? (y2 - 2) / 2 : (y2 - 3) / 2;
+      const int i1 = i0 + (odd_x ? 1 : 0), j1 = j0 + (odd_x ? 0 : 1);
+      const auto c0 = column(i0, j0), c1 = column(i1, j1);
+      const float t = p[aa];
+      const bool b0 = occupied(c0, t, true), b1 = occupied(c1, t, true);
+      const bool a0 = occupied(c0, t, false), a1 = occupied(c1, t, false);
+      double te;
+      bool first_inside;
+      if (b0 != b1 && a0 != a1 && b0 == a0) {
+        te = t, first_inside = b0;
+      } else if (b0 != b1) {
+        const double prev = neighbour_event(c0, c1, t, true, g.t_min());
+        te = t - std::min(1e-3, 0.5 * (t - prev)), first_inside = b0;
+      } else if (a0 != a1) {
+        const double next = neighbour_event(c0, c1, t, false, g.t_max());
+        te = t + std::min(1e-3, 0.5 * (next - t)), first_inside = a0;
+      } else {
+        continue;
+      }
+      // From the inside column towards the outside one.
+      const double step = k == 0 ? du : dv;
+      const Eigen::Vector3d from = g.point(first_inside ? i0 : i1, first_inside ? j0 : j1, te);
+      Eigen::Vector3d d = Eigen::Vector3d::Zero();
+      d[k == 0 ? ua : va] = first_inside ? 1 : -1;
+      a.assign(1, Interval{0.f, float(step)});
+      for (const PreparedView& view : along[k]) {
+        b.clear();
+        view.cut_line(from, d, a, &b, &scratch);
+        std::swap(a, b);
+        if (a.empty()) break;
+      }
+      // The surviving piece at the inside column; the half-cell guess when quantisation lost it.
+      double s = 0.5 * step;
+      if (!a.empty() && a.front().lo <= 0.02 * step) s = a.front().hi;
+      s = std::clamp(s, 0.02 * step, 0.98 * step);
+      const double at = from[k == 0 ? ua : va] + (first_inside ? s : -s);
+      p[k == 0 ? ua : va] = float(at);
     }
-    // From the inside column towards the outside one.
-    const double step = k == 0 ? du : dv;
-    const Eigen::Vector3d from = g.point(first_inside ? i0 : i1, first_inside ? j0 : j1, te);
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    d[k == 0 ? ua : va] = first_inside ? 1 : -1;
-    a.assign(1, Interval{0.f, float(step)});
-    for (const PreparedView& view : along[k]) {
-      b.clear();
-      view.cut_line(from, d, a, &b, &scratch);
-      std::swap(a, b);
-      if (a.empty()) break;
-    }
-    // The surviving piece at the inside column; the half-cell guess when quantisation lost it.
-    double s = 0.5 * step;
-    if (!a.empty() && a.front().lo <= 0.02 * step) s = a.front().hi;
-    s = std::clamp(s, 0.02 * step, 0.98 * step);
-    const double at = from[k == 0 ? ua : va] + (first_inside ? s : -s);
-    p[k == 0 ? ua : va] = float(at);
+  };
+  const std::size_t n = mesh.vertices.size();
+  const std::size_t workers =
+      std::clamp<std::size_t>(std::size_t(options.threads), 1, std::max<std::size_t>(n / 4096, 1));
+  {
+    std::vector<std::jthread> pool;
+    for (std::size_t w = 1; w < workers; ++w)
+      pool.emplace_back(refine_range, n * w / workers, n * (w + 1) / workers);
+    refine_range(0, n / workers);
   }
   compute_normals(mesh);
   return {};
