@@ -17,6 +17,8 @@ const char kConfigHelp[] =
     "  rig: FILE                         rig.yaml with the calibrations to publish (optional)\n"
     "  keyer: FILE                       keyer options, see keyer.example.yaml (optional)\n"
     "  image: {rate: HZ, quality: Q, raw: BOOL}   latest-image service (default 5, 85, false)\n"
+    "  masks: BOOL                       key and publish masks here (default true; false when\n"
+    "                                    studio-keyer --config keys image: {rate: 1000, raw: true})\n"
     "  recorder: {queue_frames: N}       frames buffered before the disk (default 50)\n"
     "  state_period: S                   seconds between CameraState samples (default 1)\n"
     "  cameras:                          one entry per camera:\n"
@@ -210,6 +212,7 @@ Expected<CaptureNodeOptions> read_capture_config(yaml::MapReader& config) {
     TRY(c->finish());
   }
   TRY(number(config, "state_period", o.state_period, 0.05, 60, as_double));
+  TRY(boolean(config, "masks", o.publish_masks));
   if (!keyer_path.empty()) {
     auto k = keyer::load_keyer_options(keyer_path);
     if (!k) return Fail(k.error());

@@ -6,6 +6,8 @@
 //   rig: rig.yaml                      # optional: calibrations to publish (else the source's own)
 //   keyer: keyer.yaml                  # optional: keyer options (keyer/keyer.example.yaml)
 //   image: {rate: 5, quality: 85, raw: false}   # latest-image service: Hz, JPEG quality, raw RGB8
+//   masks: true                        # false: no keying here (studio-keyer --config keys the
+//                                      # raw images; image: {rate: 1000, raw: true} sends every frame)
 //   recorder: {queue_frames: 50}       # frames buffered between capture and disk
 //   state_period: 1.0                  # seconds between CameraState samples
 //   cameras:

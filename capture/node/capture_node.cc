@@ -347,8 +347,10 @@ void CaptureNode::capture_loop(Camera& cam) {
         }
       }
 
-      // Key → mask codec → AlphaMask.
-      if (auto k = cam.keyer->key(frame.image.view(), mask); k) {
+      // Key → mask codec → AlphaMask (unless keying runs elsewhere: masks: false).
+      if (!options_.publish_masks) {
+        // studio-keyer --config keys the raw images on another machine.
+      } else if (auto k = cam.keyer->key(frame.image.view(), mask); k) {
         encode_mask(mask, options_.coding, bytes);
         from_core(cam.id, frame.frame, frame.capture_ns, bytes, mask.width(), mask.height(),
                   mask_sample);

@@ -48,6 +48,7 @@ struct CaptureNodeOptions {
   double image_rate = 5;  // Hz, 0 = no images
   int jpeg_quality = 85;
   bool image_raw = false;
+  bool publish_masks = true;  // false: no in-process keying (studio-keyer --config keys the images)
   double state_period = 1.0;  // seconds
   std::vector<CameraSetup> cameras;
 };

@@ -1,4 +1,5 @@
 // studio-keyer key: key a folder of camera images into a folder of PNG masks.
+// studio-keyer --config keyer.yaml: the standalone keyer service (keyer/node/keyer_node.h).
 //
 //   studio-keyer key --input DIR --output DIR [--key blue|green|difference] [--plate FILE]
 //                    [--config keyer.yaml] [--alpha DIR] [--json]
@@ -20,7 +21,9 @@
 #include "core/mask_codec.h"
 #include "image_io.h"
 #include "keyer/keyer.h"
+#include "keyer_node.h"
 #include "keyer_yaml.h"
+#include "runtime/service.h"
 
 namespace fs = std::filesystem;
 using namespace studio;
@@ -29,6 +32,7 @@ using namespace studio::keyer;
 namespace {
 
 constexpr const char* kUsage = R"(usage: studio-keyer key --input DIR --output DIR [options]
+       studio-keyer --config keyer.yaml     the keyer service (DDS; keys below)
 
 Keys every PNG/JPEG image in DIR and writes one PNG mask (0 backing, 255 actor) per image, with
 the same name (extension .png), into the output folder (created if missing).
@@ -174,9 +178,14 @@ int main(int argc, char** argv) {
   try {
     std::vector<std::string> args(argv + 1, argv + argc);
     if (args.empty() || args[0] == "-h" || args[0] == "--help") {
-      std::cout << kUsage;
+      const auto service = keyer_service_definition();
+      std::cout << kUsage << "\nService config (studio-keyer --config FILE): " << service.summary << "\n"
+                << service.config_help
+                << "  plus the common service keys: instance, domain, dds_config, status_period, log\n";
       return args.empty() ? 2 : 0;
     }
+    if (args[0] == "--config" || args[0].starts_with("--config="))
+      return studio::runtime::service_main(argc, argv, keyer_service_definition());
     if (args[0] == "key") return run_key({args.begin() + 1, args.end()});
     return bad_usage("unknown command '" + args[0] + "'");
   } catch (const std::exception& e) {
