@@ -238,6 +238,11 @@ int run_offline(int argc, char** argv) {
   // of a sequence or take when --out names a mesh file), a folder otherwise.
   const bool one_file =
       frames.size() == 1 && (frames[0].empty() || mesh_format_from_path(args->out).has_value());
+  if (!one_file && mesh_format_from_path(args->out).has_value()) {
+    std::cerr << "studio-hull: --out " << args->out << " names a mesh file but " << frames.size()
+              << " frames are selected; give a folder\n";
+    return 2;
+  }
   if (!one_file) {
     std::error_code ec;
     fs::create_directories(args->out, ec);

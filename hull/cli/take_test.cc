@@ -188,8 +188,8 @@ TEST_F(HullCliTake, KeysOnTheFlyAndMatchesTheMaskFolderRoute) {
     EXPECT_LT(worst, 1e-6f) << name;
     // Keyed on the fly vs the simulator's true masks (at 352x288 the actor is ~70 px wide, so the
     // keyer's half-coverage edge decisions, intersected over 6 views, cost a few % of volume;
-    // measured -1.4 .. -6.3 %): volumes within 10 %, and the keyed mesh re-projects onto the true
-    // masks (measured worst IoU 0.92-0.95; the true masks' own mesh gives the ceiling).
+    // measured 1.4 .. 6.7 % smaller): volumes within 10 %, and the keyed mesh re-projects onto the true
+    // masks (measured worst IoU 0.917-0.948; the true masks' own mesh gives the ceiling).
     const double vt = take->volume(), vs = truth->volume();
     const double iou = worst_iou(*take, f), ceiling = worst_iou(*truth, f);
     std::printf(
@@ -227,6 +227,12 @@ TEST_F(HullCliTake, FramesSelectionSingleFileAndNoRefine) {
   std::printf("frame 101 at 128x128: worst IoU exact crossings %.4f, half-cell %.4f\n", iou_exact,
               iou_plain);
   EXPECT_GT(iou_exact, iou_plain);
+  // Several frames into one mesh file.
+  r = run(base() + "--take " + (dir_ / "take").string() + " --out " + (dir_ / "all.ply").string(),
+          dir_);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("names a mesh file but 3 frames are selected"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "all.ply"));
   // Nothing selected.
   r = run(base() + "--take " + (dir_ / "take").string() + " --frames 200:300 --out " +
               (dir_ / "none").string(),
@@ -269,9 +275,7 @@ TEST_F(HullCliTake, RejectsFrameOfWrongSize) {
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("cam1: frame 100 is 320x240, camera cam1 is 352x288"), std::string::npos)
       << r.err;
-  // The error is the last line and the only one besides the progress bar (at most one line).
-  EXPECT_LE(lines(r.err), 2) << r.err;
-  EXPECT_NE(r.err.rfind("studio-hull: "), std::string::npos);
+  EXPECT_EQ(lines(r.err), 1) << r.err;  // no frame completes, so no progress bar either
 }
 
 TEST_F(HullCliTake, RejectsEmptyBoxAndBadKeyer) {
