@@ -46,6 +46,7 @@ constexpr int contour(uint8_t p, int q) {
 struct Tables {
   uint8_t pieces[16];
   int8_t dir[16][8];
+  uint8_t dir_change[16][16];  // bit q: contour direction q differs between two configurations
 };
 constexpr Tables make_tables() {
   Tables t{};
@@ -53,6 +54,10 @@ constexpr Tables make_tables() {
     t.pieces[c] = pieces(c);
     for (int q = 0; q < 8; ++q) t.dir[c][q] = int8_t(contour(t.pieces[c], q));
   }
+  for (unsigned a = 0; a < 16; ++a)
+    for (unsigned b = 0; b < 16; ++b)
+      for (int q = 0; q < 8; ++q)
+        if (t.dir[a][q] != t.dir[b][q]) t.dir_change[a][b] |= uint8_t(1u << q);
   return t;
 }
 constexpr Tables kTables = make_tables();
@@ -71,17 +76,26 @@ double Mesh::volume() const {
 
 void compute_normals(Mesh& mesh) {
   // Area-weighted vertex normals (float: the cells are centimetres, the sums stay well scaled).
-  std::vector<Eigen::Vector3f>& acc = mesh.normals;
-  acc.assign(mesh.vertices.size(), Eigen::Vector3f::Zero());
-  const Eigen::Vector3f* v = mesh.vertices.data();
-  for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3f a = v[t[0]];
-    const Eigen::Vector3f n = (v[t[1]] - a).cross(v[t[2]] - a);
-    acc[t[0]] += n;
-    acc[t[1]] += n;
-    acc[t[2]] += n;
+  mesh.normals.assign(mesh.vertices.size(), Eigen::Vector3f::Zero());
+  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
+  const float* __restrict v = mesh.vertices.data()->data();
+  float* __restrict acc = mesh.normals.data()->data();
+  const std::array<uint32_t, 3>* __restrict tri = mesh.triangles.data();
+  const std::size_t n_tri = mesh.triangles.size();
+  for (std::size_t f = 0; f < n_tri; ++f) {
+    const std::array<uint32_t, 3> t = tri[f];
+    const float* a = v + 3 * std::size_t(t[0]);
+    const float* b = v + 3 * std::size_t(t[1]);
+    const float* c = v + 3 * std::size_t(t[2]);
+    const float e0 = b[0] - a[0], e1 = b[1] - a[1], e2 = b[2] - a[2];
+    const float f0 = c[0] - a[0], f1 = c[1] - a[1], f2 = c[2] - a[2];
+    const float n0 = e1 * f2 - e2 * f1, n1 = e2 * f0 - e0 * f2, n2 = e0 * f1 - e1 * f0;
+    for (const uint32_t k : t) {
+      float* n = acc + 3 * std::size_t(k);
+      n[0] += n0, n[1] += n1, n[2] += n2;
+    }
   }
-  for (Eigen::Vector3f& n : acc) {
+  for (Eigen::Vector3f& n : mesh.normals) {
     const float len = n.norm();
     n = len > 0 ? Eigen::Vector3f(n / len) : Eigen::Vector3f::Zero();
   }
@@ -89,11 +103,27 @@ void compute_normals(Mesh& mesh) {
 
 Mesh segment_marching_cubes(const SegmentSet& set) {
   const GridSpec& g = set.grid();
-  const int nu = g.cells_u, nv = g.cells_v;
+  // Work on the bounding rectangle of the non-empty columns (local i, j = global - i0, j0): the
+  // cost follows the occupied area, not the box.
+  int i0 = g.cells_u, i1 = -1, j0 = g.cells_v, j1 = -1;
+  for (int j = 0; j < g.cells_v; ++j) {
+    const std::size_t c = set.column_index(0, j);
+    const uint32_t* st = set.start().data() + c;
+    if (st[0] == st[g.cells_u]) continue;
+    j0 = std::min(j0, j), j1 = j;
+    for (int i = 0; i < g.cells_u; ++i) {
+      if (st[i] != st[i + 1]) {
+        i0 = std::min(i0, i);
+        i1 = std::max(i1, i);
+      }
+    }
+  }
+  if (i1 < 0) return Mesh{};
+  const int nu = i1 - i0 + 1, nv = j1 - j0 + 1;
   const Lattice L(nu, nv);
   const auto column = [&](int i, int j) -> std::span<const Interval> {
     if (i < 0 || j < 0 || i >= nu || j >= nv) return {};
-    return set.column(i, j);
+    return set.column(i + i0, j + j0);
   };
 
   // Heights on every lattice line: the end points of the columns whose cells touch the line.
@@ -115,7 +145,7 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
   std::vector<uint8_t> occupied(ow * (std::size_t(nv) + 2), 0);
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
-      const uint32_t n = uint32_t(2 * set.column(i, j).size());
+      const uint32_t n = uint32_t(2 * column(i, j).size());
       if (!n) continue;
       occupied[std::size_t(i + 1) + std::size_t(j + 1) * ow] = 1;
       for_lines_of_column(i, j, [&](std::size_t l) { offset[l + 1] += n; });
@@ -125,7 +155,7 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
   std::vector<uint32_t> fill(offset.begin(), offset.end() - 1);
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
-      const auto col = set.column(i, j);
+      const auto col = column(i, j);
       if (col.empty()) continue;
       for_lines_of_column(i, j, [&](std::size_t l) {
         for (const Interval& iv : col) {
@@ -154,8 +184,8 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
   std::vector<int32_t> vertex_of(heights.size(), -1);
 
   Mesh mesh;
-  mesh.vertices.reserve(heights.size() / 2);
-  mesh.triangles.reserve(heights.size() + heights.size() / 2);
+  mesh.vertices.reserve(heights.size());  // untouched reserve costs address space only
+  mesh.triangles.reserve(2 * heights.size());
   const double du = g.du(), dv = g.dv();
   const int ua = g.u(), va = g.v(), aa = g.a();
   // The vertex at heights[slot] of line l (created on first use).
@@ -166,30 +196,18 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
       id = int32_t(mesh.vertices.size());
       const int x2 = int(l % std::size_t(L.X)), y2 = int(l / std::size_t(L.X));
       Eigen::Vector3d p;
-      p[ua] = g.box_min[ua] + (x2 * 0.5 - 0.5) * du;
-      p[va] = g.box_min[va] + (y2 * 0.5 - 0.5) * dv;
+      p[ua] = g.box_min[ua] + (x2 * 0.5 - 0.5 + i0) * du;
+      p[va] = g.box_min[va] + (y2 * 0.5 - 0.5 + j0) * dv;
       p[aa] = t;
       mesh.vertices.push_back(p.cast<float>());
     }
     return uint32_t(id);
   };
-  const auto vertex = [&](std::size_t l, float t) -> uint32_t {
-    const float* b = heights.data() + offset[l];
-    const uint32_t n = count[l];
-    uint32_t k = 0;
-    if (n <= 16) {
-      while (k < n && b[k] < t) ++k;
-    } else {
-      k = uint32_t(std::lower_bound(b, b + n, t) - b);
-    }
-    return vertex_at(l, offset[l] + k);
-  };
+
 
   // Per cell: lattice lines of corners, mid-edges and centre (doubled offsets from c0).
   static constexpr int kCorner[4][2] = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
   static constexpr int kMid[4][2] = {{1, 0}, {2, 1}, {1, 2}, {0, 1}};
-  std::vector<float> events;
-  std::vector<uint32_t> side_a, side_b;
   for (int cj = -1; cj < nv; ++cj) {
     const uint8_t* occ0 = occupied.data() + std::size_t(cj + 1) * ow;
     const uint8_t* occ1 = occ0 + ow;
@@ -198,59 +216,53 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
       const std::span<const Interval> cols[4] = {column(ci, cj), column(ci + 1, cj),
                                                  column(ci + 1, cj + 1), column(ci, cj + 1)};
       if (cols[0].empty() && cols[1].empty() && cols[2].empty() && cols[3].empty()) continue;
-      events.clear();
-      for (const auto& c : cols)
-        for (const Interval& iv : c) {
-          events.push_back(iv.lo);
-          events.push_back(iv.hi);
-        }
-      std::sort(events.begin(), events.end());
-      events.erase(std::unique(events.begin(), events.end()), events.end());
       const int x0 = 2 * ci + 2, y0 = 2 * cj + 2;
-      std::size_t corner_line[4], mid_line[4];
+      // The cell's nine lattice lines: corners 0-3, mid-edges 4-7 (m_k = 4 + k), centre 8.
+      std::size_t line[9];
       for (int k = 0; k < 4; ++k) {
-        corner_line[k] = L.line(x0 + kCorner[k][0], y0 + kCorner[k][1]);
-        mid_line[k] = L.line(x0 + kMid[k][0], y0 + kMid[k][1]);
+        line[k] = L.line(x0 + kCorner[k][0], y0 + kCorner[k][1]);
+        line[4 + k] = L.line(x0 + kMid[k][0], y0 + kMid[k][1]);
       }
-      const std::size_t centre_line = L.line(x0 + 1, y0 + 1);
-      // Internal piece edges q = 0..3: T_q | D_q, line pair (m_{q-1}, m_q);
-      // q = 4..7: D_{q-4} | D_{q-3}, line pair (o, m_{q-4}).
-      const auto edge_lines = [&](int q, int dir, std::size_t* a, std::size_t* b) {
-        std::size_t p0, p1;  // direction with the first piece (T_q or D_{q-4}) inside
-        if (q < 4) {
-          p0 = mid_line[q], p1 = mid_line[(q + 3) & 3];  // T_q inside: m_q -> m_{q-1}
-        } else {
-          p0 = mid_line[q - 4], p1 = centre_line;  // D_k inside: m_k -> o
-        }
-        if (dir > 0) *a = p0, *b = p1; else *a = p1, *b = p0;
+      line[8] = L.line(x0 + 1, y0 + 1);
+      // The centre line holds exactly the end points of the cell's four columns: the events.
+      const float* events = heights.data() + offset[line[8]];
+      const uint32_t n_events = count[line[8]];
+      // Per line a cursor into its sorted heights; events come in increasing order, so every
+      // lookup at the current event moves a cursor forward (no search). Mid-edge and centre
+      // lines hold every event of the cell, a corner line the end points of its column.
+      std::size_t cursor[9], end[9];
+      for (int k = 0; k < 9; ++k) cursor[k] = offset[line[k]], end[k] = cursor[k] + count[line[k]];
+      const auto slot_at = [&](int k, float t) -> std::size_t {
+        std::size_t& c = cursor[k];
+        while (c < end[k] && heights[c] < t) ++c;
+        return c;
       };
-      const auto emit_wall = [&](int q, int dir, float t0, float t1) {
-        std::size_t a, b;
-        edge_lines(q, dir, &a, &b);
-        const auto collect = [&](std::size_t l, std::vector<uint32_t>& out) {
-          out.clear();
-          const float* h = heights.data() + offset[l];
-          const float* lo = std::lower_bound(h, h + count[l], t0);
-          const float* hi = std::upper_bound(h, h + count[l], t1);
-          for (const float* p = lo; p < hi; ++p) out.push_back(vertex_at(l, std::size_t(p - heights.data())));
-        };
-        collect(a, side_a);
-        collect(b, side_b);
-        // Zipper between the two vertical sides, counter-clockwise seen from outside:
-        // polygon a0 -> b0 -> ... -> b_top -> a_top -> ... -> a0.
-        std::size_t i = 0, k = 0;
-        const auto h_of = [&](uint32_t idx) { return mesh.vertices[idx][aa]; };
-        while (i + 1 < side_a.size() || k + 1 < side_b.size()) {
-          const bool advance_b =
-              i + 1 >= side_a.size() ||
-              (k + 1 < side_b.size() &&
-               h_of(side_b[k + 1]) <= h_of(side_a[i + 1]));
-          if (advance_b) {
-            mesh.triangles.push_back({side_a[i], side_b[k], side_b[k + 1]});
-            ++k;
+      // Internal piece edges q = 0..3: T_q | D_q, line pair (m_q, m_{q-1});
+      // q = 4..7: D_{q-4} | D_{q-3}, line pair (m_{q-4}, o); first line when the first piece
+      // (T_q or D_{q-4}) is inside.
+      const auto edge_line = [](int q, int side) -> int {
+        if (q < 4) return side == 0 ? 4 + q : 4 + ((q + 3) & 3);
+        return side == 0 ? 4 + (q - 4) : 8;
+      };
+      std::size_t wall_start[8][2];
+      const auto emit_wall = [&](int q, int dir, float e) {
+        const int la = edge_line(q, dir > 0 ? 0 : 1), lb = edge_line(q, dir > 0 ? 1 : 0);
+        const std::size_t sa = wall_start[q][dir > 0 ? 0 : 1], sb = wall_start[q][dir > 0 ? 1 : 0];
+        const std::size_t ea = slot_at(la, e), eb = slot_at(lb, e);
+        // Zipper between the two vertical sides (every height of each line in [start, e]),
+        // counter-clockwise seen from outside: polygon a0 -> b0 -> ... -> b_top -> a_top -> a0.
+        const std::size_t la_line = line[la], lb_line = line[lb];
+        std::size_t i = sa, k = sb;
+        uint32_t va = vertex_at(la_line, i), vb = vertex_at(lb_line, k);
+        while (i < ea || k < eb) {
+          if (i >= ea || (k < eb && heights[k + 1] <= heights[i + 1])) {
+            const uint32_t vn = vertex_at(lb_line, ++k);
+            mesh.triangles.push_back({va, vb, vn});
+            vb = vn;
           } else {
-            mesh.triangles.push_back({side_a[i], side_b[k], side_a[i + 1]});
-            ++i;
+            const uint32_t vn = vertex_at(la_line, ++i);
+            mesh.triangles.push_back({va, vb, vn});
+            va = vn;
           }
         }
       };
@@ -258,14 +270,14 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
         uint32_t v[3];
         if (piece < 4) {
           const int k = piece;
-          v[0] = vertex(mid_line[(k + 3) & 3], t);
-          v[1] = vertex(corner_line[k], t);
-          v[2] = vertex(mid_line[k], t);
+          v[0] = vertex_at(line[4 + ((k + 3) & 3)], slot_at(4 + ((k + 3) & 3), t));
+          v[1] = vertex_at(line[k], slot_at(k, t));
+          v[2] = vertex_at(line[4 + k], slot_at(4 + k, t));
         } else {
           const int k = piece - 4;
-          v[0] = vertex(centre_line, t);
-          v[1] = vertex(mid_line[(k + 3) & 3], t);
-          v[2] = vertex(mid_line[k], t);
+          v[0] = vertex_at(line[8], slot_at(8, t));
+          v[1] = vertex_at(line[4 + ((k + 3) & 3)], slot_at(4 + ((k + 3) & 3), t));
+          v[2] = vertex_at(line[4 + k], slot_at(4 + k, t));
         }
         if (up) {
           mesh.triangles.push_back({v[0], v[1], v[2]});
@@ -277,14 +289,14 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
       unsigned config = 0;
       std::size_t pos[4] = {0, 0, 0, 0};
       bool inside[4] = {false, false, false, false};
-      float wall_start[8];
-      for (const float e : events) {
+      for (uint32_t ev = 0; ev < n_events; ++ev) {
+        const float e = events[ev];
         unsigned next = config;
         for (int k = 0; k < 4; ++k) {
           const auto& c = cols[k];
           if (pos[k] >= c.size()) continue;
-          const float end = inside[k] ? c[pos[k]].hi : c[pos[k]].lo;
-          if (end == e) {
+          const float edge = inside[k] ? c[pos[k]].hi : c[pos[k]].lo;
+          if (edge == e) {
             if (inside[k]) ++pos[k];
             inside[k] = !inside[k];
             next ^= 1u << k;
@@ -297,11 +309,14 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
         }
         const int8_t* dir0 = kTables.dir[config];
         const int8_t* dir1 = kTables.dir[next];
-        for (int q = 0; q < 8; ++q) {
+        for (unsigned walls = kTables.dir_change[config][next]; walls != 0; walls &= walls - 1) {
+          const int q = __builtin_ctz(walls);
           const int d0 = dir0[q], d1 = dir1[q];
-          if (d0 == d1) continue;
-          if (d0 != 0) emit_wall(q, d0, wall_start[q], e);
-          if (d1 != 0) wall_start[q] = e;
+          if (d0 != 0) emit_wall(q, d0, e);
+          if (d1 != 0) {
+            wall_start[q][0] = slot_at(edge_line(q, 0), e);
+            wall_start[q][1] = slot_at(edge_line(q, 1), e);
+          }
         }
         config = next;
       }
