@@ -1,11 +1,11 @@
 // studio-hull offline, run as a process: a mesh from a synthetic studio's masks, and one clear
 // error line each for a missing camera mask, a mask of the wrong size and an empty box.
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "core/rig.h"
@@ -23,8 +23,8 @@ struct Result {
 };
 
 Result run(const std::string& args, const fs::path& dir) {
-  const std::string cmd = std::string(STUDIO_HULL_CLI) + " " + args + " >" + (dir / "out.txt").string() +
-                          " 2>" + (dir / "err.txt").string();
+  const std::string cmd = std::string(STUDIO_HULL_CLI) + " " + args + " >" +
+                          (dir / "out.txt").string() + " 2>" + (dir / "err.txt").string();
   const int status = std::system(cmd.c_str());
   const auto slurp = [](const fs::path& p) {
     std::ifstream f(p);
@@ -70,8 +70,8 @@ TEST_F(HullCli, SingleFrameAndSequenceWithTiming) {
   // The sequence: masks/7 and masks/8 exist beside the single-frame pngs; a folder of only frames.
   for (const auto& e : fs::directory_iterator(dir_ / "masks"))
     if (e.is_regular_file()) fs::remove(e.path());
-  r = run(base_ + "--masks " + (dir_ / "masks").string() + " --box -1,0,-1,1,2,1 --frames 8:9 --out " +
-              (dir_ / "seq").string(),
+  r = run(base_ + "--masks " + (dir_ / "masks").string() +
+              " --box -1,0,-1,1,2,1 --frames 8:9 --out " + (dir_ / "seq").string(),
           dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "seq" / "8.ply"));
@@ -93,8 +93,8 @@ TEST_F(HullCli, RejectsMissingMask) {
 TEST_F(HullCli, RejectsMaskOfWrongSize) {
   cv::Mat small(100, 120, CV_8U, cv::Scalar(0));
   ASSERT_TRUE(cv::imwrite((dir_ / "masks" / "cam1.png").string(), small));
-  const Result r = run(base_ + "--masks " + (dir_ / "masks").string() + " --box -1,0,-1,1,2,1 --out " +
-                           (dir_ / "a.ply").string(),
+  const Result r = run(base_ + "--masks " + (dir_ / "masks").string() +
+                           " --box -1,0,-1,1,2,1 --out " + (dir_ / "a.ply").string(),
                        dir_);
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.err.find("mask is 120x100, camera cam1 is 352x288"), std::string::npos) << r.err;
@@ -102,8 +102,8 @@ TEST_F(HullCli, RejectsMaskOfWrongSize) {
 }
 
 TEST_F(HullCli, RejectsEmptyBox) {
-  const Result r = run(base_ + "--masks " + (dir_ / "masks").string() + " --box -1,0,-1,1,0,1 --out " +
-                           (dir_ / "a.ply").string(),
+  const Result r = run(base_ + "--masks " + (dir_ / "masks").string() +
+                           " --box -1,0,-1,1,0,1 --out " + (dir_ / "a.ply").string(),
                        dir_);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("box: empty along y"), std::string::npos) << r.err;

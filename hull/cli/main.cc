@@ -33,7 +33,8 @@ using namespace studio::hull;
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: studio-hull --config hull.yaml      the real-time DDS service (keys below)
+constexpr const char* kUsage =
+    R"(usage: studio-hull --config hull.yaml      the real-time DDS service (keys below)
        studio-hull offline --rig rig.yaml (--masks DIR | --take DIR) --box X0,Y0,Z0,X1,Y1,Z1
                            --grid N [--axis x|y|z] [--frames A:B] --out FILE|DIR
                            [--format ply|obj|glb] [--keyer keyer.yaml | --key blue|green]
@@ -103,18 +104,24 @@ Expected<Args> parse(int argc, char** argv) {
     }
     auto v = value();
     if (!v) return std::unexpected(v.error());
-    if (opt == "--rig") a.rig = *v;
-    else if (opt == "--masks") a.masks = *v;
-    else if (opt == "--take") a.take = *v;
-    else if (opt == "--keyer") a.keyer_file = *v;
+    if (opt == "--rig")
+      a.rig = *v;
+    else if (opt == "--masks")
+      a.masks = *v;
+    else if (opt == "--take")
+      a.take = *v;
+    else if (opt == "--keyer")
+      a.keyer_file = *v;
     else if (opt == "--key") {
       auto m = keyer::parse_key_mode(*v);
       if (!m || *m == keyer::KeyMode::kDifference) {
         return fail("--key: '" + *v + "': expected blue or green");
       }
       a.key = *m;
-    } else if (opt == "--out") a.out = *v;
-    else if (opt == "--format") a.format = *v;
+    } else if (opt == "--out")
+      a.out = *v;
+    else if (opt == "--format")
+      a.format = *v;
     else if (opt == "--box") {
       std::vector<double> n;
       std::stringstream ss(*v);
@@ -155,15 +162,19 @@ Expected<Args> parse(int argc, char** argv) {
       }
       a.frames = cli::FrameRange{lo, hi};
     } else if (opt == "--outside") {
-      if (*v == "keep") a.outside = Outside::keep;
-      else if (*v == "cut") a.outside = Outside::cut;
-      else return fail("--outside: '" + *v + "': expected keep or cut");
+      if (*v == "keep")
+        a.outside = Outside::keep;
+      else if (*v == "cut")
+        a.outside = Outside::cut;
+      else
+        return fail("--outside: '" + *v + "': expected keep or cut");
     } else {
       return fail("unknown option " + opt + " (see --help)");
     }
   }
   if (a.rig.empty()) return fail("--rig is required");
-  if (a.masks.empty() == a.take.empty()) return fail("give exactly one of --masks DIR or --take DIR");
+  if (a.masks.empty() == a.take.empty())
+    return fail("give exactly one of --masks DIR or --take DIR");
   if (!a.keyer_file.empty() && a.key) return fail("give --keyer FILE or --key, not both");
   if (a.take.empty() && (!a.keyer_file.empty() || a.key)) {
     return fail("--keyer/--key only apply to --take (masks are already keyed)");
@@ -297,8 +308,7 @@ int run_offline(int argc, char** argv) {
       const double refine = ms_since(t0);
       t0 = std::chrono::steady_clock::now();
       const std::string out =
-          one_file ? args->out
-                   : (fs::path(args->out) / (frames[k] + "." + args->format)).string();
+          one_file ? args->out : (fs::path(args->out) / (frames[k] + "." + args->format)).string();
       if (auto w = write_mesh(mesh, out); !w) return give_up(w.error().message);
       const double write = ms_since(t0);
       std::lock_guard g(lock);
@@ -343,9 +353,10 @@ int main(int argc, char** argv) {
   const std::string verb = argc > 1 ? argv[1] : "";
   if (verb == "-h" || verb == "--help" || verb == "help") {
     const auto service = hull_service_definition();
-    std::cout << kUsage << "\nService config (studio-hull --config FILE): " << service.summary << "\n"
-              << service.config_help
-              << "  plus the common service keys: instance, domain, dds_config, status_period, log\n";
+    std::cout
+        << kUsage << "\nService config (studio-hull --config FILE): " << service.summary << "\n"
+        << service.config_help
+        << "  plus the common service keys: instance, domain, dds_config, status_period, log\n";
     return 0;
   }
   if (verb == "--config" || verb.starts_with("--config=")) {
@@ -365,7 +376,8 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  std::cerr << "studio-hull: " << (verb.empty() ? "missing command" : "unknown command '" + verb + "'")
+  std::cerr << "studio-hull: "
+            << (verb.empty() ? "missing command" : "unknown command '" + verb + "'")
             << " (usage: studio-hull offline ...; see --help)\n";
   return 2;
 }

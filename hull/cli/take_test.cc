@@ -188,8 +188,8 @@ TEST_F(HullCliTake, KeysOnTheFlyAndMatchesTheMaskFolderRoute) {
     EXPECT_LT(worst, 1e-6f) << name;
     // Keyed on the fly vs the simulator's true masks (at 352x288 the actor is ~70 px wide, so the
     // keyer's half-coverage edge decisions, intersected over 6 views, cost a few % of volume;
-    // measured 1.4 .. 6.7 % smaller): volumes within 10 %, and the keyed mesh re-projects onto the true
-    // masks (measured worst IoU 0.917-0.948; the true masks' own mesh gives the ceiling).
+    // measured 1.4 .. 6.7 % smaller): volumes within 10 %, and the keyed mesh re-projects onto the
+    // true masks (measured worst IoU 0.917-0.948; the true masks' own mesh gives the ceiling).
     const double vt = take->volume(), vs = truth->volume();
     const double iou = worst_iou(*take, f), ceiling = worst_iou(*truth, f);
     std::printf(

@@ -1,4 +1,3 @@
-#include "core/clock.h"
 #include "hull_node.h"
 
 #include <atomic>
@@ -6,6 +5,7 @@
 #include <cmath>
 #include <thread>
 
+#include "core/clock.h"
 #include "core/frame_assembler.h"
 #include "core/log.h"
 #include "hull/crossing_refine.h"
@@ -22,7 +22,6 @@ namespace {
 
 constexpr const char* kLog = "hull";
 using SteadyClock = std::chrono::steady_clock;
-
 
 void mesh_to_wire(const Mesh& mesh, studio_ActorMesh& s) {
   std::vector<float> v, n;
@@ -83,9 +82,9 @@ class HullNode : public runtime::Node {
     if (auto r = waitset->attach(*cals, 2); !r) return std::unexpected(r.error());
     if (auto r = waitset->attach(*guard, 3); !r) return std::unexpected(r.error());
 
-    io_.emplace(Io{std::move(*mask_topic), std::move(*cal_topic), std::move(*seg_topic), std::move(*mesh_topic),
-                   std::move(*masks), std::move(*cals), std::move(*segs), std::move(*meshes), std::move(*waitset),
-                   std::move(*guard)});
+    io_.emplace(Io{std::move(*mask_topic), std::move(*cal_topic), std::move(*seg_topic),
+                   std::move(*mesh_topic), std::move(*masks), std::move(*cals), std::move(*segs),
+                   std::move(*meshes), std::move(*waitset), std::move(*guard)});
     running_ = true;
     worker_ = std::thread([this] { run(); });
     return {};
@@ -130,8 +129,8 @@ class HullNode : public runtime::Node {
     wire::GuardCondition guard;
   };
 
-  static typename FrameAssembler<RunMask>::Options make_assembler_options(const HullNodeOptions& o,
-                                                                         const std::vector<Camera>& cams) {
+  static typename FrameAssembler<RunMask>::Options make_assembler_options(
+      const HullNodeOptions& o, const std::vector<Camera>& cams) {
     typename FrameAssembler<RunMask>::Options a;
     for (const Camera& c : cams) a.sources.push_back(c.id);
     a.deadline = std::chrono::microseconds(int64_t(o.deadline_ms * 1000));
@@ -160,11 +159,12 @@ class HullNode : public runtime::Node {
           return;
         }
         const int index = assembler_.source_index(s.camera_id);
-        if (index >= 0 && (mask->width() != cameras_[index].width || mask->height() != cameras_[index].height)) {
+        if (index >= 0 &&
+            (mask->width() != cameras_[index].width || mask->height() != cameras_[index].height)) {
           masks_bad_.add();
-          STUDIO_LOG(warn, kLog) << "mask " << s.camera_id << ": " << mask->width() << "x" << mask->height()
-                                 << " differs from the camera's " << cameras_[index].width << "x"
-                                 << cameras_[index].height;
+          STUDIO_LOG(warn, kLog) << "mask " << s.camera_id << ": " << mask->width() << "x"
+                                 << mask->height() << " differs from the camera's "
+                                 << cameras_[index].width << "x" << cameras_[index].height;
           return;
         }
         assembler_.add(s.camera_id, s.frame, s.capture_ns, std::move(*mask), SteadyClock::now());
@@ -197,7 +197,8 @@ class HullNode : public runtime::Node {
     const std::vector<SegmentSet> actors = connected_components(*hull, options_.min_actor_volume);
     for (std::size_t k = 0; k < actors.size(); ++k)
       publish(actors[k], options_.actor_prefix + std::to_string(k), frame, views, cut);
-    for (std::size_t k = actors.size(); k < published_actors_; ++k) dispose(options_.actor_prefix + std::to_string(k));
+    for (std::size_t k = actors.size(); k < published_actors_; ++k)
+      dispose(options_.actor_prefix + std::to_string(k));
     published_actors_ = actors.size();
     metrics_.latency().record(realtime_ns() - frame.capture_ns);
     last_frame_ = frame.frame;
@@ -205,8 +206,9 @@ class HullNode : public runtime::Node {
     last_partial_ = views.size() < cameras_.size();
   }
 
-  void publish(const SegmentSet& set, const std::string& actor_id, const FrameAssembler<RunMask>::Frame& frame,
-               std::span<const View> views, const CutOptions& cut) {
+  void publish(const SegmentSet& set, const std::string& actor_id,
+               const FrameAssembler<RunMask>::Frame& frame, std::span<const View> views,
+               const CutOptions& cut) {
     wire::Owned<studio_SegmentSet> s;
     wire::set(s->actor_id, actor_id);
     s->frame = frame.frame;
@@ -253,8 +255,8 @@ class HullNode : public runtime::Node {
   std::vector<Camera> cameras_;
   const wire::Participant& participant_;
   runtime::Metrics& metrics_;
-  runtime::Counter &masks_in_, &masks_bad_, &frames_complete_, &frames_partial_, &frames_dropped_, &masks_late_,
-      &hulls_out_, &meshes_out_, &calibrations_in_;
+  runtime::Counter &masks_in_, &masks_bad_, &frames_complete_, &frames_partial_, &frames_dropped_,
+      &masks_late_, &hulls_out_, &meshes_out_, &calibrations_in_;
   FrameAssembler<RunMask> assembler_;
   FrameAssemblerCounts seen_;
   std::optional<Io> io_;
@@ -274,7 +276,8 @@ Expected<void> HullNodeOptions::validate() const {
   if (box.size() != 6) return fail("box: expected 6 numbers x0,y0,z0,x1,y1,z1");
   if (auto g = grid_spec().validate(); !g) return g;
   if (min_cameras < 1) return fail("min_cameras: must be >= 1");
-  if (actor_prefix.empty() || actor_prefix.size() > 40) return fail("actor_prefix: 1..40 characters");
+  if (actor_prefix.empty() || actor_prefix.size() > 40)
+    return fail("actor_prefix: 1..40 characters");
   return {};
 }
 
@@ -290,7 +293,8 @@ GridSpec HullNodeOptions::grid_spec() const {
   return g;
 }
 
-Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& options, std::vector<Camera> cameras,
+Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& options,
+                                                        std::vector<Camera> cameras,
                                                         runtime::NodeContext& context) {
   if (auto v = options.validate(); !v) return std::unexpected(v.error());
   if (cameras.empty()) return fail("rig " + options.rig + ": no cameras");
@@ -303,7 +307,8 @@ Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& o
 runtime::ServiceDefinition hull_service_definition() {
   runtime::ServiceDefinition d;
   d.name = "hull";
-  d.summary = "Real-time line-segment visual hull: masks of every camera -> per-actor segments and mesh.";
+  d.summary =
+      "Real-time line-segment visual hull: masks of every camera -> per-actor segments and mesh.";
   d.config_help =
       "  hull:                     (required section)\n"
       "    rig: FILE               rig.yaml with the cameras (relative to the config file)\n"
@@ -318,17 +323,20 @@ runtime::ServiceDefinition hull_service_definition() {
       "    refine: true            exact crossings on the mesh (else half-cell vertices)\n"
       "    min_actor_volume: 0.01  smaller components (m^3) are noise\n"
       "    actor_prefix: actor     actor ids <prefix>0, <prefix>1, ... largest first\n";
-  d.create = [](yaml::MapReader& config, runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
+  d.create = [](yaml::MapReader& config,
+                runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto section = config.required("hull");
     if (!section) return std::unexpected(section.error());
     static const yaml::Schema<HullNodeOptions> schema{
         yaml::field("rig", &HullNodeOptions::rig).required().relative_path(),
         yaml::field("box", &HullNodeOptions::box).required().size(6),
         yaml::field("grid", &HullNodeOptions::grid).range(8, 2048),
-        yaml::enum_field("axis", &HullNodeOptions::axis, {{"x", Axis::x}, {"y", Axis::y}, {"z", Axis::z}}),
+        yaml::enum_field("axis", &HullNodeOptions::axis,
+                         {{"x", Axis::x}, {"y", Axis::y}, {"z", Axis::z}}),
         yaml::field("deadline_ms", &HullNodeOptions::deadline_ms).range(1, 1000),
         yaml::field("min_cameras", &HullNodeOptions::min_cameras).range(1, 64),
-        yaml::enum_field("outside", &HullNodeOptions::outside, {{"keep", Outside::keep}, {"cut", Outside::cut}}),
+        yaml::enum_field("outside", &HullNodeOptions::outside,
+                         {{"keep", Outside::keep}, {"cut", Outside::cut}}),
         yaml::field("threads", &HullNodeOptions::threads).range(1, 64),
         yaml::field("mesh", &HullNodeOptions::mesh),
         yaml::field("refine", &HullNodeOptions::refine),
