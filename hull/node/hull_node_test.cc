@@ -1,7 +1,8 @@
 // The hull service as a real process on loopback: simulated-studio masks in over DDS, per-actor
 // segments and a watertight mesh out, stamped with the masks' frame and capture time; a missing
 // camera is waited for until the deadline and then the frame goes out without it; bad config is
-// one line.
+// one line. refine: true (default) publishes the mesh with exact crossings, refine: false the
+// half-cell one.
 #include "hull_node.h"
 
 #include <gtest/gtest.h>
@@ -87,11 +88,14 @@ class HullNodeTest : public testing::ProcessTest {
     return out;
   }
 
+  void masks_in_segments_and_mesh_out(bool refine);
+
   std::vector<Camera> cameras_;
   std::optional<sim::SimulatedStudio> studio_;
 };
 
-TEST_F(HullNodeTest, MasksInSegmentsAndMeshOut) {
+// Masks of every camera in; segments and mesh out; `refine` is the config's refine key.
+void HullNodeTest::masks_in_segments_and_mesh_out(bool refine) {
   auto p = wire::Participant::create().value();
   auto mask_topic = wire::Topic<studio_AlphaMask>::create(p).value();
   auto masks = wire::Writer<studio_AlphaMask>::create(p, mask_topic).value();
@@ -103,7 +107,8 @@ TEST_F(HullNodeTest, MasksInSegmentsAndMeshOut) {
   auto& hull = spawn(
       "hull", "hull/studio-hull",
       {"--config",
-       write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 96\n  deadline_ms: 200\n")});
+       write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 96\n  deadline_ms: 200\n" +
+                    std::string(refine ? "" : "  refine: false\n"))});
   ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
   ASSERT_TRUE(masks.wait_for_readers(1, 10s));
 
@@ -160,7 +165,7 @@ TEST_F(HullNodeTest, MasksInSegmentsAndMeshOut) {
   EXPECT_EQ((*mesh)->source_frame, (*mesh)->frame);
 
   // refine: true (the default): the published mesh is the actor's segment marching cubes mesh
-  // with exact crossings, not the half-cell one.
+  // with exact crossings; refine: false: the half-cell one.
   const auto [plain, exact] = local_meshes(int64_t((*mesh)->frame), options);
   ASSERT_EQ(m.vertices.size(), exact.vertices.size());
   float off_exact = 0, off_plain = 0;
@@ -168,10 +173,14 @@ TEST_F(HullNodeTest, MasksInSegmentsAndMeshOut) {
     off_exact = std::max(off_exact, (m.vertices[k] - exact.vertices[k]).norm());
     off_plain = std::max(off_plain, (m.vertices[k] - plain.vertices[k]).norm());
   }
-  EXPECT_LT(off_exact, 1e-5f);
-  EXPECT_GT(off_plain, 0.2f * float(options.grid_spec().du()));
+  const float cell = float(options.grid_spec().du());
+  EXPECT_LT(refine ? off_exact : off_plain, 1e-5f);
+  EXPECT_GT(refine ? off_plain : off_exact, 0.2f * cell);
   EXPECT_EQ(hull.stop(), 0) << hull.log();
 }
+
+TEST_F(HullNodeTest, MasksInSegmentsAndMeshOut) { masks_in_segments_and_mesh_out(true); }
+TEST_F(HullNodeTest, RefineOffPublishesTheHalfCellMesh) { masks_in_segments_and_mesh_out(false); }
 
 TEST_F(HullNodeTest, MissingCameraWaitsForTheDeadlineThenGoesWithout) {
   auto p = wire::Participant::create().value();
