@@ -62,6 +62,13 @@ constexpr Tables make_tables() {
 }
 constexpr Tables kTables = make_tables();
 
+struct Scratch {
+  std::vector<uint32_t> offset, fill, count;
+  std::vector<uint8_t> occupied;
+  std::vector<float> heights;
+  std::vector<int32_t> vertex_of;
+};
+
 }  // namespace
 
 double Mesh::volume() const {
@@ -128,7 +135,11 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
 
   // Heights on every lattice line: the end points of the columns whose cells touch the line.
   const std::size_t lines = std::size_t(L.X) * L.Y;
-  std::vector<uint32_t> offset(lines + 1, 0);
+  // Working memory kept per thread between calls (a frame loop meshes every frame): assign()
+  // reuses the capacity, so steady-state frames allocate only the output.
+  thread_local Scratch scratch;
+  std::vector<uint32_t>& offset = scratch.offset;
+  offset.assign(lines + 1, 0);
   const auto for_lines_of_column = [&](int i, int j, auto&& f) {
     const int x = 2 * i + 2, y = 2 * j + 2;
     f(L.line(x, y));
@@ -142,7 +153,8 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
   // Occupancy of the columns with the empty ring, (i + 1) + (j + 1) * (nu + 2): empty cells are
   // skipped with four byte loads.
   const std::size_t ow = std::size_t(nu) + 2;
-  std::vector<uint8_t> occupied(ow * (std::size_t(nv) + 2), 0);
+  std::vector<uint8_t>& occupied = scratch.occupied;
+  occupied.assign(ow * (std::size_t(nv) + 2), 0);
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
       const uint32_t n = uint32_t(2 * column(i, j).size());
@@ -151,8 +163,10 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
       for_lines_of_column(i, j, [&](std::size_t l) { offset[l + 1] += n; });
     }
   for (std::size_t l = 0; l < lines; ++l) offset[l + 1] += offset[l];
-  std::vector<float> heights(offset.back());
-  std::vector<uint32_t> fill(offset.begin(), offset.end() - 1);
+  std::vector<float>& heights = scratch.heights;
+  heights.resize(offset.back());
+  std::vector<uint32_t>& fill = scratch.fill;
+  fill.assign(offset.begin(), offset.end() - 1);
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
       const auto col = column(i, j);
@@ -164,7 +178,8 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
         }
       });
     }
-  std::vector<uint32_t> count(lines, 0);
+  std::vector<uint32_t>& count = scratch.count;
+  count.assign(lines, 0);
   for (std::size_t l = 0; l < lines; ++l) {
     float* b = heights.data() + offset[l];
     float* e = heights.data() + offset[l + 1];
@@ -181,7 +196,8 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
     }
     count[l] = uint32_t(std::unique(b, e) - b);
   }
-  std::vector<int32_t> vertex_of(heights.size(), -1);
+  std::vector<int32_t>& vertex_of = scratch.vertex_of;
+  vertex_of.assign(heights.size(), -1);
 
   Mesh mesh;
   mesh.vertices.reserve(heights.size());  // untouched reserve costs address space only

@@ -33,6 +33,8 @@ struct Mesh {
   double volume() const;
 };
 
+// Cost follows the occupied part of the grid (the bounding rectangle of the non-empty columns).
+// Keeps its working memory per thread between calls, so a frame loop does not reallocate it.
 Mesh segment_marching_cubes(const SegmentSet& set);
 
 // (Re)computes mesh.normals: unit area-weighted vertex normals (zero for isolated vertices).
