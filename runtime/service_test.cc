@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <cstdio>
 #include <fstream>
 
 #include "harness/fixture.h"
@@ -93,6 +94,42 @@ TEST_F(ServiceTest, LifecycleNotifiesAndPublishesStatus) {
   }
   EXPECT_TRUE(stopping);
   EXPECT_EQ(p.wait_exit(10s), 0) << p.log();
+}
+
+// A service killed without a word (kill -9: no dispose, no unregister) disappears from every
+// status reader when its liveliness lease (3 s, wire QoS table) runs out: the reader's writer
+// loses liveliness and the service's instance turns not-alive.
+TEST_F(ServiceTest, KilledServiceLosesLivelinessWhenItsLeaseExpires) {
+  auto participant = wire::Participant::create().value();
+  auto topic = wire::Topic<studio_ServiceStatus>::create(participant).value();
+  auto reader = wire::Reader<studio_ServiceStatus>::create(participant, topic).value();
+  const std::string path = write_config("instance: doomed\nstatus_period: 0.2\n");
+  auto& p = spawn("probe", "runtime/probe_service", {"--config", path});
+  ASSERT_TRUE(p.wait_ready(20s)) << p.log();
+  auto deadline = std::chrono::steady_clock::now() + 15s;
+  bool heard = false;
+  while (!heard && std::chrono::steady_clock::now() < deadline) {
+    for (auto& s : reader.take()) heard |= s.meta.valid_data && s.meta.alive;
+    std::this_thread::sleep_for(50ms);
+  }
+  ASSERT_TRUE(heard);
+  ASSERT_EQ(reader.alive_writers(), 1u);
+
+  ASSERT_EQ(::kill(p.pid(), SIGKILL), 0);
+  const auto killed = std::chrono::steady_clock::now();
+  bool not_alive = false;
+  deadline = killed + 10s;
+  while (!(not_alive && reader.alive_writers() == 0) && std::chrono::steady_clock::now() < deadline) {
+    for (auto& s : reader.take()) not_alive |= !s.meta.alive;
+    std::this_thread::sleep_for(20ms);
+  }
+  const double gone_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+  EXPECT_TRUE(not_alive);
+  EXPECT_EQ(reader.alive_writers(), 0u);
+  // Found by the lease, not by a goodbye message (which would take milliseconds), and soon after.
+  EXPECT_GT(gone_s, 1.0);
+  EXPECT_LT(gone_s, 6.0);
+  std::printf("status writer gone %.2f s after kill -9 (lease 3 s)\n", gone_s);
 }
 
 TEST_F(ServiceTest, PingsTheWatchdogWhenAsked) {

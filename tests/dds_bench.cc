@@ -10,16 +10,34 @@
 // A ping without its pong within 100 ms counts as lost. The baseline does the same with UDP
 // datagrams to "wire_peer udp-echo". Counters: p50_us, p99_us, max_us, lost (DDS), udp_p50_us,
 // udp_p99_us, udp_lost, ratio_p50 / ratio_p99 (DDS / UDP), bytes.
+//
+// Two delivery modes, both measured: /waitset (the reader's waitset wakes an application
+// thread, as the service nodes do today: two thread wake-ups per hop) and /listener (the
+// reader's data-available callback runs on Cyclone's receive thread; the peer echoes from it and
+// this process stamps the arrival in it: one wake-up per hop, like the UDP baseline).
+//
+// Scheduling: the studio runs its latency-critical services SCHED_FIFO on a dedicated core (as a
+// systemd unit would with CPUSchedulingPolicy=fifo and CPUAffinity). When allowed (root or
+// CAP_SYS_NICE) this bench measures that configuration: itself and both peers (they inherit it)
+// SCHED_FIFO 50 on the last CPU, so a hop never waits for a busy time-shared CPU nor for an
+// inter-processor wake-up, DDS and UDP alike. Counter `realtime` says which configuration ran;
+// STUDIO_BENCH_REALTIME=0 measures the default time-sharing scheduler instead.
 
 #include <arpa/inet.h>
 #include <benchmark/benchmark.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <sched.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <condition_variable>
 #include <cstring>
+#include <mutex>
 #include <random>
 #include <thread>
 #include <vector>
@@ -145,7 +163,7 @@ Stats run_udp(testing::Process& peer, int port, const std::vector<uint8_t>& payl
   return s;
 }
 
-Stats run_dds(const std::vector<uint8_t>& payload) {
+Stats run_dds(const std::vector<uint8_t>& payload, bool listener) {
   auto p = wire::Participant::create().value();
   auto ping_topic = wire::Topic<studio_AlphaMask>::create(p, "studio/bench/ping").value();
   auto pong_topic = wire::Topic<studio_AlphaMask>::create(p, "studio/bench/pong").value();
@@ -153,6 +171,25 @@ Stats run_dds(const std::vector<uint8_t>& payload) {
   auto reader = wire::Reader<studio_AlphaMask>::create(p, pong_topic).value();
   auto ws = wire::WaitSet::create(p).value();
   ws.attach(reader, 1).value();
+  // Listener mode: the callback stamps the arrival of pong `want` (-1: none yet).
+  std::mutex mu;
+  std::condition_variable cv;
+  uint64_t want = 0;
+  int64_t arrived_rtt = -1;
+  if (listener) {
+    reader
+        .on_data_available([&] {
+          reader.visit([&](const studio_AlphaMask& m, const wire::SampleMeta& meta) {
+            const int64_t t = now_ns();
+            std::lock_guard lock(mu);
+            if (meta.valid_data && m.frame == want) {
+              arrived_rtt = t - m.capture_ns;
+              cv.notify_one();
+            }
+          });
+        })
+        .value();
+  }
   if (!writer.wait_for_readers(1, 15s)) throw std::runtime_error("dds_bench: peer never matched");
   const auto deadline = Clock::now() + 15s;
   while (reader.matched_writers() < 1 && Clock::now() < deadline) std::this_thread::sleep_for(5ms);
@@ -164,11 +201,21 @@ Stats run_dds(const std::vector<uint8_t>& payload) {
   mask->encoding = studio_MASK_CODEC;
   wire::assign(mask->data, payload);
   auto ping = [&](int i) {
+    {
+      std::lock_guard lock(mu);
+      want = uint64_t(i);
+      arrived_rtt = -1;
+    }
     mask->frame = uint64_t(i);
     mask->capture_ns = now_ns();
     (void)writer.write(*mask);
   };
   auto pong = [&](int i, Clock::time_point until) -> int64_t {
+    if (listener) {
+      std::unique_lock lock(mu);
+      cv.wait_until(lock, until, [&] { return arrived_rtt >= 0; });
+      return arrived_rtt;
+    }
     int64_t rtt = -1;
     while (rtt < 0) {
       const auto left = until - Clock::now();
@@ -180,7 +227,27 @@ Stats run_dds(const std::vector<uint8_t>& payload) {
     }
     return rtt;
   };
-  return paced(ping, pong);
+  Stats s = paced(ping, pong);
+  if (listener) reader.on_data_available(nullptr).value();
+  return s;
+}
+
+bool g_realtime = false;
+
+// SCHED_FIFO on the last CPU for this process and everything it starts later (threads, peers).
+bool enter_realtime() {
+  if (const char* e = std::getenv("STUDIO_BENCH_REALTIME"); e && std::string(e) == "0") return false;
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+  CPU_SET(int(cpus > 0 ? cpus - 1 : 0), &one);
+  const sched_param prio{.sched_priority = 50};
+  if (sched_setaffinity(0, sizeof one, &one) != 0 || sched_setscheduler(0, SCHED_FIFO, &prio) != 0) {
+    std::fprintf(stderr, "dds_bench: no real-time scheduling here (%s); measuring time-sharing\n",
+                 std::strerror(errno));
+    return false;
+  }
+  return true;
 }
 
 void BM_Mask4kLoopback1kHz(benchmark::State& state) {
@@ -200,13 +267,17 @@ void BM_Mask4kLoopback1kHz(benchmark::State& state) {
     return std::move(*p);
   };
   auto udp_peer = start("udp-echo", {"udp-echo", std::to_string(port)});
-  auto dds_peer = start("bench-echo", {"bench-echo"});
+  const bool listener = state.range(0) == 1;
+  std::vector<std::string> echo_args{"bench-echo"};
+  if (listener) echo_args.push_back("--listener");
+  auto dds_peer = start("bench-echo", echo_args);
   Stats d, u;
   for (auto _ : state) {
     u = run_udp(udp_peer, port, payload);
-    d = run_dds(payload);
+    d = run_dds(payload, listener);
   }
   state.counters["bytes"] = double(payload.size());
+  state.counters["realtime"] = g_realtime ? 1 : 0;
   state.counters["p50_us"] = d.p50_us;
   state.counters["p99_us"] = d.p99_us;
   state.counters["max_us"] = d.max_us;
@@ -221,8 +292,21 @@ void BM_Mask4kLoopback1kHz(benchmark::State& state) {
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);
 }
-BENCHMARK(BM_Mask4kLoopback1kHz)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Mask4kLoopback1kHz)
+    ->ArgName("listener")
+    ->Arg(0)
+    ->Arg(1)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  g_realtime = enter_realtime();  // before Cyclone creates any thread
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -8,7 +8,8 @@
 //                         (transient-local), then serves SceneCommands: REMOVE_NODE disposes a
 //                         node; LOAD_SET "malformed" writes malformed samples followed by a valid
 //                         sentinel calibration "cam2"
-//   wire_peer bench-echo  AlphaMask from "studio/bench/ping" back to "studio/bench/pong"
+//   wire_peer bench-echo [--listener]  AlphaMask from "studio/bench/ping" back to
+//                                      "studio/bench/pong" (from a waitset or the listener)
 //   wire_peer udp-echo PORT   baseline: echoes UDP datagrams on 127.0.0.1:PORT
 
 #include <arpa/inet.h>
@@ -178,10 +179,18 @@ int run_publisher(runtime::SignalWatcher& signals) {
   return serve(p, {&pub}, signals);
 }
 
-int run_bench_echo(runtime::SignalWatcher& signals) {
+// --listener: echo from the reader's data-available callback on Cyclone's receive thread
+// instead of a waitset on the main thread (one wake-up per sample instead of two).
+int run_bench_echo(bool listener, runtime::SignalWatcher& signals) {
   auto p = wire::Participant::create().value();
   Echo<studio_AlphaMask> echo(p, "studio/bench/ping", "studio/bench/pong");
-  return serve(p, {&echo}, signals);
+  if (!listener) return serve(p, {&echo}, signals);
+  echo.reader.on_data_available([&echo] { echo.pump(); }).value();
+  runtime::notify("READY=1");
+  signals.wait(std::chrono::milliseconds(-1));
+  runtime::notify("STOPPING=1");
+  echo.reader.on_data_available(nullptr).value();
+  return 0;
 }
 
 int run_udp_echo(int port, runtime::SignalWatcher& signals) {
@@ -214,7 +223,7 @@ int run_udp_echo(int port, runtime::SignalWatcher& signals) {
 
 void usage(FILE* out) {
   std::fputs(
-      "usage: wire_peer echo | publisher | bench-echo | udp-echo PORT\n"
+      "usage: wire_peer echo | publisher | bench-echo [--listener] | udp-echo PORT\n"
       "Test peer for the wire integration tests and dds_bench (joins $STUDIO_DDS_DOMAIN with\n"
       "$CYCLONEDDS_URI, sends READY=1 to $NOTIFY_SOCKET, runs until SIGTERM).\n",
       out);
@@ -236,7 +245,8 @@ int main(int argc, char** argv) {
   try {
     if (mode == "echo") return run_echo(signals);
     if (mode == "publisher") return run_publisher(signals);
-    if (mode == "bench-echo") return run_bench_echo(signals);
+    if (mode == "bench-echo" && argc <= 3)
+      return run_bench_echo(argc == 3 && std::string(argv[2]) == "--listener", signals);
     if (mode == "udp-echo" && argc == 3) return run_udp_echo(std::atoi(argv[2]), signals);
   } catch (const std::bad_expected_access<studio::Error>& e) {
     std::fprintf(stderr, "wire_peer: %s\n", e.error().message.c_str());

@@ -82,6 +82,51 @@ Expected<Entity> ReaderBase::make(const Participant& p, dds_entity_t topic, Topi
   return Entity(e);
 }
 
+ReaderBase& ReaderBase::operator=(ReaderBase&& other) noexcept {
+  if (this != &other) {
+    remove_listener();
+    entity_ = std::move(other.entity_);
+    on_data_ = std::move(other.on_data_);
+    row_ = other.row_;
+    rejected_ = other.rejected_;
+    logged_ = other.logged_;
+  }
+  return *this;
+}
+
+ReaderBase::~ReaderBase() {
+  remove_listener();
+  entity_.reset();
+}
+
+// Without this, a callback can still run (and fail to take) while dds_delete tears the reader
+// down; dds_set_listener waits for a callback in progress.
+void ReaderBase::remove_listener() {
+  if (on_data_ && entity_) dds_set_listener(entity_.handle(), nullptr);
+  on_data_.reset();
+}
+
+Expected<void> ReaderBase::on_data_available(std::function<void()> f) {
+  auto next = f ? std::make_unique<std::function<void()>>(std::move(f)) : nullptr;
+  dds_listener_t* listener = dds_create_listener(next.get());
+  if (next) {
+    dds_lset_data_available(listener, [](dds_entity_t, void* arg) {
+      try {
+        (*static_cast<std::function<void()>*>(arg))();
+      } catch (const std::exception& e) {
+        STUDIO_LOG(error, "dds") << "data-available callback threw: " << e.what();
+      }
+    });
+  }
+  // Cyclone waits for a callback in progress before it swaps the listener, so the old
+  // function object can be freed afterwards.
+  const dds_return_t rc = dds_set_listener(entity_.handle(), next ? listener : nullptr);
+  dds_delete_listener(listener);
+  if (rc < 0) return fail(dds_error(std::string("dds: set listener on ") + row_->name, rc));
+  on_data_ = std::move(next);
+  return {};
+}
+
 uint32_t ReaderBase::matched_writers() const {
   dds_subscription_matched_status_t st{};
   if (dds_get_subscription_matched_status(entity_.handle(), &st) < 0) return 0;
