@@ -94,6 +94,42 @@ TEST(Cleanup, RemovesSpecksFillsHolesKeepsOpenings) {
   EXPECT_EQ(r(6, 6), 255);
 }
 
+// With a shows_backing test, a small hole one of whose runs shows the clean backing stays open;
+// the test is asked only about runs of holes that would be filled.
+TEST(Cleanup, KeepsHolesThatShowTheBacking) {
+  Mask m(40, 30, 0);
+  for (int y = 5; y < 25; ++y)
+    for (int x = 5; x < 35; ++x) m(x, y) = 255;
+  for (int y = 10; y < 14; ++y)  // hole A (x 10..13): shows backing in its row 12 only
+    for (int x = 10; x < 14; ++x) m(x, y) = 0;
+  for (int y = 10; y < 14; ++y)  // hole B (x 20..23): no backing
+    for (int x = 20; x < 24; ++x) m(x, y) = 0;
+  struct Probe {
+    int calls = 0;
+    bool outside_holes = false;
+  } probe;
+  auto shows = [](const void* c, int y, int32_t begin, int32_t end) {
+    auto& p = *static_cast<Probe*>(const_cast<void*>(c));
+    ++p.calls;
+    if (y < 10 || y >= 14 || !((begin == 10 && end == 14) || (begin == 20 && end == 24)))
+      p.outside_holes = true;
+    return y == 12 && begin == 10;
+  };
+  RunMask out;
+  CleanupScratch scratch;
+  const CleanupStats stats =
+      clean_mask(RunMask::from_mask(m.view()), {4, 50}, out, scratch, shows, &probe);
+  EXPECT_EQ(stats.holes_filled, 1);
+  EXPECT_EQ(stats.gaps_kept, 1);
+  EXPECT_FALSE(probe.outside_holes);
+  EXPECT_LE(probe.calls, 8);  // 4 rows of each hole at most, fewer once A is known
+  const Mask r = out.to_mask();
+  EXPECT_EQ(r(11, 11), 0);    // A open
+  EXPECT_EQ(r(21, 11), 255);  // B filled
+  // Without the test both are filled.
+  EXPECT_EQ(clean_mask(RunMask::from_mask(m.view()), {4, 50}, out, scratch).holes_filled, 2);
+}
+
 TEST(Cleanup, DisabledIsIdentity) {
   Mask m(9, 4, 0);
   m(1, 1) = 255;

@@ -107,6 +107,12 @@ TEST_F(KeyerCli, BadConfigAndUsageAreOneLine) {
   r = run("key --input " + (dir_ / "in").string() + " --output x --key difference");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(lines(r.err), 1) << r.err;
+  std::ofstream(dir_ / "keyer.yaml") << "keyer:\n  cleanup:\n    keep_backing_gaps: maybe\n";
+  r = run("key --input " + (dir_ / "in").string() + " --output " + (dir_ / "out").string() +
+          " --config " + (dir_ / "keyer.yaml").string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("keep_backing_gaps"), std::string::npos) << r.err;
   // The documented example config loads.
   r = run("key --input " + (dir_ / "in").string() + " --output " + (dir_ / "out").string() +
           " --config " + STUDIO_SOURCE_DIR + "/keyer/keyer.example.yaml");

@@ -174,6 +174,52 @@ TEST(Keyer, DifferenceKeyAgainstCleanPlate) {
   EXPECT_FALSE(keyer->has_plate());
 }
 
+// A small enclosed region of clean backing (a gap between arm and body) stays open; a small
+// enclosed region keyed as backing but not clean (bluish dark cloth, backing between the clips)
+// is a false hole and is filled. With keep_backing_gaps off both are filled.
+TEST(Keyer, KeepsRealGapsFillsFalseHoles) {
+  const Rgb8 backing{30, 66, 212}, cloth{20, 20, 24}, bluish{20, 30, 100};  // excess 146, 0, 70
+  Image<Rgb8> im(80, 60, backing);
+  for (int y = 10; y < 50; ++y)
+    for (int x = 20; x < 60; ++x) im(x, y) = cloth;
+  for (int y = 20; y < 26; ++y)
+    for (int x = 25; x < 29; ++x) im(x, y) = backing;  // the gap
+  for (int y = 20; y < 26; ++y)
+    for (int x = 45; x < 49; ++x) im(x, y) = bluish;   // alpha 0.375 < 0.5: keyed as backing
+  for (bool keep : {true, false}) {
+    KeyerOptions o;
+    o.cleanup.keep_backing_gaps = keep;
+    auto keyer = Keyer::create(o);
+    ASSERT_TRUE(keyer);
+    RunMask mask;
+    ASSERT_TRUE(keyer->key(im.view(), mask));
+    EXPECT_EQ(mask.contains(26, 22), !keep) << keep;
+    EXPECT_TRUE(mask.contains(46, 22)) << keep;
+    EXPECT_EQ(mask.area(), keep ? 40u * 40 - 24 : 40u * 40) << keep;
+    const Image<Bgr8> bgr = to_bgr(im);
+    ASSERT_TRUE(keyer->key(bgr.view(), mask));
+    EXPECT_EQ(mask.contains(26, 22), !keep) << "bgr " << keep;
+  }
+  // Difference key: the gap matches the plate (clean backing), the false hole differs by less
+  // than the cut but more than diff_low.
+  KeyerOptions o;
+  o.mode = KeyMode::kDifference;
+  auto keyer = Keyer::create(o);
+  ASSERT_TRUE(keyer);
+  Image<Rgb8> plate(80, 60, backing), frame = plate;
+  for (int y = 10; y < 50; ++y)
+    for (int x = 20; x < 60; ++x) frame(x, y) = cloth;
+  for (int y = 20; y < 26; ++y)
+    for (int x = 25; x < 29; ++x) frame(x, y) = backing;
+  for (int y = 20; y < 26; ++y)
+    for (int x = 45; x < 49; ++x) frame(x, y) = Rgb8{30, 66, 192};  // diff 20: alpha 1/3
+  ASSERT_TRUE(keyer->capture_plate(plate.view()));
+  RunMask mask;
+  ASSERT_TRUE(keyer->key(frame.view(), mask));
+  EXPECT_FALSE(mask.contains(26, 22));
+  EXPECT_TRUE(mask.contains(46, 22));
+}
+
 TEST(Keyer, SoftAlphaFollowsTheFormula) {
   KeyerOptions o;
   o.clip_black = 20;

@@ -30,6 +30,15 @@ Expected<void> read_int(const std::string& name, const YAML::Node& n, const std:
   }
 }
 
+Expected<void> read_bool(const std::string& name, const YAML::Node& n, const std::string& key, bool& out) {
+  try {
+    out = n.as<bool>();
+    return {};
+  } catch (const YAML::Exception&) {
+    return fail(where(name, n) + ": " + key + ": expected true or false");
+  }
+}
+
 }  // namespace
 
 Expected<KeyerOptions> parse_keyer_options(const std::string& text, const std::string& name) {
@@ -74,6 +83,8 @@ Expected<KeyerOptions> parse_keyer_options(const std::string& text, const std::s
           r = read_int(name, c.second, "cleanup.min_component_area", o.cleanup.min_component_area);
         } else if (ck == "max_hole_area") {
           r = read_int(name, c.second, "cleanup.max_hole_area", o.cleanup.max_hole_area);
+        } else if (ck == "keep_backing_gaps") {
+          r = read_bool(name, c.second, "cleanup.keep_backing_gaps", o.cleanup.keep_backing_gaps);
         } else {
           return fail(where(name, c.first) + ": cleanup: unknown key '" + ck + "'");
         }

@@ -42,6 +42,11 @@ void label_runs(const RunMask& m, bool eight_connected, std::vector<uint32_t>& p
 
 CleanupStats clean_mask(const RunMask& in, const CleanupOptions& options, RunMask& out,
                         CleanupScratch& s) {
+  return clean_mask(in, options, out, s, nullptr, nullptr);
+}
+
+CleanupStats clean_mask(const RunMask& in, const CleanupOptions& options, RunMask& out,
+                        CleanupScratch& s, ShowsBackingFn shows_backing, const void* context) {
   CleanupStats stats;
   const int w = in.width(), h = in.height();
   auto reset = [&](RunMask& m) {
@@ -90,7 +95,7 @@ CleanupStats clean_mask(const RunMask& in, const CleanupOptions& options, RunMas
   label_runs(s.gaps, /*eight_connected=*/false, s.parent);
   const auto& gaps = s.gaps.runs();
   s.area.assign(gaps.size(), 0);
-  s.flags.assign(gaps.size(), 0);  // 1 = the component touches the border
+  s.flags.assign(gaps.size(), 0);  // 1 = touches the border, 2 = shows the clean backing
   for (int y = 0; y < h; ++y)
     for (uint32_t i = s.gaps.row_start()[y]; i < s.gaps.row_start()[y + 1]; ++i) {
       const uint32_t root = find(s.parent, i);
@@ -101,6 +106,16 @@ CleanupStats clean_mask(const RunMask& in, const CleanupOptions& options, RunMas
     const uint32_t root = find(s.parent, gap);
     return !s.flags[root] && s.area[root] <= uint64_t(options.max_hole_area);
   };
+  if (shows_backing) {
+    for (int y = 0; y < h; ++y)
+      for (uint32_t i = s.gaps.row_start()[y]; i < s.gaps.row_start()[y + 1]; ++i) {
+        if (!filled(i)) continue;  // too big, on the border, or already known to show backing
+        if (shows_backing(context, y, gaps[i].begin, gaps[i].end)) {
+          s.flags[find(s.parent, i)] = 2;
+          ++stats.gaps_kept;
+        }
+      }
+  }
   for (uint32_t i = 0; i < gaps.size(); ++i)
     if (s.parent[i] == i && filled(i)) ++stats.holes_filled;
 

@@ -1,5 +1,6 @@
 #include "keyer/keyer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -38,6 +39,8 @@ Keyer::Keyer(const KeyerOptions& options) : options_(options) {
     if (a >= options_.matte_threshold) max_excess = e;
   }
   chroma_all_ = max_excess >= 255;
+  for (int e = 255; e >= 0 && chroma_alpha(float(e), options_) == 0.0f; --e) backing_excess_ = e;
+  for (int d = 0; d < 256 && difference_alpha(float(d), options_) == 0.0f; ++d) backing_diff_ = d;
   chroma_max_excess_ = uint8_t(max_excess < 0 ? 0 : max_excess);  // validate(): alpha(0) = 1
   int min_diff = 256;
   for (int d = 255; d >= 0; --d) {
@@ -95,8 +98,40 @@ Expected<void> Keyer::key_impl(ImageView<const Px> frame, RunMask& mask) {
     detail::bits_to_runs(row_bits_.data(), w, y, raw_);
   }
   raw_.finish();
-  clean_mask(raw_, options_.cleanup, mask, cleanup_scratch_);
+  if (options_.cleanup.keep_backing_gaps) {
+    frame_ = &frame;
+    clean_mask(raw_, options_.cleanup, mask, cleanup_scratch_, &Keyer::shows_backing<Px>, this);
+    frame_ = nullptr;
+  } else {
+    clean_mask(raw_, options_.cleanup, mask, cleanup_scratch_);
+  }
   return {};
+}
+
+template <class Px>
+bool Keyer::shows_backing(const void* context, int y, int32_t begin, int32_t end) {
+  const Keyer& self = *static_cast<const Keyer*>(context);
+  const ImageView<const Px>& frame = *static_cast<const ImageView<const Px>*>(self.frame_);
+  const auto* px = reinterpret_cast<const uint8_t*>(frame.row(y));
+  using L = Layout<Px>;
+  if (self.options_.mode == KeyMode::kDifference) {
+    const auto* plate = reinterpret_cast<const uint8_t*>(&self.plate_(0, y));
+    for (int32_t x = begin; x < end; ++x) {
+      const uint8_t* q = px + 3 * x;
+      const uint8_t* p = plate + 3 * x;
+      const int d = std::max({std::abs(q[L::r] - p[0]), std::abs(q[L::g] - p[1]),
+                              std::abs(q[L::b] - p[2])});
+      if (d <= self.backing_diff_) return true;
+    }
+    return false;
+  }
+  int k, o1, o2;
+  key_channels<Px>(self.options_.mode, k, o1, o2);
+  for (int32_t x = begin; x < end; ++x) {
+    const uint8_t* q = px + 3 * x;
+    if (int(q[k]) - int(std::max(q[o1], q[o2])) >= self.backing_excess_) return true;
+  }
+  return false;
 }
 
 Expected<void> Keyer::key(ImageView<const Rgb8> frame, RunMask& mask) { return key_impl(frame, mask); }

@@ -14,7 +14,9 @@
 // Clean-up runs on the binary mask's runs, at a cost linear in the number of runs: foreground
 // components (8-connected) smaller than min_component_area pixels are removed, then background
 // components (4-connected) that do not touch the image border and are at most max_hole_area
-// pixels are filled.
+// pixels are filled, except (keep_backing_gaps) those that show the clean backing somewhere: a
+// pixel with alpha 0 (chroma: backing >= clip_white; difference: diff <= diff_low) is a real gap
+// between limbs, not a false hole in the clothes.
 
 #include <string>
 #include <string_view>
@@ -31,6 +33,9 @@ Expected<KeyMode> parse_key_mode(std::string_view name);  // "blue" | "green" | 
 struct CleanupOptions {
   int min_component_area = 64;  // pixels; 0 keeps every component
   int max_hole_area = 400;      // pixels; 0 fills nothing
+  // Keep holes open when one of their pixels is clean backing (alpha 0). Used by Keyer::key();
+  // clean_mask() alone (no image) cannot tell and fills by area only.
+  bool keep_backing_gaps = true;
 };
 
 struct KeyerOptions {
