@@ -103,9 +103,11 @@ class KeyerNode : public runtime::Node {
     running_ = true;
     reader_ = std::thread([this] { read_loop(); });
     for (int i = 0; i < options_.threads; ++i) workers_.emplace_back([this] { key_loop(); });
-    STUDIO_LOG(info, kLog) << "keying " << (options_.cameras.empty() ? "every camera" : "the configured cameras")
-                           << " with the " << key_mode_name(options_.keyer.mode) << " key (" << Keyer::kernel_name()
-                           << " kernel, " << options_.threads << " thread(s))";
+    STUDIO_LOG(info, kLog) << "keying "
+                           << (options_.cameras.empty() ? "every camera" : "the configured cameras")
+                           << " with the " << key_mode_name(options_.keyer.mode) << " key ("
+                           << Keyer::kernel_name() << " kernel, " << options_.threads
+                           << " thread(s))";
     return {};
   }
 
@@ -126,7 +128,8 @@ class KeyerNode : public runtime::Node {
     h.capture_ns = last_capture_ns_.load();
     const auto now = SteadyClock::now();
     const double dt = std::chrono::duration<double>(now - last_health_).count();
-    const uint64_t in = images_in_.value(), out = masks_published_.value(), unkeyed = unkeyed_.value();
+    const uint64_t in = images_in_.value(), out = masks_published_.value(),
+                   unkeyed = unkeyed_.value();
     if (dt > 0) {
       h.input_hz = double(in - last_in_) / dt;
       h.output_hz = double(out - last_out_) / dt;
@@ -187,7 +190,8 @@ class KeyerNode : public runtime::Node {
       rejected_cameras_.add();
       rejected_.add();
       if (!warned_max_cameras_) {
-        STUDIO_LOG(warn, kLog) << "camera " << id << " rejected: already keying max_cameras " << options_.max_cameras;
+        STUDIO_LOG(warn, kLog) << "camera " << id << " rejected: already keying max_cameras "
+                               << options_.max_cameras;
       }
       warned_max_cameras_ = true;
       return nullptr;
@@ -217,9 +221,10 @@ class KeyerNode : public runtime::Node {
           rejected_format_.add();
           rejected_.add();
           if (!warned_format_) {
-            STUDIO_LOG(warn, kLog) << "camera " << s.camera_id << ": "
-                                   << (s.format == studio_IMAGE_JPEG ? "JPEG" : "MONO8")
-                                   << " image rejected: the keyer needs raw RGB8 (capture: image.raw: true)";
+            STUDIO_LOG(warn, kLog)
+                << "camera " << s.camera_id << ": "
+                << (s.format == studio_IMAGE_JPEG ? "JPEG" : "MONO8")
+                << " image rejected: the keyer needs raw RGB8 (capture: image.raw: true)";
           }
           warned_format_ = true;
           return;
@@ -257,7 +262,8 @@ class KeyerNode : public runtime::Node {
     if (!(c.value >= 0 && c.value <= kMaxPlateFrames) || c.value != double(int(c.value))) {
       controls_rejected_.add();
       STUDIO_LOG(warn, kLog) << c.camera_id << ": " << kPlateFeature << " " << c.value
-                             << " rejected: expected 0 (clear) or a frame count 1.." << kMaxPlateFrames;
+                             << " rejected: expected 0 (clear) or a frame count 1.."
+                             << kMaxPlateFrames;
       return;
     }
     std::lock_guard lock(mutex_);
@@ -342,8 +348,8 @@ class KeyerNode : public runtime::Node {
       }
       if (--slot.plate_remaining == 0) {
         plates_captured_.add();
-        STUDIO_LOG(info, kLog) << slot.id << ": clean plate captured (" << keyer.plate_frames() << " frames, "
-                               << w << "x" << h << ")";
+        STUDIO_LOG(info, kLog) << slot.id << ": clean plate captured (" << keyer.plate_frames()
+                               << " frames, " << w << "x" << h << ")";
       }
       return;
     }
@@ -351,7 +357,8 @@ class KeyerNode : public runtime::Node {
       if (options_.keyer.mode == KeyMode::kDifference && !keyer.has_plate()) {
         unkeyed_.add();
         if (!slot.warned_no_plate) {
-          STUDIO_LOG(warn, kLog) << slot.id << ": no clean plate yet (send CameraControl " << kPlateFeature
+          STUDIO_LOG(warn, kLog) << slot.id << ": no clean plate yet (send CameraControl "
+                                 << kPlateFeature
                                  << " N, or give plates: in the config); frames are not keyed";
         }
         slot.warned_no_plate = true;
@@ -379,9 +386,9 @@ class KeyerNode : public runtime::Node {
   KeyerNodeOptions options_;
   const wire::Participant& participant_;
   runtime::Metrics& metrics_;
-  runtime::Counter &images_in_, &masks_published_, &rejected_, &rejected_malformed_, &rejected_format_,
-      &rejected_keyer_, &rejected_cameras_, &images_ignored_, &dropped_, &unkeyed_, &plates_captured_,
-      &controls_rejected_;
+  runtime::Counter &images_in_, &masks_published_, &rejected_, &rejected_malformed_,
+      &rejected_format_, &rejected_keyer_, &rejected_cameras_, &images_ignored_, &dropped_,
+      &unkeyed_, &plates_captured_, &controls_rejected_;
   std::optional<Io> io_;
   std::atomic<bool> running_{false};
   std::thread reader_;
@@ -390,7 +397,7 @@ class KeyerNode : public runtime::Node {
   std::condition_variable cv_;
   std::vector<std::unique_ptr<Slot>> slots_;  // guarded by mutex_; slots are never removed
   bool warned_format_ = false, warned_max_cameras_ = false;  // reader thread
-  uint64_t seen_malformed_ = 0;                               // reader thread
+  uint64_t seen_malformed_ = 0;                              // reader thread
   std::atomic<uint64_t> last_frame_{0};
   std::atomic<int64_t> last_capture_ns_{0};
   SteadyClock::time_point last_health_ = SteadyClock::now();
@@ -417,7 +424,9 @@ Expected<KeyerNodeOptions> read_config(yaml::MapReader& config) {
   KeyerNodeOptions o;
   if (auto n = config.optional("keyer")) {
     Expected<KeyerOptions> k;
-    if (n->is_map()) {
+    if (n->is_null()) {
+      k = KeyerOptions{};  // `keyer:` with nothing under it: the defaults
+    } else if (n->is_map()) {
       k = load_keyer_options(n->file());  // reads this file's `keyer:` section
     } else if (n->is_scalar()) {
       auto path = n->as_string();
@@ -431,21 +440,25 @@ Expected<KeyerNodeOptions> read_config(yaml::MapReader& config) {
   }
   if (auto n = config.optional("cameras")) {
     if (auto r = yaml::read_value(*n, o.cameras, {}); !r) return std::unexpected(r.error());
-    if (o.cameras.empty()) return n->fail("expected at least one camera id (leave the key out to key every camera)");
+    if (o.cameras.empty())
+      return n->fail("expected at least one camera id (leave the key out to key every camera)");
     std::set<std::string> seen;
     for (const auto& id : o.cameras) {
       if (id.empty() || id.size() > 63) return n->fail("camera ids have 1..63 characters");
       if (!seen.insert(id).second) return n->fail("duplicate camera id " + id);
     }
   }
-  if (auto r = read_int(config, "max_cameras", o.max_cameras, 1, 64); !r) return std::unexpected(r.error());
+  if (auto r = read_int(config, "max_cameras", o.max_cameras, 1, 64); !r)
+    return std::unexpected(r.error());
   if (auto r = read_int(config, "threads", o.threads, 1, 16); !r) return std::unexpected(r.error());
   if (auto n = config.optional("plates")) {
-    if (o.keyer.mode != KeyMode::kDifference) return n->fail("clean plates need the difference key (keyer.key)");
+    if (o.keyer.mode != KeyMode::kDifference)
+      return n->fail("clean plates need the difference key (keyer.key)");
     auto entries = n->entries();
     if (!entries) return std::unexpected(entries.error());
     for (const auto& [id, file] : *entries) {
-      if (!o.cameras.empty() && std::find(o.cameras.begin(), o.cameras.end(), id) == o.cameras.end())
+      if (!o.cameras.empty() &&
+          std::find(o.cameras.begin(), o.cameras.end(), id) == o.cameras.end())
         return file.fail("camera " + id + " is not in cameras");
       auto path = file.as_string();
       if (!path) return std::unexpected(path.error());
@@ -463,11 +476,13 @@ Expected<void> KeyerNodeOptions::validate() const {
   if (auto k = keyer.validate(); !k) return k;
   if (max_cameras < 1 || max_cameras > 64) return fail("max_cameras: must be in [1, 64]");
   if (threads < 1 || threads > 16) return fail("threads: must be in [1, 16]");
-  if (!plates.empty() && keyer.mode != KeyMode::kDifference) return fail("plates: need the difference key");
+  if (!plates.empty() && keyer.mode != KeyMode::kDifference)
+    return fail("plates: need the difference key");
   return {};
 }
 
-Expected<std::unique_ptr<runtime::Node>> make_keyer_node(KeyerNodeOptions options, runtime::NodeContext& context) {
+Expected<std::unique_ptr<runtime::Node>> make_keyer_node(KeyerNodeOptions options,
+                                                         runtime::NodeContext& context) {
   if (auto v = options.validate(); !v) return std::unexpected(v.error());
   auto node = std::make_unique<KeyerNode>(std::move(options), context);
   if (auto r = node->init(); !r) return std::unexpected(r.error());
@@ -477,16 +492,21 @@ Expected<std::unique_ptr<runtime::Node>> make_keyer_node(KeyerNodeOptions option
 runtime::ServiceDefinition keyer_service_definition() {
   runtime::ServiceDefinition d;
   d.name = "keyer";
-  d.summary = "Standalone keyer: raw RGB8 camera images in (studio/camera/image), masks out (studio/camera/mask).";
+  d.summary =
+      "Standalone keyer: raw RGB8 camera images in (studio/camera/image), masks out "
+      "(studio/camera/mask).";
   d.config_help =
-      "  keyer: {...} | FILE       keyer options (keyer.example.yaml): this file's keyer: section or a file\n"
+      "  keyer: {...} | FILE       keyer options (keyer.example.yaml): this file's keyer: section "
+      "or a file\n"
       "  cameras: [cam0, ...]      camera ids to key (default: every camera seen)\n"
       "  max_cameras: 16           cameras keyed at most when keying every camera seen (1..64)\n"
       "  threads: 1                keying threads (1..16)\n"
       "  plates: {cam0: FILE}      clean plates for the difference key (PNG/JPEG, frame size)\n"
-      "Clean plate on command: CameraControl feature KeyerPlate, value N averages the next N frames\n"
+      "Clean plate on command: CameraControl feature KeyerPlate, value N averages the next N "
+      "frames\n"
       "(0 clears). Only the newest frame per camera waits; older ones are dropped and counted.\n";
-  d.create = [](yaml::MapReader& config, runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
+  d.create = [](yaml::MapReader& config,
+                runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto options = read_config(config);
     if (!options) return std::unexpected(options.error());
     return make_keyer_node(std::move(*options), ctx);

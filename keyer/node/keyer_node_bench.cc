@@ -65,7 +65,8 @@ void BM_InProcessKeyEncode(benchmark::State& state) {
     encode_mask(mask, MaskCoding::kRowDelta, bytes);
     benchmark::DoNotOptimize(bytes.data());
   }
-  state.counters["frames_per_s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["frames_per_s"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -89,7 +90,9 @@ void BM_NodeAt25Fps(benchmark::State& state) {
       (void)keyer.key(frames[i % 6][(i / 6) % kFramesPerCamera].view(), mask);
       encode_mask(mask, MaskCoding::kRowDelta, bytes);
     }
-    key_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / 480;
+    key_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() /
+        480;
   }
 
   const auto dir = testing::make_test_dir("keyer_node_bench");
@@ -97,7 +100,8 @@ void BM_NodeAt25Fps(benchmark::State& state) {
   // Another Cyclone profile for both ends (e.g. larger socket buffers): STUDIO_BENCH_DDS_URI.
   if (const char* uri = std::getenv("STUDIO_BENCH_DDS_URI")) dds.config_uri = uri;
   dds.apply_to_this_process();
-  std::ofstream(dir / "keyer.yaml") << "instance: bench\nstatus_period: 0.5\nthreads: " << threads << "\n";
+  std::ofstream(dir / "keyer.yaml")
+      << "instance: bench\nstatus_period: 0.5\nthreads: " << threads << "\n";
   auto node = testing::Process::start({.name = "keyer",
                                        .binary = testing::built_binary("keyer/studio-keyer"),
                                        .args = {"--config", (dir / "keyer.yaml").string()},
@@ -144,7 +148,8 @@ void BM_NodeAt25Fps(benchmark::State& state) {
         ws.wait(20ms);
         const int64_t now = realtime_ns();
         masks.visit([&](const studio_AlphaMask& m, const wire::SampleMeta& meta) {
-          if (meta.valid_data && m.capture_ns > 0) latencies.push_back(double(now - m.capture_ns) * 1e-6);
+          if (meta.valid_data && m.capture_ns > 0)
+            latencies.push_back(double(now - m.capture_ns) * 1e-6);
         });
       }
     });
@@ -170,8 +175,10 @@ void BM_NodeAt25Fps(benchmark::State& state) {
     for (auto& s : status.take())
       if (s.meta.valid_data)
         for (const auto& c : wire::view(s.data->counters))
-          if (std::string(wire::str(c.name)) == "frames_dropped") dropped = c.value;
-          else if (std::string(wire::str(c.name)) == "images_in") node_in = c.value;
+          if (std::string(wire::str(c.name)) == "frames_dropped")
+            dropped = c.value;
+          else if (std::string(wire::str(c.name)) == "images_in")
+            node_in = c.value;
     std::this_thread::sleep_for(100ms);
   }
   node->stop();

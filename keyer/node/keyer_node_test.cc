@@ -51,7 +51,8 @@ Image<Rgb8> chroma_frame(int w, int h, uint64_t frame) {
 Image<Rgb8> plate_image(int w, int h) {
   Image<Rgb8> img(w, h);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) img(x, y) = Rgb8{uint8_t(x % 200), uint8_t(60 + y % 100), uint8_t((x + y) % 160)};
+    for (int x = 0; x < w; ++x)
+      img(x, y) = Rgb8{uint8_t(x % 200), uint8_t(60 + y % 100), uint8_t((x + y) % 160)};
   return img;
 }
 Image<Rgb8> actor_on(const Image<Rgb8>& plate, uint64_t frame) {
@@ -84,15 +85,17 @@ class KeyerNodeTest : public testing::ProcessTest {
 
   template <class T>
   wire::Writer<T> writer() {
-    return wire::Writer<T>::create(*participant_, wire::Topic<T>::create(*participant_).value()).value();
+    return wire::Writer<T>::create(*participant_, wire::Topic<T>::create(*participant_).value())
+        .value();
   }
   template <class T>
   wire::Reader<T> reader() {
-    return wire::Reader<T>::create(*participant_, wire::Topic<T>::create(*participant_).value()).value();
+    return wire::Reader<T>::create(*participant_, wire::Topic<T>::create(*participant_).value())
+        .value();
   }
 
-  static void send_image(wire::Writer<studio_CameraImage>& w, const std::string& cam, uint64_t frame,
-                         const Image<Rgb8>& img) {
+  static void send_image(wire::Writer<studio_CameraImage>& w, const std::string& cam,
+                         uint64_t frame, const Image<Rgb8>& img) {
     wire::Owned<studio_CameraImage> s;
     wire::set(s->camera_id, cam);
     s->frame = frame;
@@ -110,15 +113,18 @@ class KeyerNodeTest : public testing::ProcessTest {
                    double* latency_ms = nullptr) {
     for (auto& s : r.take()) {
       if (!s.meta.valid_data || wire::str(s.data->service) != "keyer") continue;
-      for (const auto& c : wire::view(s.data->counters)) out[std::string(wire::str(c.name))] = c.value;
+      for (const auto& c : wire::view(s.data->counters))
+        out[std::string(wire::str(c.name))] = c.value;
       if (latency_ms && s.data->latency_ms > 0) *latency_ms = s.data->latency_ms;
     }
   }
 
   // Masks received, by camera and frame.
-  void poll_masks(wire::Reader<studio_AlphaMask>& r, std::map<Key, wire::Owned<studio_AlphaMask>>& out) {
+  void poll_masks(wire::Reader<studio_AlphaMask>& r,
+                  std::map<Key, wire::Owned<studio_AlphaMask>>& out) {
     for (auto& s : r.take())
-      if (s.meta.valid_data) out[{std::string(wire::str(s.data->camera_id)), s.data->frame}] = std::move(s.data);
+      if (s.meta.valid_data)
+        out[{std::string(wire::str(s.data->camera_id)), s.data->frame}] = std::move(s.data);
   }
 
   std::optional<wire::Participant> participant_;
@@ -128,13 +134,15 @@ TEST_F(KeyerNodeTest, CaptureImagesKeyedExactlyAsInProcess) {
   constexpr int kW = 352, kH = 288;
   const std::string capture_cfg = write_file(
       "capture.yaml",
-      "instance: cap\nclock: {fps: 25}\ntakes_dir: takes\nmasks: false\nimage: {rate: 1000, raw: true}\ncameras:\n"
+      "instance: cap\nclock: {fps: 25}\ntakes_dir: takes\nmasks: false\nimage: {rate: 1000, raw: "
+      "true}\ncameras:\n"
       "  - id: cam0\n    source: {type: sim, ring: 6, index: 0, width: 352, height: 288}\n"
       "  - id: cam1\n    source: {type: sim, ring: 6, index: 3, width: 352, height: 288}\n");
-  const std::string keyer_cfg = write_file(
-      "keyer.yaml",
-      "instance: keyer-test\nstatus_period: 0.2\ncameras: [cam0, cam1]\nthreads: 2\n"
-      "keyer:\n  key: blue\n  clip_black: 22\n  clip_white: 100\n  cleanup: {min_component_area: 32, max_hole_area: 200}\n");
+  const std::string keyer_cfg =
+      write_file("keyer.yaml",
+                 "instance: keyer-test\nstatus_period: 0.2\ncameras: [cam0, cam1]\nthreads: 2\n"
+                 "keyer:\n  key: blue\n  clip_black: 22\n  clip_white: 100\n  cleanup: "
+                 "{min_component_area: 32, max_hole_area: 200}\n");
   auto options = load_keyer_options(keyer_cfg);
   ASSERT_TRUE(options.has_value()) << options.error().message;
   ASSERT_EQ(options->clip_black, 22.0f);
@@ -158,7 +166,8 @@ TEST_F(KeyerNodeTest, CaptureImagesKeyedExactlyAsInProcess) {
     return n;
   };
   const auto t0 = std::chrono::steady_clock::now();
-  while (std::chrono::steady_clock::now() - t0 < 25s && (pairs("cam0") < 10 || pairs("cam1") < 10)) {
+  while (std::chrono::steady_clock::now() - t0 < 25s &&
+         (pairs("cam0") < 10 || pairs("cam1") < 10)) {
     for (auto& s : images.take()) {
       if (!s.meta.valid_data) continue;
       ASSERT_EQ(s.data->format, studio_IMAGE_RGB8);
@@ -213,7 +222,8 @@ TEST_F(KeyerNodeTest, CaptureImagesKeyedExactlyAsInProcess) {
   std::map<std::string, double> counters;
   double latency_ms = 0;
   const auto until = std::chrono::steady_clock::now() + 5s;
-  while (std::chrono::steady_clock::now() < until && !(counters["masks_published"] >= compared && latency_ms > 0)) {
+  while (std::chrono::steady_clock::now() < until &&
+         !(counters["masks_published"] >= compared && latency_ms > 0)) {
     poll_status(status, counters, &latency_ms);
     std::this_thread::sleep_for(50ms);
   }
@@ -239,7 +249,8 @@ TEST_F(KeyerNodeTest, BadSamplesAreCountedAndTheNodeKeepsKeying) {
   ASSERT_TRUE(node.wait_ready(20s)) << node.log();
   ASSERT_TRUE(images.wait_for_readers(1, 10s));
 
-  auto raw = [&](const std::string& cam, uint32_t w, uint32_t h, studio_ImageFormat f, std::size_t bytes) {
+  auto raw = [&](const std::string& cam, uint32_t w, uint32_t h, studio_ImageFormat f,
+                 std::size_t bytes) {
     wire::Owned<studio_CameraImage> s;
     wire::set(s->camera_id, cam);
     s->frame = 1;
@@ -247,7 +258,8 @@ TEST_F(KeyerNodeTest, BadSamplesAreCountedAndTheNodeKeepsKeying) {
     s->height = h;
     s->format = f;
     std::vector<uint8_t> data(bytes, 0x5A);
-    if (f == studio_IMAGE_JPEG && bytes >= 2) data[0] = 0xFF, data[1] = 0xD8;  // passes the SOI check
+    if (f == studio_IMAGE_JPEG && bytes >= 2)
+      data[0] = 0xFF, data[1] = 0xD8;  // passes the SOI check
     wire::assign(s->data, data);
     ASSERT_TRUE(images.write(*s).has_value());
   };
@@ -256,16 +268,16 @@ TEST_F(KeyerNodeTest, BadSamplesAreCountedAndTheNodeKeepsKeying) {
   const Image<Rgb8> good = chroma_frame(kW, kH, 5);
   const auto t0 = std::chrono::steady_clock::now();
   auto done = [&] {
-    return counters["rejected_malformed"] >= 3 && counters["rejected_format"] >= 2 && counters["rejected_cameras"] >= 1 &&
-           got.count({"camA", 5}) && got.count({"camB", 5});
+    return counters["rejected_malformed"] >= 3 && counters["rejected_format"] >= 2 &&
+           counters["rejected_cameras"] >= 1 && got.count({"camA", 5}) && got.count({"camB", 5});
   };
   while (std::chrono::steady_clock::now() - t0 < 20s && !done()) {
     // One instance (camera id) per bad sample, so none replaces another in the keep-last-1 cache.
-    raw("short", kW, kH, studio_IMAGE_RGB8, kW * kH * 3 - 1);      // data shorter than w*h*3
-    raw("zero", 0, kH, studio_IMAGE_RGB8, 0);                     // no pixels
-    raw("huge", 70000, 70000, studio_IMAGE_RGB8, 16);              // absurd size
-    raw("mono", kW, kH, studio_IMAGE_MONO8, kW * kH);              // valid MONO8: unsupported
-    raw("jpeg", kW, kH, studio_IMAGE_JPEG, 4000);                  // JPEG: unsupported
+    raw("short", kW, kH, studio_IMAGE_RGB8, kW * kH * 3 - 1);  // data shorter than w*h*3
+    raw("zero", 0, kH, studio_IMAGE_RGB8, 0);                  // no pixels
+    raw("huge", 70000, 70000, studio_IMAGE_RGB8, 16);          // absurd size
+    raw("mono", kW, kH, studio_IMAGE_MONO8, kW * kH);          // valid MONO8: unsupported
+    raw("jpeg", kW, kH, studio_IMAGE_JPEG, 4000);              // JPEG: unsupported
     send_image(images, "camA", 5, good);
     send_image(images, "camB", 5, good);
     std::this_thread::sleep_for(50ms);
@@ -277,8 +289,9 @@ TEST_F(KeyerNodeTest, BadSamplesAreCountedAndTheNodeKeepsKeying) {
   EXPECT_GE(counters["rejected_malformed"], 3);
   EXPECT_GE(counters["rejected_format"], 2);
   EXPECT_GE(counters["rejected_cameras"], 1);
-  EXPECT_GE(counters["images_rejected"],
-            counters["rejected_malformed"] + counters["rejected_format"] + counters["rejected_cameras"]);
+  EXPECT_GE(
+      counters["images_rejected"],
+      counters["rejected_malformed"] + counters["rejected_format"] + counters["rejected_cameras"]);
   ASSERT_TRUE(got.count({"camA", 5})) << node.log();
   EXPECT_FALSE(got.count({"camC", 5}));
   EXPECT_FALSE(got.count({"mono", 1}));
@@ -301,10 +314,10 @@ TEST_F(KeyerNodeTest, DifferenceKeyWithPlateFromFileAndOnCommand) {
     cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
     ASSERT_TRUE(cv::imwrite((dir_ / "plate0.png").string(), bgr));
   }
-  const std::string cfg = write_file(
-      "keyer.yaml",
-      "status_period: 0.2\ncameras: [cam0, cam1]\nplates: {cam0: plate0.png}\nkeyer: {key: difference, diff_low: 10, "
-      "diff_high: 30}\n");
+  const std::string cfg = write_file("keyer.yaml",
+                                     "status_period: 0.2\ncameras: [cam0, cam1]\nplates: {cam0: "
+                                     "plate0.png}\nkeyer: {key: difference, diff_low: 10, "
+                                     "diff_high: 30}\n");
   auto options = load_keyer_options(cfg);
   ASSERT_TRUE(options.has_value()) << options.error().message;
   auto file_plate = read_rgb((dir_ / "plate0.png").string());
@@ -326,7 +339,8 @@ TEST_F(KeyerNodeTest, DifferenceKeyWithPlateFromFileAndOnCommand) {
   // for cam0's plate is rejected.
   auto t0 = std::chrono::steady_clock::now();
   while (std::chrono::steady_clock::now() - t0 < 20s &&
-         !(got.count({"cam0", 100}) && counters["frames_unkeyed"] >= 1 && counters["rejected_keyer"] >= 1)) {
+         !(got.count({"cam0", 100}) && counters["frames_unkeyed"] >= 1 &&
+           counters["rejected_keyer"] >= 1)) {
     send_image(images, "cam0", 99, small);
     std::this_thread::sleep_for(60ms);
     send_image(images, "cam0", 100, actor_on(plate, 100));
@@ -370,7 +384,15 @@ TEST_F(KeyerNodeTest, DifferenceKeyWithPlateFromFileAndOnCommand) {
     poll_masks(masks, got);
   }
   ASSERT_TRUE(got.count({"cam1", 500})) << node.log();
-  EXPECT_EQ(wire::to_core(*got.at({"cam1", 500})).value(), key_in_process(keyer1, actor_on(plate, 500)));
+  EXPECT_EQ(wire::to_core(*got.at({"cam1", 500})).value(),
+            key_in_process(keyer1, actor_on(plate, 500)));
+  EXPECT_EQ(node.stop(), 0) << node.log();
+}
+
+TEST_F(KeyerNodeTest, ExampleConfigRuns) {
+  auto& node = spawn("keyer", "keyer/studio-keyer",
+                     {"--config", STUDIO_SOURCE_DIR "/keyer/node/keyer-node.example.yaml"});
+  ASSERT_TRUE(node.wait_ready(20s)) << node.log();
   EXPECT_EQ(node.stop(), 0) << node.log();
 }
 
@@ -388,7 +410,8 @@ TEST_F(KeyerNodeTest, BadConfigIsOneLine) {
       {"cameras: [a, a]\n", "duplicate camera id a"},
       {"plates: {cam0: p.png}\n", "difference key"},
       {"keyer: {key: difference}\nplates: {cam0: nowhere.png}\n", "nowhere.png"},
-      {"keyer: {key: difference}\ncameras: [cam1]\nplates: {cam0: nowhere.png}\n", "not in cameras"},
+      {"keyer: {key: difference}\ncameras: [cam1]\nplates: {cam0: nowhere.png}\n",
+       "not in cameras"},
       {"cameras: [cam0\n", "keyer.yaml:"},
   };
   for (const auto& c : cases) {
