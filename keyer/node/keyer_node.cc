@@ -37,6 +37,7 @@ struct Slot {
   std::vector<uint8_t> pending;
   int pending_w = 0, pending_h = 0;
   uint64_t pending_frame = 0;
+  uint64_t last_frame_in = 0;  // newest frame number received (0: none yet)
   int64_t pending_capture_ns = 0;
   bool has_pending = false;
   bool busy = false;
@@ -64,6 +65,7 @@ class KeyerNode : public runtime::Node {
         rejected_cameras_(ctx.metrics.counter("rejected_cameras")),
         images_ignored_(ctx.metrics.counter("images_ignored")),
         dropped_(ctx.metrics.counter("frames_dropped")),
+        missed_(ctx.metrics.counter("frames_missed")),
         unkeyed_(ctx.metrics.counter("frames_unkeyed")),
         plates_captured_(ctx.metrics.counter("plates_captured")),
         controls_rejected_(ctx.metrics.counter("controls_rejected")) {}
@@ -114,6 +116,7 @@ class KeyerNode : public runtime::Node {
   void stop() override {
     if (!running_.exchange(false)) return;
     io_->guard.trigger();
+    { std::lock_guard lock(mutex_); }  // a keying thread between its check and its wait sees it
     cv_.notify_all();
     if (reader_.joinable()) reader_.join();
     for (auto& w : workers_)
@@ -245,6 +248,9 @@ class KeyerNode : public runtime::Node {
         incoming.assign(data.begin(), data.end());
         std::lock_guard lock(mutex_);
         if (slot->has_pending) dropped_.add();  // the previous frame was never keyed
+        if (slot->last_frame_in != 0 && s.frame > slot->last_frame_in + 1)
+          missed_.add(std::min<uint64_t>(s.frame - slot->last_frame_in - 1, 1000));
+        if (s.frame > slot->last_frame_in) slot->last_frame_in = s.frame;
         slot->pending.swap(incoming);
         slot->pending_w = int(s.width);
         slot->pending_h = int(s.height);
@@ -388,7 +394,7 @@ class KeyerNode : public runtime::Node {
   runtime::Metrics& metrics_;
   runtime::Counter &images_in_, &masks_published_, &rejected_, &rejected_malformed_,
       &rejected_format_, &rejected_keyer_, &rejected_cameras_, &images_ignored_, &dropped_,
-      &unkeyed_, &plates_captured_, &controls_rejected_;
+      &missed_, &unkeyed_, &plates_captured_, &controls_rejected_;
   std::optional<Io> io_;
   std::atomic<bool> running_{false};
   std::thread reader_;

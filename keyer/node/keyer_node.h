@@ -20,7 +20,9 @@
 //                          camera's clean plate)
 //   rejected_cameras       camera ids beyond max_cameras (when keying every camera seen)
 // Other counters: images_in, masks_published, frames_dropped, frames_unkeyed (difference key
-// before a clean plate exists), plates_captured, controls_rejected.
+// before a clean plate exists), plates_captured, controls_rejected, frames_missed (frame numbers
+// skipped between a camera's images: lost in transport before the node saw them, or never sent
+// when the capture node's image.rate is below the frame rate; at most 1000 per gap).
 //
 // Difference key: one clean plate per camera, loaded from a file given in the config
 // (`plates: {cam0: plate0.png}`), or captured on command: CameraControl on studio/camera/control

@@ -140,7 +140,7 @@ void BM_NodeAt25Fps(benchmark::State& state) {
 
   std::vector<double> latencies;
   uint64_t sent = 0;
-  double dropped = 0, node_in = 0;
+  double dropped = 0, node_in = 0, missed = 0;
   for (auto _ : state) {
     std::atomic<bool> receiving{true};
     std::thread receiver([&] {
@@ -177,6 +177,8 @@ void BM_NodeAt25Fps(benchmark::State& state) {
         for (const auto& c : wire::view(s.data->counters))
           if (std::string(wire::str(c.name)) == "frames_dropped")
             dropped = c.value;
+          else if (std::string(wire::str(c.name)) == "frames_missed")
+            missed = c.value;
           else if (std::string(wire::str(c.name)) == "images_in")
             node_in = c.value;
     std::this_thread::sleep_for(100ms);
@@ -191,6 +193,7 @@ void BM_NodeAt25Fps(benchmark::State& state) {
   state.counters["masks_per_s"] = double(latencies.size()) / seconds;
   state.counters["delivered"] = sent ? double(latencies.size()) / double(sent) : 0;
   state.counters["dropped"] = dropped;
+  state.counters["missed"] = missed;  // the node's count of frame numbers it never received
   state.counters["node_in"] = sent ? node_in / double(sent) : 0;  // images that reached the node
   state.counters["lat_p50_ms"] = percentile(latencies, 0.5);
   state.counters["lat_p99_ms"] = percentile(latencies, 0.99);
