@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace studio {
@@ -75,6 +76,23 @@ class Image {
   Image() = default;
   Image(int width, int height, T fill = T{})
       : width_(width), height_(height), pixels_(std::size_t(width) * std::size_t(height), fill) {}
+  // A moved-from image is empty (0x0), never a size without pixels.
+  Image(Image&& other) noexcept
+      : width_(std::exchange(other.width_, 0)),
+        height_(std::exchange(other.height_, 0)),
+        pixels_(std::move(other.pixels_)) {
+    other.pixels_.clear();
+  }
+  Image& operator=(Image&& other) noexcept {
+    if (this == &other) return *this;
+    width_ = std::exchange(other.width_, 0);
+    height_ = std::exchange(other.height_, 0);
+    pixels_ = std::move(other.pixels_);
+    other.pixels_.clear();
+    return *this;
+  }
+  Image(const Image&) = default;
+  Image& operator=(const Image&) = default;
 
   int width() const { return width_; }
   int height() const { return height_; }
