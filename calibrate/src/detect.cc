@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include "calibrate/text.h"
 #include <map>
@@ -13,6 +14,36 @@
 namespace studio::calibrate {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// OpenCV 4.6's interpolateCornersCharuco returns corners about +0.4 px off in x and y (measured
+// against the simulator's exact projections, calibrate/sim_calibration_test.cc): its internal
+// cornerSubPix stops at 0.1 px steps and its output is not in the pixel-centre convention of
+// cornerSubPix / findChessboardCorners that core/camera.h uses. The corners are refined again
+// here, to convergence, in that convention. The window half-size is 0.35 of the distance to the
+// nearest detected neighbour corner (2..5 px), so it never reaches the next corner; closer in,
+// the marker borders (1/8 of a square from the corner) are symmetric about it.
+void refine_charuco_corners(const cv::Mat& grey, int corners_per_row, const std::vector<int>& ids,
+                            std::vector<cv::Point2f>* corners) {
+  const std::vector<cv::Point2f> start = *corners;
+  for (size_t k = 0; k < start.size(); ++k) {
+    double nearest = 1e9;
+    for (size_t m = 0; m < start.size(); ++m) {
+      const int a = ids[k], b = ids[m];
+      const bool row_neighbour = std::abs(a - b) == 1 && a / corners_per_row == b / corners_per_row;
+      if (row_neighbour || std::abs(a - b) == corners_per_row)
+        nearest = std::min(nearest, static_cast<double>(cv::norm(start[m] - start[k])));
+    }
+    const int half = nearest > 1e8 ? 5 : std::clamp(static_cast<int>(0.35 * nearest), 2, 5);
+    std::vector<cv::Point2f> one{start[k]};
+    cv::cornerSubPix(grey, one, cv::Size(half, half), cv::Size(-1, -1),
+                     cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 100, 1e-4));
+    (*corners)[k] = one[0];
+  }
+}
+
+}  // namespace
 
 Expected<std::vector<PointObservation>> detect_target(const cv::Mat& image, const TargetSpec& target) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
@@ -47,6 +78,7 @@ Expected<std::vector<PointObservation>> detect_target(const cv::Mat& image, cons
       std::vector<int> ids;
       cv::aruco::interpolateCornersCharuco(marker_corners, marker_ids, grey, board, corners, ids,
                                            cv::noArray(), cv::noArray(), 2);
+      refine_charuco_corners(grey, target.cols - 1, ids, &corners);
       for (size_t i = 0; i < ids.size(); ++i)
         out.push_back({ids[i], Eigen::Vector2d(corners[i].x, corners[i].y)});
       std::sort(out.begin(), out.end(), [](auto& a, auto& b) { return a.id < b.id; });
