@@ -161,6 +161,56 @@ TEST(SilhouetteCut, PencilAndRowWalkerAgree) {
   EXPECT_EQ(*a, *c);
 }
 
+// The grid fast path of cut() (bin and run ends affine in the column index, row spans of the
+// occupied bins) against PreparedView::cut_line on every column, view after view: the same
+// intervals up to float rounding, except where a column's pencil coordinate lies on a bin border
+// and the two roundings pick neighbouring half-pixel bins.
+TEST(SilhouetteCut, GridFastPathMatchesPerLineCut) {
+  const Scene s = testing::actor();
+  auto cams = testing::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
+  std::vector<RunMask> masks;
+  std::vector<View> views;
+  for (const Camera& c : cams) masks.push_back(testing::render_mask(c, s));
+  for (std::size_t k = 0; k < cams.size(); ++k) views.push_back({&cams[k], &masks[k]});
+  GridSpec g;
+  g.box_min = {-1, 0, -1};
+  g.box_max = {1, 2, 1};
+  g.cells_u = g.cells_v = 128;
+  auto fast = visual_hull(g, views);
+  ASSERT_TRUE(fast);
+  const Eigen::AlignedBox3d domain(g.box_min, g.box_max);
+  std::vector<PreparedView> prepared;
+  for (const View& v : views) {
+    auto p = PreparedView::create(*v.camera, *v.mask, Eigen::Vector4d(0, 1, 0, 0), CutOptions{},
+                                  &domain);
+    ASSERT_TRUE(p);
+    ASSERT_TRUE(p->uses_pencil() && p->domain_inside_image());
+    prepared.push_back(std::move(*p));
+  }
+  const Eigen::Vector3d d(0, 1, 0);
+  CutScratch scratch;
+  int nonempty = 0, differ = 0;
+  for (int j = 0; j < g.cells_v; ++j)
+    for (int i = 0; i < g.cells_u; ++i) {
+      std::vector<Interval> cur{{float(g.t_min()), float(g.t_max())}}, next;
+      const Eigen::Vector3d o = g.point(i, j, 0);
+      for (const PreparedView& p : prepared) {
+        next.clear();
+        if (!cur.empty()) p.cut_line(o, d, cur, &next, &scratch);
+        std::swap(cur, next);
+      }
+      const auto got = fast->column(i, j);
+      nonempty += !cur.empty() || !got.empty();
+      bool same = got.size() == cur.size();
+      for (std::size_t k = 0; same && k < cur.size(); ++k) {
+        same = std::abs(got[k].lo - cur[k].lo) <= 1e-5f && std::abs(got[k].hi - cur[k].hi) <= 1e-5f;
+      }
+      differ += !same;
+    }
+  EXPECT_GT(nonempty, 500);
+  EXPECT_LE(differ, nonempty / 100) << differ << " of " << nonempty << " columns differ";
+}
+
 TEST(SilhouetteCut, OutsideImageKeptOrCut) {
   Scene s;
   s.ellipsoids.push_back({Eigen::Vector3d(0, 1, 0), Eigen::Vector3d::Constant(0.3)});
