@@ -2,8 +2,8 @@
 // the capture recorder (6 cameras, 352x288, frames 100..102): it keys every frame on the fly and
 // writes the same meshes as the mask-folder route given the same keyer's masks; the meshes
 // re-project onto the true masks; exact crossings (default) beat --no-refine; --frames, --timing
-// and --progress work; a missing camera, a frame one camera lacks, a frame of the wrong size, an
-// empty box and a bad keyer file each give one clear error line.
+// and --progress work; a missing camera, a frame one camera lacks, a frame of the wrong size, a
+// frame that fails its CRC, an empty box and a bad keyer file each give one clear error line.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -276,6 +276,24 @@ TEST_F(HullCliTake, RejectsFrameOfWrongSize) {
   EXPECT_NE(r.err.find("cam1: frame 100 is 320x240, camera cam1 is 352x288"), std::string::npos)
       << r.err;
   EXPECT_EQ(lines(r.err), 1) << r.err;  // no frame completes, so no progress bar either
+}
+
+TEST_F(HullCliTake, RejectsCorruptFrame) {
+  const fs::path take = dir_ / "take_corrupt";
+  fs::copy(dir_ / "take", take, fs::copy_options::recursive);
+  {  // One payload byte of cam3's second frame (frames of 352x288 RGB8 follow 48-byte headers).
+    std::fstream f(take / "cam3" / "frames.raw", std::ios::in | std::ios::out | std::ios::binary);
+    const std::streamoff at = 48 + 352 * 288 * 3 + 48 + 1000;
+    f.seekg(at);
+    const char c = char(f.get() ^ 0x55);
+    f.seekp(at);
+    f.put(c);
+  }
+  const Result r =
+      run(base() + "--take " + take.string() + " --threads 1 --out " + (dir_ / "x").string(), dir_);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("frame 101 fails its CRC"), std::string::npos) << r.err;
+  EXPECT_EQ(lines(r.err), 1) << r.err;
 }
 
 TEST_F(HullCliTake, RejectsEmptyBoxAndBadKeyer) {
