@@ -67,8 +67,8 @@ Offline visual hull (line-segment representation, segment marching cubes) from s
   --progress        progress bar on stderr even when it is not a terminal (default: only on a
                     terminal, for more than one frame); --quiet: never
 Exit status: 0 done; 2 bad arguments or input found before any frame (missing camera, empty
-box, ...); 1 a frame failed (unreadable or wrong-size mask or take frame, CRC, disk), after
-the frames before it were written. Errors are one line on stderr.
+box, ...); 1 a frame failed (unreadable or wrong-size mask or take frame, CRC, disk); frames
+finished before it stay written. Errors are one line on stderr.
 )";
 
 struct Args {
