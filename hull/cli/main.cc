@@ -341,11 +341,12 @@ int run_offline(int argc, char** argv) {
     const double n = double(frames.size());
     std::printf(
         "{\"input\": \"%s\", \"frames\": %zu, \"grid\": %d, \"cameras\": %zu, \"threads\": %d, "
+        "\"frames_in_parallel\": %d, "
         "\"exact_crossings\": %s, \"load\": %.3f, \"key\": %.3f, \"cut\": %.3f, \"mesh\": %.3f, "
         "\"refine\": %.3f, \"write\": %.3f, \"unit\": \"ms per frame\", \"wall_ms\": %.3f}\n",
-        in.keyed() ? "take" : "masks", frames.size(), args->grid, cameras.size(), workers,
-        args->refine ? "true" : "false", t_load.read / n, t_load.key / n, t_cut / n, t_mesh / n,
-        t_refine / n, t_write / n, ms_since(wall0));
+        in.keyed() ? "take" : "masks", frames.size(), args->grid, cameras.size(), args->threads,
+        workers, args->refine ? "true" : "false", t_load.read / n, t_load.key / n, t_cut / n,
+        t_mesh / n, t_refine / n, t_write / n, ms_since(wall0));
   }
   return 0;
 }
