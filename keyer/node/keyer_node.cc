@@ -275,10 +275,7 @@ class KeyerNode : public runtime::Node {
     std::lock_guard lock(mutex_);
     bool ignored = false;
     Slot* slot = slot_for(c.camera_id, ignored);
-    if (!slot) {
-      if (ignored) controls_rejected_.add();
-      return;
-    }
+    if (!slot) return;  // another keyer node's camera (or over max_cameras, counted there)
     slot->plate_request = int(c.value);
     STUDIO_LOG(info, kLog) << c.camera_id << ": "
                            << (c.value == 0 ? std::string("clean plate cleared")
