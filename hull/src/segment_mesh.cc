@@ -2,7 +2,11 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <unordered_map>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace studio::hull {
 namespace {
@@ -82,30 +86,56 @@ double Mesh::volume() const {
 }
 
 void compute_normals(Mesh& mesh) {
-  // Area-weighted vertex normals (float: the cells are centimetres, the sums stay well scaled).
-  mesh.normals.assign(mesh.vertices.size(), Eigen::Vector3f::Zero());
-  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
-  const float* __restrict v = mesh.vertices.data()->data();
-  float* __restrict acc = mesh.normals.data()->data();
-  const std::array<uint32_t, 3>* __restrict tri = mesh.triangles.data();
-  const std::size_t n_tri = mesh.triangles.size();
-  for (std::size_t f = 0; f < n_tri; ++f) {
-    const std::array<uint32_t, 3> t = tri[f];
-    const float* a = v + 3 * std::size_t(t[0]);
-    const float* b = v + 3 * std::size_t(t[1]);
-    const float* c = v + 3 * std::size_t(t[2]);
-    const float e0 = b[0] - a[0], e1 = b[1] - a[1], e2 = b[2] - a[2];
-    const float f0 = c[0] - a[0], f1 = c[1] - a[1], f2 = c[2] - a[2];
-    const float n0 = e1 * f2 - e2 * f1, n1 = e2 * f0 - e0 * f2, n2 = e0 * f1 - e1 * f0;
-    for (const uint32_t k : t) {
-      float* n = acc + 3 * std::size_t(k);
-      n[0] += n0, n[1] += n1, n[2] += n2;
-    }
+  // Area-weighted vertex normals in float (cells are centimetres, the sums stay well scaled).
+  const std::size_t n_vertices = mesh.vertices.size();
+  mesh.normals.resize(n_vertices);
+#if defined(__SSE2__)
+  // SSE2 (the x86-64 baseline): one vertex per register, the cross product by two shuffles;
+  // the same products and differences as the scalar code, so the same floats.
+  struct alignas(16) Lane {
+    __m128 v;
+  };
+  thread_local std::vector<Lane> pos, acc;
+  pos.resize(n_vertices);
+  acc.assign(n_vertices, Lane{_mm_setzero_ps()});
+  for (std::size_t k = 0; k < n_vertices; ++k) {
+    const Eigen::Vector3f& x = mesh.vertices[k];
+    pos[k].v = _mm_setr_ps(x[0], x[1], x[2], 0.f);
   }
-  for (Eigen::Vector3f& n : mesh.normals) {
-    const float len = n.norm();
-    n = len > 0 ? Eigen::Vector3f(n / len) : Eigen::Vector3f::Zero();
+  const Lane* __restrict p = pos.data();
+  Lane* __restrict n = acc.data();
+  for (const auto& t : mesh.triangles) {
+    const __m128 a = p[t[0]].v;
+    const __m128 e = _mm_sub_ps(p[t[1]].v, a), f = _mm_sub_ps(p[t[2]].v, a);
+    const __m128 e_yzx = _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1));
+    const __m128 f_yzx = _mm_shuffle_ps(f, f, _MM_SHUFFLE(3, 0, 2, 1));
+    const __m128 c_zxy = _mm_sub_ps(_mm_mul_ps(e, f_yzx), _mm_mul_ps(e_yzx, f));
+    const __m128 c = _mm_shuffle_ps(c_zxy, c_zxy, _MM_SHUFFLE(3, 0, 2, 1));
+    n[t[0]].v = _mm_add_ps(n[t[0]].v, c);
+    n[t[1]].v = _mm_add_ps(n[t[1]].v, c);
+    n[t[2]].v = _mm_add_ps(n[t[2]].v, c);
   }
+  for (std::size_t k = 0; k < n_vertices; ++k) {
+    alignas(16) float s[4];
+    _mm_store_ps(s, n[k].v);
+    const float len = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    mesh.normals[k] = len > 0 ? Eigen::Vector3f(s[0] / len, s[1] / len, s[2] / len)
+                              : Eigen::Vector3f::Zero();
+  }
+#else
+  std::fill(mesh.normals.begin(), mesh.normals.end(), Eigen::Vector3f::Zero());
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3f& a = mesh.vertices[t[0]];
+    const Eigen::Vector3f e = mesh.vertices[t[1]] - a, f = mesh.vertices[t[2]] - a;
+    const Eigen::Vector3f c(e[1] * f[2] - e[2] * f[1], e[2] * f[0] - e[0] * f[2],
+                            e[0] * f[1] - e[1] * f[0]);
+    for (const uint32_t k : t) mesh.normals[k] += c;
+  }
+  for (Eigen::Vector3f& x : mesh.normals) {
+    const float len = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    x = len > 0 ? Eigen::Vector3f(x / len) : Eigen::Vector3f::Zero();
+  }
+#endif
 }
 
 Mesh segment_marching_cubes(const SegmentSet& set) {
