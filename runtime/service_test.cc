@@ -54,6 +54,9 @@ TEST_F(ServiceTest, ConfigErrorsAreOneLineAndNonZero) {
   EXPECT_EQ(missing.wait_exit(10s), 1);
   auto& noargs = spawn("probe", "runtime/probe_service", {});
   EXPECT_EQ(noargs.wait_exit(10s), 2);
+  auto& nofile = spawn("probe", "runtime/probe_service", {"--config"});
+  EXPECT_EQ(nofile.wait_exit(10s), 2);
+  EXPECT_NE(nofile.log().find("--config needs a FILE"), std::string::npos) << nofile.log();
 }
 
 TEST_F(ServiceTest, LifecycleNotifiesAndPublishesStatus) {

@@ -84,7 +84,11 @@ int service_main(int argc, char** argv, const ServiceDefinition& definition) {
       print_help(definition);
       return 0;
     }
-    if (a == "--config" && i + 1 < argc) {
+    if (a == "--config") {
+      if (i + 1 == argc) {
+        std::fprintf(stderr, "%s: --config needs a FILE (see --help)\n", prog.c_str());
+        return 2;
+      }
       config_path = argv[++i];
     } else if (a.starts_with("--config=")) {
       config_path = std::string(a.substr(9));
