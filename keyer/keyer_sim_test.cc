@@ -102,12 +102,13 @@ Score score_keyer(bool motion_blur) {
         }
     }
   }
-  std::printf("sim keyer (%s): %d masks, mean IoU %.4f (worst %.4f), mean boundary error %.3f px, "
-              "false pos %ld / neg %ld px, mean encoded mask %.0f bytes; interior pixels lost %ld "
-              "(dark: %ld of %ld)\n",
-              motion_blur ? "motion blur" : "anti-aliased", s.masks, s.mean_iou(), s.worst_iou,
-              s.mean_boundary(), s.false_pos, s.false_neg, s.bytes_sum / s.masks, s.interior_lost,
-              s.dark_lost, s.dark_pixels);
+  std::printf(
+      "sim keyer (%s): %d masks, mean IoU %.4f (worst %.4f), mean boundary error %.3f px, "
+      "false pos %ld / neg %ld px, mean encoded mask %.0f bytes; interior pixels lost %ld "
+      "(dark: %ld of %ld)\n",
+      motion_blur ? "motion blur" : "anti-aliased", s.masks, s.mean_iou(), s.worst_iou,
+      s.mean_boundary(), s.false_pos, s.false_neg, s.bytes_sum / s.masks, s.interior_lost,
+      s.dark_lost, s.dark_pixels);
   return s;
 }
 
@@ -115,9 +116,9 @@ void expect_accurate(const Score& s, double min_mean_iou) {
   ASSERT_GT(s.masks, 40);
   EXPECT_GE(s.mean_iou(), min_mean_iou);
   EXPECT_GE(s.worst_iou, 0.96);
-  EXPECT_LE(s.mean_boundary(), 1.0);  // the bound
-  EXPECT_LE(s.mean_boundary(), 0.25); // what is reached (0.17-0.19 px): guards regressions
-  EXPECT_EQ(s.dark_lost, 0);          // no false holes where the clothes are dark
+  EXPECT_LE(s.mean_boundary(), 1.0);   // the bound
+  EXPECT_LE(s.mean_boundary(), 0.25);  // what is reached (0.17-0.19 px): guards regressions
+  EXPECT_EQ(s.dark_lost, 0);           // no false holes where the clothes are dark
   EXPECT_LE(s.interior_lost, 10);
   EXPECT_LE(s.bytes_sum / s.masks, 1500);
 }
@@ -135,8 +136,9 @@ TEST(KeyerSim, AccurateWithAntiAliasedEdges) { expect_accurate(score_keyer(false
 // The best any per-pixel binary cut can do on these frames: the true masks of the simulator's
 // own sub-samples (rendered exactly: the shutter instants at 16x the frame rate, the 2x2 grid as
 // a 2x camera whose pixel centres are the sub-sample positions), counted per pixel and cut at
-// 2 of 4. The keyer must come within 0.001 of it (measured 0.0001 / 0.0006 below). Also prints what a symmetric 3x3 filter of the
-// exact counts would reach (sub-pixel localisation; not achievable without exact coverage).
+// 2 of 4. The keyer must come within 0.001 of it (measured 0.0001 / 0.0006 below). Also prints what
+// a symmetric 3x3 filter of the exact counts would reach (sub-pixel localisation; not achievable
+// without exact coverage).
 struct Limit {
   double per_pixel = 0, filtered = 0;
 };
@@ -173,7 +175,8 @@ Limit coverage_limit(bool motion_blur) {
     studio->render_all(frame, nullptr, &truths);
     if (motion_blur) {
       const int64_t offsets[4] = {-3, -1, 1, 3};
-      for (int k = 0; k < 4; ++k) fine->render_all(fps_factor * frame + offsets[k], nullptr, &sub[k]);
+      for (int k = 0; k < 4; ++k)
+        fine->render_all(fps_factor * frame + offsets[k], nullptr, &sub[k]);
     } else {
       fine->render_all(frame, nullptr, &sub[0]);
     }
@@ -211,9 +214,10 @@ Limit coverage_limit(bool motion_blur) {
   }
   limit.per_pixel /= n;
   limit.filtered /= n;
-  std::printf("coverage limit (%s): per-pixel cut at 2/4 IoU %.4f, 3x3-filtered exact coverage "
-              "%.4f (%d masks)\n",
-              motion_blur ? "motion blur" : "anti-aliased", limit.per_pixel, limit.filtered, n);
+  std::printf(
+      "coverage limit (%s): per-pixel cut at 2/4 IoU %.4f, 3x3-filtered exact coverage "
+      "%.4f (%d masks)\n",
+      motion_blur ? "motion blur" : "anti-aliased", limit.per_pixel, limit.filtered, n);
   return limit;
 }
 
@@ -260,15 +264,19 @@ TEST(KeyerSim, DISABLED_ErrorsPerCamera) {
               near = u >= 0 && v >= 0 && u < got.width() && v < got.height() &&
                      bool(truth(u, v)) != bool(truth(x, y));
             }
-          if (got(x, y)) (near ? fp_near : fp_far)++; else (near ? fn_near : fn_far)++;
+          if (got(x, y))
+            (near ? fp_near : fp_far)++;
+          else
+            (near ? fn_near : fn_far)++;
           if (!near && std::getenv("DUMP")) {
             const Rgb8 p = images[c](x, y), q = studio->background(c)(x, y);
             std::printf("  far %s at (%d, %d): image %d %d %d, empty studio %d %d %d\n",
                         got(x, y) ? "FP" : "FN", x, y, p.r, p.g, p.b, q.r, q.g, q.b);
           }
         }
-      std::printf("frame %3d cam%d area %6ld IoU %.4f  FP near %4ld far %3ld  FN near %4ld far %3ld\n",
-                  int(frame), c, area, testing::iou(got, truth), fp_near, fp_far, fn_near, fn_far);
+      std::printf(
+          "frame %3d cam%d area %6ld IoU %.4f  FP near %4ld far %3ld  FN near %4ld far %3ld\n",
+          int(frame), c, area, testing::iou(got, truth), fp_near, fp_far, fn_near, fn_far);
     }
   }
 }

@@ -185,7 +185,7 @@ TEST(Keyer, KeepsRealGapsFillsFalseHoles) {
   for (int y = 20; y < 26; ++y)
     for (int x = 25; x < 29; ++x) im(x, y) = backing;  // the gap
   for (int y = 20; y < 26; ++y)
-    for (int x = 45; x < 49; ++x) im(x, y) = bluish;   // alpha 0.375 < 0.5: keyed as backing
+    for (int x = 45; x < 49; ++x) im(x, y) = bluish;  // alpha 0.375 < 0.5: keyed as backing
   for (bool keep : {true, false}) {
     KeyerOptions o;
     o.cleanup.keep_backing_gaps = keep;

@@ -30,7 +30,8 @@ Expected<void> read_int(const std::string& name, const YAML::Node& n, const std:
   }
 }
 
-Expected<void> read_bool(const std::string& name, const YAML::Node& n, const std::string& key, bool& out) {
+Expected<void> read_bool(const std::string& name, const YAML::Node& n, const std::string& key,
+                         bool& out) {
   try {
     out = n.as<bool>();
     return {};

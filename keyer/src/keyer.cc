@@ -119,8 +119,8 @@ bool Keyer::shows_backing(const void* context, int y, int32_t begin, int32_t end
     for (int32_t x = begin; x < end; ++x) {
       const uint8_t* q = px + 3 * x;
       const uint8_t* p = plate + 3 * x;
-      const int d = std::max({std::abs(q[L::r] - p[0]), std::abs(q[L::g] - p[1]),
-                              std::abs(q[L::b] - p[2])});
+      const int d =
+          std::max({std::abs(q[L::r] - p[0]), std::abs(q[L::g] - p[1]), std::abs(q[L::b] - p[2])});
       if (d <= self.backing_diff_) return true;
     }
     return false;

@@ -40,7 +40,6 @@ CleanupStats clean_mask(const RunMask& in, const CleanupOptions& options, RunMas
 // Does background run [begin, end) of row y show the clean backing? `context` is passed through.
 using ShowsBackingFn = bool (*)(const void* context, int y, int32_t begin, int32_t end);
 CleanupStats clean_mask(const RunMask& in, const CleanupOptions& options, RunMask& out,
-                        CleanupScratch& scratch, ShowsBackingFn shows_backing,
-                        const void* context);
+                        CleanupScratch& scratch, ShowsBackingFn shows_backing, const void* context);
 
 }  // namespace studio::keyer

@@ -66,9 +66,9 @@ class Keyer {
   bool chroma_all_ = false;        // every pixel is foreground (threshold above 255)
   uint8_t diff_min_ = 0;           // foreground iff max|I - P| >= this
   uint8_t alpha_lut_[256] = {};    // alpha of an excess (chroma) or a difference (difference key)
-  int backing_excess_ = 256;        // chroma: excess at and above which alpha = 0 (clean backing)
-  int backing_diff_ = -1;           // difference: diff at and below which alpha = 0
-  const void* frame_ = nullptr;     // the frame key() is working on (for shows_backing)
+  int backing_excess_ = 256;       // chroma: excess at and above which alpha = 0 (clean backing)
+  int backing_diff_ = -1;          // difference: diff at and below which alpha = 0
+  const void* frame_ = nullptr;    // the frame key() is working on (for shows_backing)
   // Clean plate: per-channel sums over plate_frames_ frames, and their average in RGB order.
   std::vector<uint32_t> plate_sum_;
   Image<Rgb8> plate_;
