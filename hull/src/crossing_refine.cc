@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -31,6 +32,26 @@ double neighbour_event(std::span<const Interval> a, std::span<const Interval> b,
   return best;
 }
 
+// Whether the straight image of the segment p0-p1 (a distortion-free camera, P = K [R | t]) lies
+// in one pixel row and within one run of `mask`, i.e. wholly inside the silhouette: cutting it
+// with that view would keep it whole (pixel (x, y) covers [x-0.5, x+0.5) x [y-0.5, y+0.5), the
+// row walker's convention). False means "cut to find out".
+bool inside_one_run(const Eigen::Matrix<double, 3, 4>& P, const RunMask& mask,
+                    const Eigen::Vector3d& p0, const Eigen::Vector3d& p1) {
+  const Eigen::Vector3d h0 = P * p0.homogeneous(), h1 = P * p1.homogeneous();
+  if (!(h0.z() > 0) || !(h1.z() > 0)) return false;
+  const double y0 = std::floor(h0.y() / h0.z() + 0.5), y1 = std::floor(h1.y() / h1.z() + 0.5);
+  if (y0 != y1 || y0 < 0 || y0 >= mask.height()) return false;
+  const double xa = std::floor(h0.x() / h0.z() + 0.5), xb = std::floor(h1.x() / h1.z() + 0.5);
+  const double lo = std::min(xa, xb), hi = std::max(xa, xb);
+  if (lo < 0 || hi >= mask.width()) return false;
+  const auto runs = mask.row(int(y0));
+  // The first run ending after lo must also start at or before it and reach past hi.
+  const auto it = std::upper_bound(runs.begin(), runs.end(), lo,
+                                   [](double x, const Run& r) { return x < double(r.end); });
+  return it != runs.end() && double(it->begin) <= lo && hi < double(it->end);
+}
+
 }  // namespace
 
 Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<const View> views,
@@ -51,6 +72,11 @@ Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<con
       along[k].push_back(std::move(*p));
     }
   }
+  // Distortion-free cameras get a cheap whole-segment test before the cut (inside_one_run).
+  std::vector<std::optional<Eigen::Matrix<double, 3, 4>>> straight(views.size());
+  for (std::size_t v = 0; v < views.size(); ++v)
+    if (views[v].camera->distortion.is_identity())
+      straight[v] = views[v].camera->projection_matrix();
   const auto column = [&](int i, int j) -> std::span<const Interval> {
     if (i < 0 || j < 0 || i >= g.cells_u || j >= g.cells_v) return {};
     return set.column(i, j);
@@ -93,9 +119,14 @@ Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<con
       Eigen::Vector3d d = Eigen::Vector3d::Zero();
       d[k == 0 ? ua : va] = first_inside ? 1 : -1;
       a.assign(1, Interval{0.f, float(step)});
-      for (const PreparedView& view : along[k]) {
+      for (std::size_t v = 0; v < views.size(); ++v) {
+        if (a.size() == 1 && straight[v] &&
+            inside_one_run(*straight[v], *views[v].mask, from + double(a[0].lo) * d,
+                           from + double(a[0].hi) * d)) {
+          continue;  // this view keeps the piece whole
+        }
         b.clear();
-        view.cut_line(from, d, a, &b, &scratch);
+        along[k][v].cut_line(from, d, a, &b, &scratch);
         std::swap(a, b);
         if (a.empty()) break;
       }
