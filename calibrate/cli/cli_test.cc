@@ -99,6 +99,32 @@ TEST(CalibrateCli, MalformedObservationsFileIsOneLineWithItsLine) {
   EXPECT_EQ(lines(r.err), 1) << r.err;
 }
 
+// Garbage that makes yaml-cpp throw, and a small file whose aliases repeat one list millions of
+// times: one line and exit 1 each (found while writing observations_yaml_fuzz).
+TEST(CalibrateCli, GarbageAndAliasBombsAreOneLine) {
+  const fs::path dir = scratch("garbage");
+  std::string bytes;
+  for (int i = 0; i < 1024; ++i) bytes += static_cast<char>(i * 37 % 256);
+  std::ofstream(dir / "binary.yaml", std::ios::binary) << bytes;
+  std::ofstream(dir / "deep.yaml") << "frames: " << std::string(5000, '[') << std::string(5000, ']');
+  std::string bomb = "frames:\n  - &f {id: 0, views: {";
+  std::string points = "[";
+  for (int i = 0; i < 300; ++i) points += i ? ", [0, 1, 2]" : "[0, 1, 2]";
+  for (int c = 0; c < 100; ++c) bomb += format("{}c{}: {}", c ? ", " : "", c, c ? "*p" : "&p " + points + "]");
+  bomb += "}}\n";
+  for (int f = 0; f < 200; ++f) bomb += "  - *f\n";  // 201 x 100 x 300 = 6.03M points in 5.6 kB
+  std::ofstream(dir / "bomb.yaml") << bomb;
+  for (const char* name : {"binary.yaml", "deep.yaml", "bomb.yaml"}) {
+    const Outcome r = run(dir, format("cameras --observations {} --out {}", (dir / name).string(),
+                                      (dir / "rig.yaml").string()));
+    EXPECT_EQ(r.code, 1) << name;
+    EXPECT_EQ(lines(r.err), 1) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(name), std::string::npos) << r.err;
+    if (std::string(name) == "bomb.yaml")
+      EXPECT_NE(r.err.find("more than 5000000 observations"), std::string::npos) << r.err;
+  }
+}
+
 TEST(CalibrateCli, CameraWithNoSharedFrameIsNamed) {
   const fs::path dir = scratch("island");
   SyntheticStudio s = make_synthetic_studio(SyntheticStudioOptions{});

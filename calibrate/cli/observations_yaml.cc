@@ -9,6 +9,8 @@
 namespace studio::calibrate {
 namespace {
 
+constexpr size_t kMaxObservations = 5'000'000;  // e.g. 50 cameras x 1000 frames x 100 points
+
 Expected<int> as_int(const yaml::Node& n) {
   auto v = n.as_int();
   if (!v) return std::unexpected(v.error());
@@ -55,7 +57,8 @@ Expected<TargetSpec> target_from(const yaml::Node& node) {
   return parsed;
 }
 
-Expected<FrameObservations> frame_from(const yaml::Node& node, Observations* obs) {
+Expected<FrameObservations> frame_from(const yaml::Node& node, Observations* obs,
+                                       size_t* point_count) {
   auto m = yaml::MapReader::from(node);
   if (!m) return std::unexpected(m.error());
   FrameObservations frame;
@@ -85,6 +88,9 @@ Expected<FrameObservations> frame_from(const yaml::Node& node, Observations* obs
     auto points = list.elements();
     if (!points) return std::unexpected(points.error());
     for (const yaml::Node& p : *points) {
+      // YAML aliases let a small file repeat one long list many times; cap what is read.
+      if (++*point_count > kMaxObservations)
+        return p.fail(format("more than {} observations in one file", kMaxObservations));
       auto v = p.as_doubles(3);
       if (!v) return std::unexpected(v.error());
       const double pid = (*v)[0];
@@ -111,8 +117,9 @@ Expected<TargetSpec> read_target_yaml(const std::string& path) {
   return target_from(*root);
 }
 
-Expected<ObservationsFile> read_observations_yaml(const std::string& path) {
-  auto root = yaml::load_file(path);
+namespace {
+
+Expected<ObservationsFile> observations_from(const Expected<yaml::Node>& root) {
   if (!root) return std::unexpected(root.error());
   auto m = yaml::MapReader::from(*root);
   if (!m) return std::unexpected(m.error());
@@ -146,13 +153,24 @@ Expected<ObservationsFile> read_observations_yaml(const std::string& path) {
   auto list = frames->elements();
   if (!list) return std::unexpected(list.error());
   if (list->empty()) return frames->fail("expected at least one frame");
+  size_t point_count = 0;
   for (const yaml::Node& f : *list) {
-    auto frame = frame_from(f, &out.observations);
+    auto frame = frame_from(f, &out.observations, &point_count);
     if (!frame) return std::unexpected(frame.error());
     out.observations.frames.push_back(std::move(*frame));
   }
   if (auto f = m->finish(); !f) return std::unexpected(f.error());
   return out;
+}
+
+}  // namespace
+
+Expected<ObservationsFile> read_observations_yaml(const std::string& path) {
+  return observations_from(yaml::load_file(path));
+}
+
+Expected<ObservationsFile> parse_observations_yaml(std::string_view text, const std::string& name) {
+  return observations_from(yaml::parse(text, name));
 }
 
 std::string format_observations_yaml(const Observations& obs, const TargetSpec& t) {

@@ -14,6 +14,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "calibrate/observations.h"
 #include "calibrate/target.h"
@@ -27,6 +28,8 @@ struct ObservationsFile {
 };
 
 Expected<ObservationsFile> read_observations_yaml(const std::string& path);
+// The same from text already in memory; `name` stands for the file in error messages.
+Expected<ObservationsFile> parse_observations_yaml(std::string_view text, const std::string& name);
 // A target FILE.yaml: {type: chessboard|grid|charuco, cols, rows, spacing[, marker, dictionary]},
 // at the top level or under `target:`.
 Expected<TargetSpec> read_target_yaml(const std::string& path);
