@@ -1,6 +1,8 @@
 #pragma once
 // Target detection in images (OpenCV): chessboards (cv::findChessboardCorners + cornerSubPix)
-// and ChArUco boards (OpenCV contrib aruco, 4.6 API; partial views give the corners seen).
+// and ChArUco boards (OpenCV contrib aruco, 4.6 API; partial views give the corners seen). ChArUco
+// corners are refined again in the pixel-centre convention (OpenCV 4.6 returns them ~0.4 px off)
+// and a corner whose id disagrees with its neighbours (a misread marker) is dropped.
 
 #include <functional>
 #include <string>
