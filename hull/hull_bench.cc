@@ -53,12 +53,14 @@ std::size_t voxel_carving(const Studio& s, int n) {
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
-        const Eigen::Vector4d x(g.box_min.x() + (i + 0.5) * step.x(), g.box_min.y() + (j + 0.5) * step.y(),
+        const Eigen::Vector4d x(g.box_min.x() + (i + 0.5) * step.x(),
+                                g.box_min.y() + (j + 0.5) * step.y(),
                                 g.box_min.z() + (k + 0.5) * step.z(), 1.0);
         bool in = true;
         for (std::size_t c = 0; c < P.size() && in; ++c) {
           const Eigen::Vector3d h = P[c] * x;
-          const int u = int(std::floor(h.x() / h.z() + 0.5)), v = int(std::floor(h.y() / h.z() + 0.5));
+          const int u = int(std::floor(h.x() / h.z() + 0.5)),
+                    v = int(std::floor(h.y() / h.z() + 0.5));
           const Mask& m = s.images[c];
           if (h.z() > 0 && u >= 0 && v >= 0 && u < m.width() && v < m.height()) in = m(u, v) != 0;
         }
@@ -102,8 +104,14 @@ void BM_Cut(benchmark::State& state) {
   state.counters["intervals"] = double(intervals);
   state.counters["speedup_vs_voxel"] = baseline_seconds(n) / per;
 }
-BENCHMARK(BM_Cut)->Args({128, 1})->Args({128, 2})->Args({256, 1})->Args({256, 2})->Args({512, 2})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Cut)
+    ->Args({128, 1})
+    ->Args({128, 2})
+    ->Args({256, 1})
+    ->Args({256, 2})
+    ->Args({512, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_Mesh(benchmark::State& state) {
   const Studio& s = Studio::get();

@@ -95,8 +95,8 @@ TEST(SilhouetteCut, RandomScenesContainTheObjectAndViewsOnlyShrink) {
   for (int trial = 0; trial < 4; ++trial) {
     Scene s;
     for (int k = 0; k < 4; ++k) {
-      s.ellipsoids.push_back({Eigen::Vector3d(U(rng), 1.0 + U(rng), U(rng)),
-                              Eigen::Vector3d(R(rng), R(rng), R(rng))});
+      s.ellipsoids.push_back(
+          {Eigen::Vector3d(U(rng), 1.0 + U(rng), U(rng)), Eigen::Vector3d(R(rng), R(rng), R(rng))});
     }
     s.boxes.push_back({Eigen::Vector3d(U(rng), 0.2, U(rng)), Eigen::Vector3d::Zero()});
     s.boxes.back().max = s.boxes.back().min + Eigen::Vector3d(0.2, 0.3, 0.15);
@@ -112,7 +112,8 @@ TEST(SilhouetteCut, RandomScenesContainTheObjectAndViewsOnlyShrink) {
     double previous = SegmentSet::full(g).volume();
     SegmentSet hull = SegmentSet::full(g);
     for (std::size_t k = 0; k < cams.size(); ++k) {
-      ASSERT_TRUE(cut(hull, std::span<const View>(&views.emplace_back(View{&cams[k], &masks[k]}), 1)));
+      ASSERT_TRUE(
+          cut(hull, std::span<const View>(&views.emplace_back(View{&cams[k], &masks[k]}), 1)));
       EXPECT_LE(hull.volume(), previous + 1e-12) << "view " << k;
       previous = hull.volume();
     }
@@ -124,7 +125,8 @@ TEST(SilhouetteCut, RandomScenesContainTheObjectAndViewsOnlyShrink) {
       for (int a = -1; a <= 1 && !found; ++a)
         for (int b = -1; b <= 1 && !found; ++b)
           for (int c = -1; c <= 1 && !found; ++c)
-            found = hull.contains(p + Eigen::Vector3d(a * g.dv() * 0.999, b * g.du() * 0.999, c * g.du() * 0.999));
+            found = hull.contains(
+                p + Eigen::Vector3d(a * g.dv() * 0.999, b * g.du() * 0.999, c * g.du() * 0.999));
       missed += !found;
       ++total;
     }
@@ -215,7 +217,8 @@ TEST(SilhouetteCut, OutsideImageKeptOrCut) {
   Scene s;
   s.ellipsoids.push_back({Eigen::Vector3d(0, 1, 0), Eigen::Vector3d::Constant(0.3)});
   // A camera close enough that the top and bottom of the box leave its image.
-  Camera cam = testing::look_at("c", {0, 1, 2.0}, {0, 1, 0}, Eigen::Vector3d::UnitY(), 320, 240, 300);
+  Camera cam =
+      testing::look_at("c", {0, 1, 2.0}, {0, 1, 0}, Eigen::Vector3d::UnitY(), 320, 240, 300);
   RunMask mask = testing::render_mask(cam, s);
   View v{&cam, &mask};
   GridSpec g;
@@ -234,7 +237,8 @@ TEST(SilhouetteCut, OutsideImageKeptOrCut) {
 }
 
 TEST(SilhouetteCut, RejectsMaskOfWrongSize) {
-  Camera cam = testing::look_at("cam3", {0, 1, 4}, {0, 1, 0}, Eigen::Vector3d::UnitY(), 320, 240, 300);
+  Camera cam =
+      testing::look_at("cam3", {0, 1, 4}, {0, 1, 0}, Eigen::Vector3d::UnitY(), 320, 240, 300);
   RunMask mask(100, 100);
   mask.finish();
   View v{&cam, &mask};

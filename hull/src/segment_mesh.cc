@@ -25,7 +25,8 @@ struct Lattice {
 // m_k is the midpoint of c_k c_{k+1}; o the centre.
 constexpr uint8_t pieces(unsigned config) {
   uint8_t p = uint8_t(config & 15u);
-  const int n = int(((config >> 0) & 1) + ((config >> 1) & 1) + ((config >> 2) & 1) + ((config >> 3) & 1));
+  const int n =
+      int(((config >> 0) & 1) + ((config >> 1) & 1) + ((config >> 2) & 1) + ((config >> 3) & 1));
   if (n >= 3) {
     p |= 0xF0;
   } else if (n == 2) {
@@ -119,8 +120,8 @@ void compute_normals(Mesh& mesh) {
     alignas(16) float s[4];
     _mm_store_ps(s, n[k].v);
     const float len = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-    mesh.normals[k] = len > 0 ? Eigen::Vector3f(s[0] / len, s[1] / len, s[2] / len)
-                              : Eigen::Vector3f::Zero();
+    mesh.normals[k] =
+        len > 0 ? Eigen::Vector3f(s[0] / len, s[1] / len, s[2] / len) : Eigen::Vector3f::Zero();
   }
 #else
   std::fill(mesh.normals.begin(), mesh.normals.end(), Eigen::Vector3f::Zero());
@@ -249,7 +250,6 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
     }
     return uint32_t(id);
   };
-
 
   // Per cell: lattice lines of corners, mid-edges and centre (doubled offsets from c0).
   static constexpr int kCorner[4][2] = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
@@ -384,7 +384,8 @@ MeshTopology check_topology(const Mesh& mesh) {
   }
   for (const auto& [key, n] : directed) {
     const uint32_t a = uint32_t(key >> 32), b = uint32_t(key);
-    if (a > b && directed.contains((uint64_t(b) << 32) | a)) continue;  // counted from the other side
+    if (a > b && directed.contains((uint64_t(b) << 32) | a))
+      continue;  // counted from the other side
     const auto it = directed.find((uint64_t(b) << 32) | a);
     const int m = it == directed.end() ? 0 : it->second;
     ++topo.edges;

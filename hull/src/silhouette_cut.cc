@@ -5,6 +5,8 @@
 #include <string>
 #include <thread>
 
+#include "grid_cut.h"
+
 namespace studio::hull {
 namespace {
 
@@ -159,7 +161,7 @@ struct PreparedView::Impl {
   double vref = 0, smin = 0, ds = 0.5, inv_ds = 2.0;
   int nbins = 0;
   std::vector<uint32_t> bin_start;
-  std::vector<float> bin_v;  // pairs (v0, v1) per run, in ideal pixel rows
+  std::vector<float> bin_v;                   // pairs (v0, v1) per run, in ideal pixel rows
   std::vector<std::pair<int, int>> occupied;  // maximal ranges [k0, k1) of non-empty bins
 
   double pencil_s(double u, double v) const {
@@ -480,269 +482,33 @@ void PreparedView::cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
   emit(result, out, out->size());
 }
 
-// The grid fast path of cut(): for a view whose pencil bins are built and whose whole domain
-// projects inside the image, every column (i, j) of the grid is the line o(i, j) + t e_axis with
-// o affine in (i, j), so its homogeneous image A(i, j) = P (o, 1) is affine in (i, j) and its
-// direction's image is the vanishing point V itself. The column's pencil coordinate (where its
-// image line A x V crosses the reference row) is then a ratio of two affine functions of (i, j)
-// — one division per column and camera — and a bin run [y0, y1) maps back to the column by
-// t(y) = (y A2 - A1) / (V1 - y V2) = y a(y) A2 - a(y) A1 with a(y) = 1 / (V1 - y V2) precomputed
-// per run end, so cutting costs a few multiplications per run and no division. Along a grid row
-// the bin coordinate is a monotone Moebius function of i, so the columns whose bins hold
-// silhouette form a few i-ranges per row, found by inverting it at the ends of the runs of
-// occupied bins: whole stretches of empty columns are skipped without touching them.
-struct GridCutAccess {
-  struct End {
-    double p, q;  // t = p A2 - q A1
-  };
-  using Span = std::pair<int, int>;
-  struct Fast {
-    double n0, ni, nj, d0, di, dj;        // bin coordinate = (n0 + j nj + i ni) / (d0 + j dj + i di)
-    double a10, a1i, a1j, a20, a2i, a2j;  // A1, A2 of column (i, j)
-    int nbins = 0;
-    const uint32_t* bin_start = nullptr;
-    const std::vector<Span>* occupied = nullptr;  // maximal runs of bins holding silhouette
-    std::vector<End> ends;                        // two per bin run, in bin order
-
-    // The column's bin when it holds silhouette, else -1.
-    int bin(int i, int j) const {
-      const double x = (n0 + j * nj + i * ni) / (d0 + j * dj + i * di);
-      if (!(x >= 0 && x < nbins)) return -1;
-      const int k = int(x);
-      return bin_start[k] == bin_start[k + 1] ? -1 : k;
-    }
-    // Sorted, disjoint i-ranges of row j holding every column whose bin holds silhouette (a
-    // superset: one column of margin for rounding; bin() decides exactly).
-    void row_spans(int j, int nu, std::vector<Span>* r) const {
-      r->clear();
-      const double N = n0 + j * nj, D = d0 + j * dj;
-      const double pole = -D / di;  // x(i) has its pole here (outside the domain)
-      for (const auto& [ka, kb] : *occupied) {
-        const double ia = (ka * D - N) / (ni - ka * di), ib = (kb * D - N) / (ni - kb * di);
-        const double lo = std::min(ia, ib), hi = std::max(ia, ib);
-        if (!(std::isfinite(lo) && std::isfinite(hi)) || (pole >= lo && pole <= hi)) {
-          r->assign(1, {0, nu});  // degenerate: keep the whole row
-          return;
-        }
-        const int a = int(std::floor(std::clamp(lo, -4.0, nu + 4.0))) - 1;
-        const int b = int(std::ceil(std::clamp(hi, -4.0, nu + 4.0))) + 2;
-        if (std::max(a, 0) < std::min(b, nu)) r->push_back({std::max(a, 0), std::min(b, nu)});
-      }
-      if (r->size() > 1) {
-        std::sort(r->begin(), r->end());
-        std::size_t w = 0;
-        for (std::size_t k = 1; k < r->size(); ++k) {
-          if ((*r)[k].first <= (*r)[w].second) {
-            (*r)[w].second = std::max((*r)[w].second, (*r)[k].second);
-          } else {
-            (*r)[++w] = (*r)[k];
-          }
-        }
-        r->resize(w + 1);
-      }
-    }
-    // out = in ∩ (the t-ranges of bin k's runs), float end points, touching pieces merged.
-    void cut(int i, int j, int k, std::span<const Interval> in, std::vector<Range>* pieces,
-             std::vector<Interval>* out) const {
-      const double A1 = a10 + j * a1j + i * a1i, A2 = a20 + j * a2j + i * a2i;
-      const uint32_t r0 = bin_start[k], r1 = bin_start[k + 1];
-      const End* e = ends.data() + 2 * r0;
-      const std::size_t n = r1 - r0;
-      pieces->resize(n);
-      Range* pc = pieces->data();
-      // t decreases with the image row when D > 0: the runs come in reverse t order.
-      if ((d0 + j * dj + i * di) > 0) {
-        for (std::size_t r = 0; r < n; ++r)
-          pc[n - 1 - r] = {e[2 * r + 1].p * A2 - e[2 * r + 1].q * A1,
-                           e[2 * r].p * A2 - e[2 * r].q * A1};
-      } else {
-        for (std::size_t r = 0; r < n; ++r)
-          pc[r] = {e[2 * r].p * A2 - e[2 * r].q * A1, e[2 * r + 1].p * A2 - e[2 * r + 1].q * A1};
-      }
-      std::size_t p = 0;
-      for (const Interval& iv : in) {
-        const double ilo = iv.lo, ihi = iv.hi;
-        while (p < n && pc[p].hi <= ilo) ++p;
-        for (std::size_t q = p; q < n && pc[q].lo < ihi; ++q) {
-          const float flo = float(std::max(ilo, pc[q].lo)), fhi = float(std::min(ihi, pc[q].hi));
-          if (!(fhi > flo)) continue;
-          if (!out->empty() && out->back().hi >= flo) {
-            out->back().hi = std::max(out->back().hi, fhi);
-          } else {
-            out->push_back({flo, fhi});
-          }
-        }
-      }
-    }
-  };
-
-  // A fast cutter for `view` over grid g, or false when the view has no pencil bins or the
-  // domain does not project inside its image.
-  static bool make(const PreparedView& view, const GridSpec& g, Fast* f) {
-    const PreparedView::Impl& m = *view.impl_;
-    if (!m.pencil || !m.all_inside) return false;
-    const Vec3& V = m.V;
-    Vec3 o = Vec3::Zero();
-    o[g.u()] = g.box_min[g.u()] + 0.5 * g.du();
-    o[g.v()] = g.box_min[g.v()] + 0.5 * g.dv();
-    const Vec3 A0 = m.P.leftCols<3>() * o + m.P.col(3);
-    const Vec3 Ai = m.P.col(g.u()) * g.du(), Aj = m.P.col(g.v()) * g.dv();
-    // Image line L = A x V crosses row vref at s = -(L1 vref + L2) / L0; bin coordinate
-    // (s - smin) / ds = N(A) / D(A), both linear in A.
-    const Vec3 cn = Vec3(m.vref * V[2] - V[1], V[0] - m.smin * V[2], m.smin * V[1] - m.vref * V[0]) *
-                    m.inv_ds;
-    const Vec3 cd(0, V[2], -V[1]);
-    f->n0 = cn.dot(A0), f->ni = cn.dot(Ai), f->nj = cn.dot(Aj);
-    f->d0 = cd.dot(A0), f->di = cd.dot(Ai), f->dj = cd.dot(Aj);
-    f->a10 = A0[1], f->a1i = Ai[1], f->a1j = Aj[1];
-    f->a20 = A0[2], f->a2i = Ai[2], f->a2j = Aj[2];
-    f->nbins = m.nbins;
-    f->bin_start = m.bin_start.data();
-    f->occupied = &m.occupied;
-    f->ends.resize(m.bin_v.size());
-    for (std::size_t r = 0; r < m.bin_v.size(); ++r) {
-      const double y = m.bin_v[r], a = 1 / (V[1] - y * V[2]);
-      f->ends[r] = {y * a, a};
-    }
-    return true;
+bool GridCutAccess::make(const PreparedView& view, const GridSpec& g, Fast* f) {
+  const PreparedView::Impl& m = *view.impl_;
+  if (!m.pencil || !m.all_inside) return false;
+  const Vec3& V = m.V;
+  Vec3 o = Vec3::Zero();
+  o[g.u()] = g.box_min[g.u()] + 0.5 * g.du();
+  o[g.v()] = g.box_min[g.v()] + 0.5 * g.dv();
+  const Vec3 A0 = m.P.leftCols<3>() * o + m.P.col(3);
+  const Vec3 Ai = m.P.col(g.u()) * g.du(), Aj = m.P.col(g.v()) * g.dv();
+  // Image line L = A x V crosses row vref at s = -(L1 vref + L2) / L0; bin coordinate
+  // (s - smin) / ds = N(A) / D(A), both linear in A.
+  const Vec3 cn =
+      Vec3(m.vref * V[2] - V[1], V[0] - m.smin * V[2], m.smin * V[1] - m.vref * V[0]) * m.inv_ds;
+  const Vec3 cd(0, V[2], -V[1]);
+  f->n0 = cn.dot(A0), f->ni = cn.dot(Ai), f->nj = cn.dot(Aj);
+  f->d0 = cd.dot(A0), f->di = cd.dot(Ai), f->dj = cd.dot(Aj);
+  f->a10 = A0[1], f->a1i = Ai[1], f->a1j = Aj[1];
+  f->a20 = A0[2], f->a2i = Ai[2], f->a2j = Aj[2];
+  f->nbins = m.nbins;
+  f->bin_start = m.bin_start.data();
+  f->occupied = &m.occupied;
+  f->ends.resize(m.bin_v.size());
+  for (std::size_t r = 0; r < m.bin_v.size(); ++r) {
+    const double y = m.bin_v[r], a = 1 / (V[1] - y * V[2]);
+    f->ends[r] = {y * a, a};
   }
-};
-
-namespace {
-
-// Cuts the columns of `src` (nullptr: every column full) by every view into `dst`.
-Expected<void> cut_grid(const GridSpec& g, const SegmentSet* src, std::span<const View> views,
-                        const CutOptions& options, SegmentSet* dst) {
-  if (auto ok = options.validate(); !ok) return ok;
-  Eigen::Vector4d X = Eigen::Vector4d::Zero();
-  X[g.a()] = 1;  // the columns meet at infinity along the continuous axis
-  std::vector<PreparedView> prepared;
-  prepared.reserve(views.size());
-  const Eigen::AlignedBox3d domain(g.box_min, g.box_max);
-  for (const View& v : views) {
-    auto p = PreparedView::create(*v.camera, *v.mask, X, options, &domain);
-    if (!p) return std::unexpected(p.error());
-    prepared.push_back(std::move(*p));
-  }
-  // Views with pencil bins over the whole domain take the grid fast path; the rest cut line by
-  // line. Cutting is an intersection, so the order of the views does not matter up to where
-  // touching float pieces merge; it is fixed, so the result does not depend on the threads.
-  std::vector<GridCutAccess::Fast> fast;
-  std::vector<const PreparedView*> general;
-  for (const PreparedView& p : prepared) {
-    GridCutAccess::Fast f;
-    if (GridCutAccess::make(p, g, &f)) {
-      fast.push_back(std::move(f));
-    } else {
-      general.push_back(&p);
-    }
-  }
-  Vec3 d = Vec3::Zero();
-  d[g.a()] = 1;
-  const int nu = g.cells_u, nv = g.cells_v;
-  const std::size_t columns = g.columns();
-  const Interval full_column{float(g.t_min()), float(g.t_max())};
-  const int T = int(
-      std::min<std::size_t>(std::size_t(options.threads), std::max<std::size_t>(columns / 256, 1)));
-  std::vector<std::vector<Interval>> chunk_iv(T);
-  std::vector<uint32_t> start(columns + 1, 0);  // counts at c + 1 first, prefix sums at the end
-  const auto work = [&](int chunk) {
-    const int j0 = int(int64_t(nv) * chunk / T), j1 = int(int64_t(nv) * (chunk + 1) / T);
-    std::vector<Interval>& out = chunk_iv[chunk];
-    std::vector<Interval> a, b;
-    std::vector<Range> pieces;
-    std::vector<GridCutAccess::Span> alive, spans, next;
-    CutScratch scratch;
-    const double du = g.du(), dv = g.dv();
-    const std::size_t F = fast.size();
-    std::vector<int> bins(F);
-    for (int j = j0; j < j1; ++j) {
-      // Candidate columns of the row: the intersection of every fast view's row spans.
-      alive.assign(1, {0, nu});
-      for (std::size_t f = 0; f < F && !alive.empty(); ++f) {
-        fast[f].row_spans(j, nu, &spans);
-        next.clear();
-        std::size_t q = 0;
-        for (const auto& [x0, x1] : alive) {
-          while (q < spans.size() && spans[q].second <= x0) ++q;
-          for (std::size_t r = q; r < spans.size() && spans[r].first < x1; ++r) {
-            const int lo = std::max(x0, spans[r].first), hi = std::min(x1, spans[r].second);
-            if (lo < hi) next.push_back({lo, hi});
-          }
-        }
-        std::swap(alive, next);
-      }
-      for (const auto& [x0, x1] : alive) {
-        for (int i = x0; i < x1; ++i) {
-          const std::size_t c = std::size_t(i) + std::size_t(j) * std::size_t(nu);
-          std::span<const Interval> cur =
-              src ? src->column(c) : std::span<const Interval>(&full_column, 1);
-          if (cur.empty()) continue;
-          bool dead = false;
-          for (std::size_t f = 0; f < F && !dead; ++f) dead = (bins[f] = fast[f].bin(i, j)) < 0;
-          if (dead) continue;
-          for (std::size_t f = 0; f < F && !cur.empty(); ++f) {
-            b.clear();
-            fast[f].cut(i, j, bins[f], cur, &pieces, &b);
-            std::swap(a, b);
-            cur = a;
-          }
-          if (!cur.empty() && !general.empty()) {
-            Vec3 o;
-            o[g.u()] = g.box_min[g.u()] + (i + 0.5) * du;
-            o[g.v()] = g.box_min[g.v()] + (j + 0.5) * dv;
-            o[g.a()] = 0;
-            for (const PreparedView* view : general) {
-              if (view->misses(o, d, cur.front().lo, cur.back().hi)) {
-                cur = {};
-                break;
-              }
-              b.clear();
-              view->cut_line(o, d, cur, &b, &scratch);
-              std::swap(a, b);
-              cur = a;
-              if (cur.empty()) break;
-            }
-          }
-          out.insert(out.end(), cur.begin(), cur.end());
-          start[c + 1] = uint32_t(cur.size());
-        }
-      }
-    }
-  };
-  std::vector<std::jthread> workers;
-  for (int k = 1; k < T; ++k) workers.emplace_back(work, k);
-  work(0);
-  workers.clear();
-  std::vector<Interval> all;
-  if (T == 1) {
-    all = std::move(chunk_iv[0]);
-  } else {
-    std::size_t total = 0;
-    for (const auto& v : chunk_iv) total += v.size();
-    all.reserve(total);
-    for (const auto& v : chunk_iv) all.insert(all.end(), v.begin(), v.end());
-  }
-  for (std::size_t c = 0; c < columns; ++c) start[c + 1] += start[c];
-  if (dst != src) *dst = SegmentSet::empty(g);
-  dst->assign(std::move(all), std::move(start));
-  return {};
-}
-
-}  // namespace
-
-Expected<void> cut(SegmentSet& set, std::span<const View> views, const CutOptions& options) {
-  return cut_grid(set.grid(), &set, views, options, &set);
-}
-
-Expected<SegmentSet> visual_hull(const GridSpec& grid, std::span<const View> views,
-                                 const CutOptions& options) {
-  if (auto ok = grid.validate(); !ok) return std::unexpected(ok.error());
-  SegmentSet set;
-  if (auto ok = cut_grid(grid, nullptr, views, options, &set); !ok) {
-    return std::unexpected(ok.error());
-  }
-  return set;
+  return true;
 }
 
 }  // namespace studio::hull
