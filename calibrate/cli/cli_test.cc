@@ -125,6 +125,22 @@ TEST(CalibrateCli, GarbageAndAliasBombsAreOneLine) {
   }
 }
 
+// Found by observations_yaml_fuzz: a frame without views was written as a bare "views:" that
+// did not read back.
+TEST(ObservationsYaml, FrameWithoutViewsRoundTrips) {
+  Observations obs;
+  obs.cameras.push_back({"cam0", 0, 0});
+  obs.frames.push_back({"0", Placement::origin, false, {View{"cam0", {{3, {1.5, 2.25}}}}}});
+  obs.frames.push_back({"1", Placement::free, true, {}});
+  auto back = parse_observations_yaml(format_observations_yaml(obs, *parse_target_spec("grid:10x10:0.1")),
+                                      "roundtrip.yaml");
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_EQ(back->observations.frames.size(), 2u);
+  EXPECT_TRUE(back->observations.frames[1].views.empty());
+  EXPECT_TRUE(back->observations.frames[1].holdout);
+  EXPECT_EQ(back->observations.frames[0].views[0].points[0].pixel, Eigen::Vector2d(1.5, 2.25));
+}
+
 TEST(CalibrateCli, CameraWithNoSharedFrameIsNamed) {
   const fs::path dir = scratch("island");
   SyntheticStudio s = make_synthetic_studio(SyntheticStudioOptions{});

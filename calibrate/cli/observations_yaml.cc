@@ -190,7 +190,7 @@ std::string format_observations_yaml(const Observations& obs, const TargetSpec& 
   for (const auto& f : obs.frames) {
     s += format("  - id: {}\n    placement: {}\n", yaml::quote(f.id), to_string(f.placement));
     if (f.holdout) s += "    holdout: true\n";
-    s += "    views:\n";
+    s += f.views.empty() ? "    views: {}\n" : "    views:\n";  // a frame nobody saw reads back
     for (const auto& v : f.views) {
       s += format("      {}: [", yaml::quote(v.camera_id));
       for (size_t i = 0; i < v.points.size(); ++i)
