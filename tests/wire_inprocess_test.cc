@@ -13,6 +13,7 @@
 #include "harness/fixture.h"
 #include "harness/wire_samples.h"
 #include "wire/endpoint.h"
+#include "wire/pubsub.h"
 
 namespace studio::testing {
 namespace {
@@ -171,6 +172,28 @@ TEST_F(WireInProcess, DataAvailableCallbackDeliversValidSamplesUntilRemoved) {
   stop = true;
   pump.join();
   EXPECT_GT(calls.load(), 0);
+}
+
+// A node's endpoints come from gather(): all or the first error, and the bundled publication
+// and subscription talk to each other.
+TEST_F(WireInProcess, GatherBuildsEndpointsOrReturnsTheFirstError) {
+  struct Io {
+    wire::Publication<studio_HeadPose> out;
+    wire::Subscription<studio_HeadPose> in;
+  };
+  auto io = wire::gather([](auto&&... e) { return Io{std::move(e)...}; },
+                         wire::Publication<studio_HeadPose>::create(*p_),
+                         wire::Subscription<studio_HeadPose>::create(*p_));
+  ASSERT_TRUE(io) << io.error().message;
+  ASSERT_TRUE(io->out->write(*make<studio_HeadPose>(3)));
+  EXPECT_EQ(io->in->take().size(), 1u);
+
+  auto failed = wire::gather([](int a, int b, int c) { return a + b + c; }, Expected<int>(1),
+                             Expected<int>(fail("second")), Expected<int>(fail("third")));
+  ASSERT_FALSE(failed);
+  EXPECT_EQ(failed.error().message, "second");
+  EXPECT_EQ(wire::gather([](int a, int b) { return a + b; }, Expected<int>(1), Expected<int>(2)),
+            3);
 }
 
 TEST_F(WireInProcess, BadConfigGivesOneLineError) {

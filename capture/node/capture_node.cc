@@ -11,6 +11,7 @@
 #include "core/log.h"
 #include "keyer/keyer.h"
 #include "wire/endpoint.h"
+#include "wire/pubsub.h"
 #include "yaml_io/rig_yaml.h"
 
 namespace studio::capture::node {
@@ -31,18 +32,12 @@ bool valid_take_name(const std::string& s) {
 }  // namespace
 
 struct CaptureNode::Wire {
-  wire::Topic<studio_AlphaMask> mask_topic;
-  wire::Topic<studio_CameraImage> image_topic;
-  wire::Topic<studio_CameraState> state_topic;
-  wire::Topic<studio_CameraCalibration> calibration_topic;
-  wire::Topic<studio_CameraControl> control_topic;
-  wire::Topic<studio_CaptureCommand> command_topic;
-  wire::Writer<studio_AlphaMask> masks;
-  wire::Writer<studio_CameraImage> images;
-  wire::Writer<studio_CameraState> states;
-  wire::Writer<studio_CameraCalibration> calibrations;
-  wire::Reader<studio_CameraControl> controls;
-  wire::Reader<studio_CaptureCommand> commands;
+  wire::Publication<studio_AlphaMask> masks;
+  wire::Publication<studio_CameraImage> images;
+  wire::Publication<studio_CameraState> states;
+  wire::Publication<studio_CameraCalibration> calibrations;
+  wire::Subscription<studio_CameraControl> controls;
+  wire::Subscription<studio_CaptureCommand> commands;
   wire::GuardCondition wake;
   wire::WaitSet waitset;
 };
@@ -100,37 +95,18 @@ CaptureNode::~CaptureNode() { stop(); }
 Expected<void> CaptureNode::start() {
   const auto& p = context_.participant;
   auto fail_with = [](const Error& e) { return std::unexpected(e); };
-  auto mt = wire::Topic<studio_AlphaMask>::create(p);
-  if (!mt) return fail_with(mt.error());
-  auto it = wire::Topic<studio_CameraImage>::create(p);
-  if (!it) return fail_with(it.error());
-  auto st = wire::Topic<studio_CameraState>::create(p);
-  if (!st) return fail_with(st.error());
-  auto ct = wire::Topic<studio_CameraCalibration>::create(p);
-  if (!ct) return fail_with(ct.error());
-  auto rt = wire::Topic<studio_CameraControl>::create(p);
-  if (!rt) return fail_with(rt.error());
-  auto qt = wire::Topic<studio_CaptureCommand>::create(p);
-  if (!qt) return fail_with(qt.error());
-  auto mw = wire::Writer<studio_AlphaMask>::create(p, *mt);
-  auto iw = wire::Writer<studio_CameraImage>::create(p, *it);
-  auto sw = wire::Writer<studio_CameraState>::create(p, *st);
-  auto cw = wire::Writer<studio_CameraCalibration>::create(p, *ct);
-  auto rr = wire::Reader<studio_CameraControl>::create(p, *rt);
-  auto qr = wire::Reader<studio_CaptureCommand>::create(p, *qt);
-  auto guard = wire::GuardCondition::create(p);
-  auto ws = wire::WaitSet::create(p);
-  for (const Error* e :
-       {mw ? nullptr : &mw.error(), iw ? nullptr : &iw.error(), sw ? nullptr : &sw.error(),
-        cw ? nullptr : &cw.error(), rr ? nullptr : &rr.error(), qr ? nullptr : &qr.error(),
-        guard ? nullptr : &guard.error(), ws ? nullptr : &ws.error()})
-    if (e) return fail_with(*e);
-  wire_.reset(new Wire{std::move(*mt), std::move(*it), std::move(*st), std::move(*ct),
-                       std::move(*rt), std::move(*qt), std::move(*mw), std::move(*iw),
-                       std::move(*sw), std::move(*cw), std::move(*rr), std::move(*qr),
-                       std::move(*guard), std::move(*ws)});
-  if (auto a = wire_->waitset.attach(wire_->controls, 1); !a) return fail_with(a.error());
-  if (auto a = wire_->waitset.attach(wire_->commands, 2); !a) return fail_with(a.error());
+  auto w = wire::gather([](auto&&... e) { return std::unique_ptr<Wire>(new Wire{std::move(e)...}); },
+                        wire::Publication<studio_AlphaMask>::create(p),
+                        wire::Publication<studio_CameraImage>::create(p),
+                        wire::Publication<studio_CameraState>::create(p),
+                        wire::Publication<studio_CameraCalibration>::create(p),
+                        wire::Subscription<studio_CameraControl>::create(p),
+                        wire::Subscription<studio_CaptureCommand>::create(p),
+                        wire::GuardCondition::create(p), wire::WaitSet::create(p));
+  if (!w) return fail_with(w.error());
+  wire_ = std::move(*w);
+  if (auto a = wire_->waitset.attach(*wire_->controls, 1); !a) return fail_with(a.error());
+  if (auto a = wire_->waitset.attach(*wire_->commands, 2); !a) return fail_with(a.error());
   if (auto a = wire_->waitset.attach(wire_->wake, 3); !a) return fail_with(a.error());
 
   for (auto& cam : cameras_) {
@@ -140,7 +116,7 @@ Expected<void> CaptureNode::start() {
     if (cam->calibration) {
       wire::Owned<studio_CameraCalibration> c;
       from_core(*cam->calibration, 0, realtime_ns(), false, c);
-      if (auto w = wire_->calibrations.write(*c); !w) return fail_with(w.error());
+      if (auto w = wire_->calibrations->write(*c); !w) return fail_with(w.error());
     }
     if (auto s = cam->source->start(); !s)
       return fail("camera " + cam->id + ": " + s.error().message);
@@ -226,7 +202,7 @@ void CaptureNode::publish_state(Camera& cam) {
   wire::Owned<studio_CameraState> sample;
   from_core(s, sample);
   if (wire_) {
-    if (auto w = wire_->states.write(*sample); !w) {
+    if (auto w = wire_->states->write(*sample); !w) {
       STUDIO_LOG(warn, kLog) << cam.id << ": state: " << w.error().message;
     }
   }
@@ -354,7 +330,7 @@ void CaptureNode::capture_loop(Camera& cam) {
         encode_mask(mask, options_.coding, bytes);
         from_core(cam.id, frame.frame, frame.capture_ns, bytes, mask.width(), mask.height(),
                   mask_sample);
-        if (wire_->masks.write(*mask_sample)) {
+        if (wire_->masks->write(*mask_sample)) {
           masks_published_.add();
           context_.metrics.latency().record(realtime_ns() - frame.capture_ns);
         }
@@ -374,7 +350,7 @@ void CaptureNode::capture_loop(Camera& cam) {
           cv::imencode(".jpg", bgr, image_bytes, {cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality});
         }
         from_core(cam.id, frame.frame, frame.capture_ns, w, h, !raw, image_bytes, image_sample);
-        if (wire_->images.write(*image_sample)) images_published_.add();
+        if (wire_->images->write(*image_sample)) images_published_.add();
       }
     }
     bool publish = false;
@@ -397,11 +373,11 @@ void CaptureNode::control_loop() {
   while (running_) {
     wire_->waitset.wait(std::chrono::milliseconds(200));
     wire_->wake.take();
-    for (auto& s : wire_->controls.take()) {
+    for (auto& s : wire_->controls->take()) {
       if (!s.meta.valid_data) continue;
       handle_control(to_core(*s.data));
     }
-    for (auto& s : wire_->commands.take()) {
+    for (auto& s : wire_->commands->take()) {
       if (!s.meta.valid_data) continue;
       handle_command(to_core(*s.data));
     }

@@ -13,6 +13,7 @@
 #include "segments_wire.h"
 #include "wire/convert.h"
 #include "wire/endpoint.h"
+#include "wire/pubsub.h"
 #include "wire/sample.h"
 #include "yaml_io/options.h"
 #include "yaml_io/rig_yaml.h"
@@ -58,33 +59,18 @@ class HullNode : public runtime::Node {
   ~HullNode() override { stop(); }
 
   Expected<void> start() override {
-    auto mask_topic = wire::Topic<studio_AlphaMask>::create(participant_);
-    if (!mask_topic) return std::unexpected(mask_topic.error());
-    auto cal_topic = wire::Topic<studio_CameraCalibration>::create(participant_);
-    if (!cal_topic) return std::unexpected(cal_topic.error());
-    auto seg_topic = wire::Topic<studio_SegmentSet>::create(participant_);
-    if (!seg_topic) return std::unexpected(seg_topic.error());
-    auto mesh_topic = wire::Topic<studio_ActorMesh>::create(participant_);
-    if (!mesh_topic) return std::unexpected(mesh_topic.error());
-    auto masks = wire::Reader<studio_AlphaMask>::create(participant_, *mask_topic);
-    if (!masks) return std::unexpected(masks.error());
-    auto cals = wire::Reader<studio_CameraCalibration>::create(participant_, *cal_topic);
-    if (!cals) return std::unexpected(cals.error());
-    auto segs = wire::Writer<studio_SegmentSet>::create(participant_, *seg_topic);
-    if (!segs) return std::unexpected(segs.error());
-    auto meshes = wire::Writer<studio_ActorMesh>::create(participant_, *mesh_topic);
-    if (!meshes) return std::unexpected(meshes.error());
-    auto waitset = wire::WaitSet::create(participant_);
-    if (!waitset) return std::unexpected(waitset.error());
-    auto guard = wire::GuardCondition::create(participant_);
-    if (!guard) return std::unexpected(guard.error());
-    if (auto r = waitset->attach(*masks, 1); !r) return std::unexpected(r.error());
-    if (auto r = waitset->attach(*cals, 2); !r) return std::unexpected(r.error());
-    if (auto r = waitset->attach(*guard, 3); !r) return std::unexpected(r.error());
-
-    io_.emplace(Io{std::move(*mask_topic), std::move(*cal_topic), std::move(*seg_topic),
-                   std::move(*mesh_topic), std::move(*masks), std::move(*cals), std::move(*segs),
-                   std::move(*meshes), std::move(*waitset), std::move(*guard)});
+    auto io = wire::gather([](auto&&... e) { return Io{std::move(e)...}; },
+                           wire::Subscription<studio_AlphaMask>::create(participant_),
+                           wire::Subscription<studio_CameraCalibration>::create(participant_),
+                           wire::Publication<studio_SegmentSet>::create(participant_),
+                           wire::Publication<studio_ActorMesh>::create(participant_),
+                           wire::WaitSet::create(participant_),
+                           wire::GuardCondition::create(participant_));
+    if (!io) return std::unexpected(io.error());
+    if (auto r = io->waitset.attach(*io->masks, 1); !r) return std::unexpected(r.error());
+    if (auto r = io->waitset.attach(*io->cals, 2); !r) return std::unexpected(r.error());
+    if (auto r = io->waitset.attach(io->guard, 3); !r) return std::unexpected(r.error());
+    io_.emplace(std::move(*io));
     running_ = true;
     worker_ = std::thread([this] { run(); });
     return {};
@@ -117,14 +103,10 @@ class HullNode : public runtime::Node {
 
  private:
   struct Io {
-    wire::Topic<studio_AlphaMask> mask_topic;
-    wire::Topic<studio_CameraCalibration> cal_topic;
-    wire::Topic<studio_SegmentSet> seg_topic;
-    wire::Topic<studio_ActorMesh> mesh_topic;
-    wire::Reader<studio_AlphaMask> masks;
-    wire::Reader<studio_CameraCalibration> cals;
-    wire::Writer<studio_SegmentSet> segs;
-    wire::Writer<studio_ActorMesh> meshes;
+    wire::Subscription<studio_AlphaMask> masks;
+    wire::Subscription<studio_CameraCalibration> cals;
+    wire::Publication<studio_SegmentSet> segs;
+    wire::Publication<studio_ActorMesh> meshes;
     wire::WaitSet waitset;
     wire::GuardCondition guard;
   };
@@ -145,11 +127,11 @@ class HullNode : public runtime::Node {
         timeout = std::max(std::chrono::nanoseconds(0), std::min(timeout, *d - SteadyClock::now()));
       io_->waitset.wait(timeout);
       if (!running_) break;
-      io_->cals.visit([&](const studio_CameraCalibration& s, const wire::SampleMeta& meta) {
+      io_->cals->visit([&](const studio_CameraCalibration& s, const wire::SampleMeta& meta) {
         if (!meta.valid_data) return;
         update_camera(s);
       });
-      io_->masks.visit([&](const studio_AlphaMask& s, const wire::SampleMeta& meta) {
+      io_->masks->visit([&](const studio_AlphaMask& s, const wire::SampleMeta& meta) {
         if (!meta.valid_data) return;
         masks_in_.add();
         auto mask = wire::to_core(s);
@@ -214,7 +196,7 @@ class HullNode : public runtime::Node {
     s->frame = frame.frame;
     s->capture_ns = frame.capture_ns;
     wire::from_core(set, *s);
-    if (auto r = io_->segs.write(*s); r) hulls_out_.add();
+    if (auto r = io_->segs->write(*s); r) hulls_out_.add();
     if (!options_.mesh) return;
     wire::Owned<studio_ActorMesh> m;
     wire::set(m->actor_id, actor_id);
@@ -229,16 +211,16 @@ class HullNode : public runtime::Node {
       }
     }
     mesh_to_wire(mesh, *m);
-    if (auto r = io_->meshes.write(*m); r) meshes_out_.add();
+    if (auto r = io_->meshes->write(*m); r) meshes_out_.add();
   }
 
   void dispose(const std::string& actor_id) {
     wire::Owned<studio_SegmentSet> s;
     wire::set(s->actor_id, actor_id);
-    (void)io_->segs.dispose(*s);
+    (void)io_->segs->dispose(*s);
     wire::Owned<studio_ActorMesh> m;
     wire::set(m->actor_id, actor_id);
-    (void)io_->meshes.dispose(*m);
+    (void)io_->meshes->dispose(*m);
   }
 
   // Mirrors the assembler's counts into the service metrics.

@@ -18,6 +18,7 @@
 #include "keyer_yaml.h"
 #include "wire/convert.h"
 #include "wire/endpoint.h"
+#include "wire/pubsub.h"
 #include "wire/sample.h"
 #include "yaml_io/options.h"
 
@@ -80,28 +81,17 @@ class KeyerNode : public runtime::Node {
   }
 
   Expected<void> start() override {
-    auto image_topic = wire::Topic<studio_CameraImage>::create(participant_);
-    if (!image_topic) return std::unexpected(image_topic.error());
-    auto mask_topic = wire::Topic<studio_AlphaMask>::create(participant_);
-    if (!mask_topic) return std::unexpected(mask_topic.error());
-    auto control_topic = wire::Topic<studio_CameraControl>::create(participant_);
-    if (!control_topic) return std::unexpected(control_topic.error());
-    auto images = wire::Reader<studio_CameraImage>::create(participant_, *image_topic);
-    if (!images) return std::unexpected(images.error());
-    auto controls = wire::Reader<studio_CameraControl>::create(participant_, *control_topic);
-    if (!controls) return std::unexpected(controls.error());
-    auto masks = wire::Writer<studio_AlphaMask>::create(participant_, *mask_topic);
-    if (!masks) return std::unexpected(masks.error());
-    auto waitset = wire::WaitSet::create(participant_);
-    if (!waitset) return std::unexpected(waitset.error());
-    auto guard = wire::GuardCondition::create(participant_);
-    if (!guard) return std::unexpected(guard.error());
-    if (auto r = waitset->attach(*images, 1); !r) return std::unexpected(r.error());
-    if (auto r = waitset->attach(*controls, 2); !r) return std::unexpected(r.error());
-    if (auto r = waitset->attach(*guard, 3); !r) return std::unexpected(r.error());
-    io_.emplace(Io{std::move(*image_topic), std::move(*mask_topic), std::move(*control_topic),
-                   std::move(*images), std::move(*controls), std::move(*masks), std::move(*waitset),
-                   std::move(*guard)});
+    auto io = wire::gather([](auto&&... e) { return Io{std::move(e)...}; },
+                           wire::Subscription<studio_CameraImage>::create(participant_),
+                           wire::Subscription<studio_CameraControl>::create(participant_),
+                           wire::Publication<studio_AlphaMask>::create(participant_),
+                           wire::WaitSet::create(participant_),
+                           wire::GuardCondition::create(participant_));
+    if (!io) return std::unexpected(io.error());
+    if (auto r = io->waitset.attach(*io->images, 1); !r) return std::unexpected(r.error());
+    if (auto r = io->waitset.attach(*io->controls, 2); !r) return std::unexpected(r.error());
+    if (auto r = io->waitset.attach(io->guard, 3); !r) return std::unexpected(r.error());
+    io_.emplace(std::move(*io));
     running_ = true;
     reader_ = std::thread([this] { read_loop(); });
     for (int i = 0; i < options_.threads; ++i) workers_.emplace_back([this] { key_loop(); });
@@ -148,12 +138,9 @@ class KeyerNode : public runtime::Node {
 
  private:
   struct Io {
-    wire::Topic<studio_CameraImage> image_topic;
-    wire::Topic<studio_AlphaMask> mask_topic;
-    wire::Topic<studio_CameraControl> control_topic;
-    wire::Reader<studio_CameraImage> images;
-    wire::Reader<studio_CameraControl> controls;
-    wire::Writer<studio_AlphaMask> masks;
+    wire::Subscription<studio_CameraImage> images;
+    wire::Subscription<studio_CameraControl> controls;
+    wire::Publication<studio_AlphaMask> masks;
     wire::WaitSet waitset;
     wire::GuardCondition guard;
   };
@@ -214,10 +201,10 @@ class KeyerNode : public runtime::Node {
     while (running_) {
       io_->waitset.wait(std::chrono::milliseconds(200));
       if (!running_) break;
-      io_->controls.visit([&](const studio_CameraControl& c, const wire::SampleMeta& meta) {
+      io_->controls->visit([&](const studio_CameraControl& c, const wire::SampleMeta& meta) {
         if (meta.valid_data) handle_control(c);
       });
-      io_->images.visit([&](const studio_CameraImage& s, const wire::SampleMeta& meta) {
+      io_->images->visit([&](const studio_CameraImage& s, const wire::SampleMeta& meta) {
         if (!meta.valid_data) return;
         images_in_.add();
         if (s.format != studio_IMAGE_RGB8) {
@@ -285,7 +272,7 @@ class KeyerNode : public runtime::Node {
 
   // Mirrors the wire validator's refusals into the service counters.
   void sync_wire_rejections() {
-    const uint64_t total = io_->images.rejected().total();
+    const uint64_t total = io_->images->rejected().total();
     if (total > seen_malformed_) {
       rejected_malformed_.add(total - seen_malformed_);
       rejected_.add(total - seen_malformed_);
@@ -376,7 +363,7 @@ class KeyerNode : public runtime::Node {
     s.frame = frame;
     s.capture_ns = capture_ns;
     wire::from_core(slot.mask, studio_MASK_CODEC, s);
-    if (auto r = io_->masks.write(s); !r) {
+    if (auto r = io_->masks->write(s); !r) {
       STUDIO_LOG(warn, kLog) << slot.id << ": " << r.error().message;
       return;
     }

@@ -11,6 +11,7 @@
 #include "segments_wire.h"
 #include "tracker/segment_raster.h"
 #include "wire/endpoint.h"
+#include "wire/pubsub.h"
 
 namespace studio::tracker::node {
 namespace {
@@ -27,10 +28,8 @@ struct TrackerNode::Worker {
 
   const NodeOptions& options;
   runtime::Metrics& metrics;
-  wire::Topic<studio_SegmentSet> segments_topic;
-  wire::Topic<studio_HeadPose> head_topic;
-  wire::Reader<studio_SegmentSet> reader;
-  wire::Writer<studio_HeadPose> writer;
+  wire::Subscription<studio_SegmentSet> segments;
+  wire::Publication<studio_HeadPose> heads;
   wire::GuardCondition stop_guard;
   wire::WaitSet waitset;
   HeadSearch search;
@@ -62,7 +61,7 @@ struct TrackerNode::Worker {
     wire::set(out->actor_id, id);
     out->frame = frame;
     wire::from_core(pose, *out);
-    if (auto r = writer.write(*out); !r) {
+    if (auto r = heads->write(*out); !r) {
       STUDIO_LOG(warn, kCategory) << r.error().message;
       return;
     }
@@ -143,10 +142,10 @@ struct TrackerNode::Worker {
       const auto triggered = waitset.wait(wait);
       if (std::find(triggered.begin(), triggered.end(), dds_attach_t(kStop)) != triggered.end())
         break;
-      reader.visit([&](const studio_SegmentSet& s, const wire::SampleMeta& meta) {
+      segments->visit([&](const studio_SegmentSet& s, const wire::SampleMeta& meta) {
         if (meta.valid_data) on_segments(s);
       });
-      const uint64_t total = reader.rejected().total();
+      const uint64_t total = segments->rejected().total();
       if (total > reader_rejects_seen) {
         rejected.add(total - reader_rejects_seen);
         reader_rejects_seen = total;
@@ -167,19 +166,15 @@ TrackerNode::~TrackerNode() { stop(); }
 
 Expected<void> TrackerNode::start() {
   if (worker_) return {};
-  auto segments_topic = wire::Topic<studio_SegmentSet>::create(participant_);
-  if (!segments_topic) return std::unexpected(segments_topic.error());
-  auto head_topic = wire::Topic<studio_HeadPose>::create(participant_);
-  if (!head_topic) return std::unexpected(head_topic.error());
-  auto reader = wire::Reader<studio_SegmentSet>::create(participant_, *segments_topic);
-  if (!reader) return std::unexpected(reader.error());
-  auto writer = wire::Writer<studio_HeadPose>::create(participant_, *head_topic);
-  if (!writer) return std::unexpected(writer.error());
+  auto segments = wire::Subscription<studio_SegmentSet>::create(participant_);
+  if (!segments) return std::unexpected(segments.error());
+  auto heads = wire::Publication<studio_HeadPose>::create(participant_);
+  if (!heads) return std::unexpected(heads.error());
   auto guard = wire::GuardCondition::create(participant_);
   if (!guard) return std::unexpected(guard.error());
   auto waitset = wire::WaitSet::create(participant_);
   if (!waitset) return std::unexpected(waitset.error());
-  if (auto r = waitset->attach(*reader, Worker::kData); !r) return std::unexpected(r.error());
+  if (auto r = waitset->attach(segments->reader, Worker::kData); !r) return std::unexpected(r.error());
   if (auto r = waitset->attach(*guard, Worker::kStop); !r) return std::unexpected(r.error());
   auto search = HeadSearch::create(options_.search);
   if (!search) return std::unexpected(search.error());
@@ -188,10 +183,8 @@ Expected<void> TrackerNode::start() {
 
   worker_.reset(new Worker{.options = options_,
                            .metrics = metrics_,
-                           .segments_topic = std::move(*segments_topic),
-                           .head_topic = std::move(*head_topic),
-                           .reader = std::move(*reader),
-                           .writer = std::move(*writer),
+                           .segments = std::move(*segments),
+                           .heads = std::move(*heads),
                            .stop_guard = std::move(*guard),
                            .waitset = std::move(*waitset),
                            .search = std::move(*search),
