@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -65,13 +67,15 @@ TEST(Detect, CharucoCornersLandWhereTheBoardPutsThem) {
   const auto pts = t.points();
   double worst = 0;
   for (const auto& p : *found) {
-    // Board pixel of the corner: y down from the top-left like the target frame; draw() puts
-    // the square edges at integer pixel coordinates (measured on the unwarped board: 99.99).
-    const cv::Vec3d b(pts[p.id].x() * ppm, pts[p.id].y() * ppm, 1);
+    // Board pixel of the corner: y down from the top-left like the target frame. draw() puts
+    // the square edges on pixel borders (pixels 0..99 are the first square), so in the
+    // pixel-centre convention of core/camera.h and warpPerspective a corner lies at 100k - 0.5.
+    const cv::Vec3d b(pts[p.id].x() * ppm - 0.5, pts[p.id].y() * ppm - 0.5, 1);
     const cv::Vec3d q = h * b;
     worst = std::max(worst, std::hypot(q[0] / q[2] - p.pixel.x(), q[1] / q[2] - p.pixel.y()));
   }
-  EXPECT_LT(worst, 0.5);  // within the ±0.5 px of the rendering convention
+  std::printf("worst ChArUco corner error on the warped board: %.3f px\n", worst);
+  EXPECT_LT(worst, 0.3);
 
   // Partial view: the right part of the board cut away still gives the corners that are seen.
   cv::Mat cut = image.clone();
