@@ -2,8 +2,11 @@
 
 #include <atomic>
 #include <chrono>
+#include <algorithm>
 #include <cmath>
+#include <deque>
 #include <thread>
+#include <utility>
 
 #include "core/clock.h"
 #include "core/frame_assembler.h"
@@ -54,6 +57,8 @@ class HullNode : public runtime::Node {
         hulls_out_(ctx.metrics.counter("segment_sets_out")),
         meshes_out_(ctx.metrics.counter("meshes_out")),
         calibrations_in_(ctx.metrics.counter("calibrations_in")),
+        calibrations_stale_(ctx.metrics.counter("calibrations_not_of_frame")),
+        tracked_(cameras_.size()),
         assembler_(make_assembler_options(options_, cameras_)) {}
 
   ~HullNode() override { stop(); }
@@ -156,18 +161,49 @@ class HullNode : public runtime::Node {
     }
   }
 
+  // A fixed camera's calibration replaces the camera. A tracked camera (Free-D) sends one per
+  // frame; the last kTrackedHistory are kept so that frame N is cut with the pose of frame N even
+  // when the calibration of N+1 has already arrived (DESIGN §5: everything is stamped by frame).
   void update_camera(const studio_CameraCalibration& s) {
     auto cam = wire::to_core(s);
     const int index = assembler_.source_index(s.camera_id);
     if (!cam || index < 0) return;
     calibrations_in_.add();
-    cameras_[index] = std::move(*cam);
+    auto& history = tracked_[std::size_t(index)];
+    if (s.tracked) {
+      auto at = std::lower_bound(history.begin(), history.end(), s.frame,
+                                 [](const auto& e, uint64_t f) { return e.first < f; });
+      if (at != history.end() && at->first == s.frame)
+        at->second = *cam;
+      else
+        history.insert(at, {s.frame, *cam});
+      while (history.size() > kTrackedHistory) history.pop_front();
+    } else {
+      history.clear();
+    }
+    cameras_[std::size_t(index)] = std::move(*cam);
+  }
+
+  // The camera to cut `frame` with: a tracked camera's calibration of that frame, else its
+  // latest one before it (counted: the pose may be a frame off), else the rig's or the last.
+  const Camera& camera_for(std::size_t index, uint64_t frame) {
+    const auto& history = tracked_[index];
+    if (history.empty()) return cameras_[index];
+    auto after = std::upper_bound(history.begin(), history.end(), frame,
+                                  [](uint64_t f, const auto& e) { return f < e.first; });
+    if (after == history.begin()) {
+      calibrations_stale_.add();
+      return history.front().second;
+    }
+    const auto& [at, camera] = *std::prev(after);
+    if (at != frame) calibrations_stale_.add();
+    return camera;
   }
 
   void process(const FrameAssembler<RunMask>::Frame& frame) {
     std::vector<View> views;
     for (std::size_t i = 0; i < frame.items.size(); ++i)
-      if (frame.items[i]) views.push_back(View{&cameras_[i], &*frame.items[i]});
+      if (frame.items[i]) views.push_back(View{&camera_for(i, frame.frame), &*frame.items[i]});
     CutOptions cut;
     cut.outside = options_.outside;
     cut.threads = options_.threads;
@@ -238,7 +274,9 @@ class HullNode : public runtime::Node {
   const wire::Participant& participant_;
   runtime::Metrics& metrics_;
   runtime::Counter &masks_in_, &masks_bad_, &frames_complete_, &frames_partial_, &frames_dropped_,
-      &masks_late_, &hulls_out_, &meshes_out_, &calibrations_in_;
+      &masks_late_, &hulls_out_, &meshes_out_, &calibrations_in_, &calibrations_stale_;
+  static constexpr std::size_t kTrackedHistory = 64;
+  std::vector<std::deque<std::pair<uint64_t, Camera>>> tracked_;  // per camera, by frame
   FrameAssembler<RunMask> assembler_;
   FrameAssemblerCounts seen_;
   std::optional<Io> io_;

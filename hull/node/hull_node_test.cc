@@ -235,6 +235,98 @@ TEST_F(HullNodeTest, MissingCameraWaitsForTheDeadlineThenGoesWithout) {
   EXPECT_EQ(hull.stop(), 0);
 }
 
+// A tracked camera's calibration changes every frame. Camera 0 alternates between its rig pose
+// (even frames) and one swung 25 degrees about the studio's vertical axis (odd frames), and its
+// masks are rendered from that frame's pose. The calibration of frame N+1 arrives before the
+// masks of frame N: the node must still cut frame N with the pose of frame N (the latest pose
+// would carve the actor away in camera 0).
+TEST_F(HullNodeTest, TrackedCameraIsCutWithThePoseOfItsFrame) {
+  std::vector<Camera> swung = cameras_;
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(25.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  swung[0].cam_from_world = cameras_[0].cam_from_world * Rigid3(turn, Eigen::Vector3d::Zero());
+  sim::StudioOptions so;
+  so.actor.motion = sim::Motion::walk;
+  auto swung_studio = sim::SimulatedStudio::create(swung, so).value();
+  auto pose_of = [&](int64_t f) -> const std::vector<Camera>& { return f % 2 ? swung : cameras_; };
+
+  auto p = wire::Participant::create().value();
+  auto mask_topic = wire::Topic<studio_AlphaMask>::create(p).value();
+  auto masks = wire::Writer<studio_AlphaMask>::create(p, mask_topic).value();
+  auto cal_topic = wire::Topic<studio_CameraCalibration>::create(p).value();
+  auto cals = wire::Writer<studio_CameraCalibration>::create(p, cal_topic).value();
+  auto seg_topic = wire::Topic<studio_SegmentSet>::create(p).value();
+  auto segs = wire::Reader<studio_SegmentSet>::create(p, seg_topic).value();
+  auto& hull = spawn("hull", "hull/studio-hull",
+                     {"--config", write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 96\n"
+                                               "  deadline_ms: 300\n  refine: false\n")});
+  ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
+  ASSERT_TRUE(masks.wait_for_readers(1, 10s));
+  ASSERT_TRUE(cals.wait_for_readers(1, 10s));
+
+  auto send_calibration = [&](int64_t f) {
+    wire::Owned<studio_CameraCalibration> c;
+    ASSERT_TRUE(wire::from_core(pose_of(f)[0], *c).has_value());
+    c->frame = uint64_t(f);
+    c->capture_ns = f;
+    c->tracked = true;
+    ASSERT_TRUE(cals.write(*c).has_value());
+  };
+  auto send_masks = [&](int64_t f) {
+    for (std::size_t c = 0; c < cameras_.size(); ++c) {
+      Mask m;
+      (f % 2 && c == 0 ? swung_studio : *studio_).render(int(c), f, nullptr, &m);
+      wire::Owned<studio_AlphaMask> s;
+      wire::set(s->camera_id, cameras_[c].id);
+      s->frame = uint64_t(f);
+      s->capture_ns = f;
+      wire::from_core(RunMask::from_mask(m.view()), studio_MASK_CODEC, *s);
+      ASSERT_TRUE(masks.write(*s).has_value());
+    }
+  };
+  auto local_volume = [&](int64_t f) {
+    std::vector<RunMask> runs(cameras_.size());
+    std::vector<View> views;
+    for (std::size_t c = 0; c < cameras_.size(); ++c) {
+      Mask m;
+      (f % 2 && c == 0 ? swung_studio : *studio_).render(int(c), f, nullptr, &m);
+      runs[c] = RunMask::from_mask(m.view());
+      views.push_back({&pose_of(f)[c], &runs[c]});
+    }
+    HullNodeOptions o;
+    o.box = {-1.5, 0, -1.5, 1.5, 2.2, 1.5};
+    o.grid = 96;
+    auto h = visual_hull(o.grid_spec(), views);
+    const auto actors = connected_components(*h, o.min_actor_volume);
+    return actors.empty() ? 0.0 : actors[0].volume();
+  };
+
+  // Frames 41, 43, ... (camera 0 swung): calibration N and N+1, then the masks of N.
+  std::map<int64_t, double> got;
+  for (int64_t f = 41; f < 41 + 2 * 12 && got.size() < 3; f += 2) {
+    send_calibration(f);
+    std::this_thread::sleep_for(150ms);  // taken by the node before N+1 replaces it (keep-last 1)
+    send_calibration(f + 1);
+    std::this_thread::sleep_for(150ms);
+    send_masks(f);
+    const auto until = std::chrono::steady_clock::now() + 1s;
+    while (std::chrono::steady_clock::now() < until && !got.count(f)) {
+      for (auto& s : segs.take())
+        if (s.meta.valid_data && std::string(s.data->actor_id) == "actor0" &&
+            s.data->frame == uint64_t(f))
+          got[f] = wire::to_core(*s.data).value().volume();
+      std::this_thread::sleep_for(20ms);
+    }
+  }
+  ASSERT_GE(got.size(), 2u) << hull.log();
+  for (const auto& [f, volume] : got) {
+    const double expected = local_volume(f);
+    EXPECT_GT(expected, 0.05);
+    EXPECT_NEAR(volume, expected, 1e-6 * expected) << "frame " << f;
+  }
+  EXPECT_EQ(hull.stop(), 0) << hull.log();
+}
+
 TEST_F(HullNodeTest, BadConfigIsOneLine) {
   struct Case {
     std::string section, expect;
