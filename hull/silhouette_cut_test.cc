@@ -37,6 +37,24 @@ Rig axis_rig(const Scene& scene, double r, std::initializer_list<int> axes) {
   return rig;
 }
 
+// The benchmark's scene: the synthetic actor seen by 8 cameras 704x576 on a 4 m ring.
+Rig actor_ring() {
+  Rig rig;
+  rig.cameras = testing::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
+  const Scene s = testing::actor();
+  for (const Camera& c : rig.cameras) rig.masks.push_back(testing::render_mask(c, s));
+  return rig;
+}
+
+// 128x128 columns along y over the actor's 2 m box.
+GridSpec actor_grid() {
+  GridSpec g;
+  g.box_min = {-1, 0, -1};
+  g.box_max = {1, 2, 1};
+  g.cells_u = g.cells_v = 128;
+  return g;
+}
+
 GridSpec cube_grid(double half, int n, Axis axis = Axis::y) {
   GridSpec g;
   g.box_min = Eigen::Vector3d::Constant(-half);
@@ -137,16 +155,11 @@ TEST(SilhouetteCut, RandomScenesContainTheObjectAndViewsOnlyShrink) {
 }
 
 TEST(SilhouetteCut, PencilAndRowWalkerAgree) {
-  const Scene s = testing::actor();
-  auto cams = testing::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
-  std::vector<RunMask> masks;
-  std::vector<View> views;
-  for (const Camera& c : cams) masks.push_back(testing::render_mask(c, s));
-  for (std::size_t k = 0; k < cams.size(); ++k) views.push_back({&cams[k], &masks[k]});
-  GridSpec g;
-  g.box_min = {-1, 0, -1};
-  g.box_max = {1, 2, 1};
-  g.cells_u = g.cells_v = 128;
+  const Rig rig = actor_ring();
+  const auto& cams = rig.cameras;
+  const auto& masks = rig.masks;
+  const std::vector<View> views = rig.views();
+  const GridSpec g = actor_grid();
   CutOptions fast, exact;
   exact.allow_pencil = false;
   fast.threads = 2;
@@ -168,16 +181,9 @@ TEST(SilhouetteCut, PencilAndRowWalkerAgree) {
 // intervals up to float rounding, except where a column's pencil coordinate lies on a bin border
 // and the two roundings pick neighbouring half-pixel bins.
 TEST(SilhouetteCut, GridFastPathMatchesPerLineCut) {
-  const Scene s = testing::actor();
-  auto cams = testing::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
-  std::vector<RunMask> masks;
-  std::vector<View> views;
-  for (const Camera& c : cams) masks.push_back(testing::render_mask(c, s));
-  for (std::size_t k = 0; k < cams.size(); ++k) views.push_back({&cams[k], &masks[k]});
-  GridSpec g;
-  g.box_min = {-1, 0, -1};
-  g.box_max = {1, 2, 1};
-  g.cells_u = g.cells_v = 128;
+  const Rig rig = actor_ring();
+  const std::vector<View> views = rig.views();
+  const GridSpec g = actor_grid();
   auto fast = visual_hull(g, views);
   ASSERT_TRUE(fast);
   const Eigen::AlignedBox3d domain(g.box_min, g.box_max);
