@@ -212,19 +212,8 @@ bool Recorder::write_frame(const std::vector<uint8_t>& pixels, uint64_t frame, i
     std::memcpy(entry + 8, &offset, 8);
     // A failed index append is an error too (the disk is full); the index is rebuilt at the end.
     const ssize_t w = ::write(index_fd_, entry, sizeof entry);
-    if (w != ssize_t(sizeof entry)) {
-      err = w < 0 ? errno : ENOSPC;
-      // The frame itself is complete: keep it.
-      good_bytes_ += total;
-      index_.push_back({frame, offset});
-      if (!first_frame_) first_frame_ = frame;
-      last_frame_ = frame;
-      std::lock_guard lock(mutex_);
-      ++stats_.frames_written;
-      stats_.bytes_written += total;
-      error_ = errno_text("recorder: cannot append to " + options_.dir + "/index", err);
-      return false;
-    }
+    const int index_err = w == ssize_t(sizeof entry) ? 0 : w < 0 ? errno : ENOSPC;
+    // The frame itself is complete: keep it, even when its index entry failed.
     good_bytes_ += total;
     index_.push_back({frame, offset});
     if (!first_frame_) first_frame_ = frame;
@@ -232,7 +221,9 @@ bool Recorder::write_frame(const std::vector<uint8_t>& pixels, uint64_t frame, i
     std::lock_guard lock(mutex_);
     ++stats_.frames_written;
     stats_.bytes_written += total;
-    return true;
+    if (index_err == 0) return true;
+    error_ = errno_text("recorder: cannot append to " + options_.dir + "/index", index_err);
+    return false;
   }
   // Remove the torn frame so the file ends with a complete one.
   if (::ftruncate(frames_fd_, off_t(good_bytes_)) != 0) {
