@@ -203,7 +203,9 @@ void check_disk_full(const std::string& report, bool exact_ten, const char* what
   EXPECT_EQ(torn, 0u) << report;  // the torn frame was cut off
   EXPECT_EQ(error_state, 1) << report;
   EXPECT_EQ(yaml_error, 1) << report;
-  if (exact_ten) EXPECT_EQ(written, 10u) << report;
+  if (exact_ten) {
+    EXPECT_EQ(written, 10u) << report;
+  }
   std::printf("%s: %llu frames intact, error:%s\n", what, (unsigned long long)written,
               message.c_str());
 }
@@ -221,8 +223,9 @@ TEST(Recorder, FullTmpfsStopsTakeCleanly) {
   const std::string dir = temp_dir("tmpfs") + "/mnt";
   const std::string report = disk_full_child(dir, Limit::kTmpfs, 0);
   check_disk_full(report, false, "tmpfs");
-  if (!HasFatalFailure() && !IsSkipped())
+  if (!HasFatalFailure() && !IsSkipped()) {
     EXPECT_NE(report.find("No space left on device"), std::string::npos) << report;
+  }
   std::filesystem::remove_all(std::filesystem::path(dir).parent_path());
 }
 

@@ -46,7 +46,9 @@ TEST(SimFrameSource, PacedFramesFollowTheStudioClock) {
     timespec ts{};
     clock_gettime(CLOCK_REALTIME, &ts);
     EXPECT_GE(int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec, fr.capture_ns);  // never early
-    if (prev) EXPECT_GT(fr.frame, *prev);
+    if (prev) {
+      EXPECT_GT(fr.frame, *prev);
+    }
     if (!first) first = fr.frame;
     prev = fr.frame;
     EXPECT_EQ(fr.image.width(), 176);
@@ -70,10 +72,11 @@ TEST(SimFrameSource, SameFrameSamePictureAcrossInstances) {
   auto fb = (*b)->next(1s).value().value();
   auto fa2 = (*a)->next(1s).value().value();
   EXPECT_EQ(fa2.frame, fa.frame + 1);
-  if (fb.frame == fa.frame)
+  if (fb.frame == fa.frame) {
     EXPECT_EQ(fa.image.pixels(), fb.image.pixels());
-  else if (fb.frame == fa2.frame)
+  } else if (fb.frame == fa2.frame) {
     EXPECT_EQ(fa2.image.pixels(), fb.image.pixels());
+  }
 }
 
 TEST(SimFrameSource, FeaturesClampReadBackAndChangeThePicture) {
