@@ -14,7 +14,8 @@ namespace {
 using namespace std::chrono_literals;
 
 Process sh(const std::filesystem::path& dir, const std::string& name, const std::string& script) {
-  auto p = Process::start({.name = name, .binary = "/bin/sh", .args = {"-c", script}, .dir = dir});
+  auto p = Process::start(
+      {.name = name, .binary = "/bin/sh", .args = {"-c", script}, .env = {}, .dir = dir});
   if (!p) throw std::runtime_error(p.error().message);
   return std::move(*p);
 }

@@ -120,8 +120,9 @@ TEST(CalibrateCli, GarbageAndAliasBombsAreOneLine) {
     EXPECT_EQ(r.code, 1) << name;
     EXPECT_EQ(lines(r.err), 1) << name << ": " << r.err;
     EXPECT_NE(r.err.find(name), std::string::npos) << r.err;
-    if (std::string(name) == "bomb.yaml")
+    if (std::string(name) == "bomb.yaml") {
       EXPECT_NE(r.err.find("more than 5000000 observations"), std::string::npos) << r.err;
+    }
   }
 }
 

@@ -173,14 +173,18 @@ void BM_NodeAt25Fps(benchmark::State& state) {
   const auto until = std::chrono::steady_clock::now() + 2s;
   while (std::chrono::steady_clock::now() < until) {
     for (auto& s : status.take())
-      if (s.meta.valid_data)
-        for (const auto& c : wire::view(s.data->counters))
-          if (std::string(wire::str(c.name)) == "frames_dropped")
+      if (s.meta.valid_data) {
+        for (const auto& c : wire::view(s.data->counters)) {
+          const std::string name(wire::str(c.name));
+          if (name == "frames_dropped") {
             dropped = c.value;
-          else if (std::string(wire::str(c.name)) == "frames_missed")
+          } else if (name == "frames_missed") {
             missed = c.value;
-          else if (std::string(wire::str(c.name)) == "images_in")
+          } else if (name == "images_in") {
             node_in = c.value;
+          }
+        }
+      }
     std::this_thread::sleep_for(100ms);
   }
   node->stop();

@@ -21,7 +21,9 @@ enum class Level { trace = 0, debug, info, warn, error, off };
 void set_level(std::string_view category, Level level);
 Level level_for(std::string_view category);
 bool enabled(std::string_view category, Level level);
-// Parses "info,hull=debug"; returns false (and changes nothing) on a malformed spec.
+// Parses "info,hull=debug" and applies it: the default level and the named categories' levels;
+// categories not named keep theirs (so a service's `log:` key adds to $STUDIO_LOG). Returns false
+// (and changes nothing) on a malformed spec.
 bool configure(std::string_view spec);
 std::string_view level_name(Level level);
 
@@ -43,9 +45,18 @@ class Line {
   std::ostringstream stream_;
 };
 
+// Turns `Line(...) << a << b` into a void expression for the conditional in STUDIO_LOG
+// ('&' binds looser than '<<').
+struct Voidify {
+  void operator&(const Line&) const {}
+};
+
 }  // namespace studio::log
 
-#define STUDIO_LOG(level, category)                                                 \
-  if (!::studio::log::enabled((category), ::studio::log::Level::level)) {           \
-  } else                                                                            \
-    ::studio::log::Line(::studio::log::Level::level, (category))
+// STUDIO_LOG(warn, "hull") << "frame " << n << ": " << message;
+// The arguments are not evaluated when the level is off. An expression, not an if/else, so it is
+// safe as the body of an unbraced if.
+#define STUDIO_LOG(level, category)                                             \
+  !::studio::log::enabled((category), ::studio::log::Level::level)              \
+      ? (void)0                                                                 \
+      : ::studio::log::Voidify() & ::studio::log::Line(::studio::log::Level::level, (category))
