@@ -228,6 +228,86 @@ TEST(SimStudio, MotionBlurSmearsTheImageButNotTheMask) {
   EXPECT_GT(changed, 200);
 }
 
+// The true matte: 255 inside, 0 outside, fractions of the 16 sub-samples only where the
+// silhouette crosses a pixel; cut at 1/2 it is the true mask up to sub-pixel ties.
+TEST(SimStudio, TrueMatteIsTheSubSampleCoverage) {
+  const SimulatedStudio studio = make();
+  std::vector<Mask> masks, mattes;
+  studio.render_all(40, nullptr, &masks, &mattes);
+  for (int c = 0; c < studio.camera_count(); ++c) {
+    const Mask& m = masks[c];
+    const Mask& a = mattes[c];
+    ASSERT_EQ(a.width(), m.width());
+    long edge = 0, partial = 0, disagree = 0, area = 0;
+    for (int y = 1; y + 1 < m.height(); ++y)
+      for (int x = 1; x + 1 < m.width(); ++x) {
+        const uint8_t v = a(x, y);
+        const int k = (v * 16 + 127) / 255;
+        ASSERT_EQ(v, (255 * k + 8) / 16) << "a multiple of 1/16 at " << x << "," << y;
+        area += m(x, y) != 0;
+        disagree += (v >= 128) != (m(x, y) != 0);
+        const bool uniform = m(x - 1, y) == m(x, y) && m(x + 1, y) == m(x, y) &&
+                             m(x, y - 1) == m(x, y) && m(x, y + 1) == m(x, y);
+        if (uniform) {
+          ASSERT_EQ(v, m(x, y)) << "away from the silhouette the matte is the mask";
+          continue;
+        }
+        ++edge;
+        partial += v != 0 && v != 255;
+      }
+    if (area == 0) continue;
+    EXPECT_GT(double(partial) / edge, 0.4) << "camera " << c;
+    EXPECT_LT(double(disagree) / area, 0.01) << "camera " << c;
+  }
+}
+
+// Edge pixels mix actor and backing by area: the image of an edge pixel lies between its
+// neighbours' colours in proportion to the matte (checked on the blue channel, where the
+// backing and the actor differ most; no noise, no spill).
+TEST(SimStudio, EdgePixelsMixActorAndBackingByCoverage) {
+  StudioOptions o;
+  o.noise_sigma = 0;
+  o.spill = 0;
+  const SimulatedStudio studio = make(o);
+  Image<Rgb8> im;
+  Mask m, a;
+  studio.render(0, 40, &im, &m, &a);
+  const Image<Rgb8>& bg = studio.background(0);
+  long checked = 0, close = 0;
+  for (int y = 2; y + 2 < m.height(); ++y)
+    for (int x = 2; x + 2 < m.width(); ++x) {
+      // Horizontal edges only: actor at x - 1 and x - 2, backing at x + 1 and x + 2.
+      if (!(a(x - 2, y) == 255 && a(x - 1, y) == 255 && a(x + 1, y) == 0 && a(x + 2, y) == 0))
+        continue;
+      const double c = a(x, y) / 255.0;
+      const double actor = im(x - 1, y).b, back = bg(x, y).b;
+      if (std::abs(actor - back) < 60) continue;
+      ++checked;
+      close += std::abs(im(x, y).b - (c * actor + (1 - c) * back)) < 0.2 * std::abs(actor - back);
+    }
+  ASSERT_GT(checked, 30);
+  EXPECT_GT(double(close) / checked, 0.85) << close << " of " << checked;
+}
+
+// With motion blur (and antialias, the default) the matte smears with the motion and still holds
+// the actor's area: summed over the image it is the coverage integrated over the shutter.
+TEST(SimStudio, MotionBlurredMatteKeepsTheArea) {
+  StudioOptions o;
+  o.motion_blur = true;
+  const SimulatedStudio studio = make(o);
+  Mask m, a;
+  studio.render(1, 60, nullptr, &m, &a);
+  double area = 0, matte = 0;
+  long partial = 0;
+  for (std::size_t i = 0; i < m.pixels().size(); ++i) {
+    area += m.pixels()[i] != 0;
+    matte += a.pixels()[i] / 255.0;
+    partial += a.pixels()[i] != 0 && a.pixels()[i] != 255;
+  }
+  EXPECT_NEAR(matte / area, 1.0, 0.03);
+  EXPECT_GT(partial, 300);
+}
+
 TEST(SimStudio, ProjectedImageAppearsFaintlyOnTheBackWall) {
   StudioOptions plain;
   StudioOptions projected;
@@ -271,6 +351,13 @@ TEST(SimStudio, RejectsBadConfigurationWithOneLine) {
   cams = ring_cameras({.count = 1});
   cams[0].width = 0;
   EXPECT_FALSE(SimulatedStudio::create(cams, {}));
+  for (int samples : {1, 65}) {
+    StudioOptions bad;
+    bad.aa_samples = samples;
+    auto aa = SimulatedStudio::create(ring_cameras(), bad);
+    ASSERT_FALSE(aa);
+    EXPECT_NE(aa.error().message.find("aa_samples"), std::string::npos);
+  }
 }
 
 }  // namespace

@@ -74,6 +74,21 @@ Expected<KeyerOptions> parse_keyer_options(const std::string& text, const std::s
       r = read_float(name, v, key, o.diff_high);
     } else if (key == "matte_threshold") {
       r = read_float(name, v, key, o.matte_threshold);
+    } else if (key == "edge_refine") {
+      r = read_bool(name, v, key, o.edge_refine);
+    } else if (key == "edge") {
+      if (!v.IsMap()) return fail(where(name, v) + ": edge: expected a mapping");
+      for (const auto& c : v) {
+        const std::string ek = c.first.as<std::string>("");
+        if (ek == "threshold") {
+          r = read_float(name, c.second, "edge.threshold", o.edge.threshold);
+        } else if (ek == "min_contrast") {
+          r = read_float(name, c.second, "edge.min_contrast", o.edge.min_contrast);
+        } else {
+          return fail(where(name, c.first) + ": edge: unknown key '" + ek + "'");
+        }
+        if (!r) return std::unexpected(r.error());
+      }
     } else if (key == "spill_strength") {
       r = read_float(name, v, key, o.spill_strength);
     } else if (key == "cleanup") {

@@ -98,12 +98,17 @@ Expected<void> Keyer::key_impl(ImageView<const Px> frame, RunMask& mask) {
     detail::bits_to_runs(row_bits_.data(), w, y, raw_);
   }
   raw_.finish();
+  const RunMask* keyed = &raw_;
+  if (options_.edge_refine) {
+    refine_edges(frame, raw_, options_.edge, refined_, edge_scratch_);
+    keyed = &refined_;
+  }
   if (options_.cleanup.keep_backing_gaps) {
     frame_ = &frame;
-    clean_mask(raw_, options_.cleanup, mask, cleanup_scratch_, &Keyer::shows_backing<Px>, this);
+    clean_mask(*keyed, options_.cleanup, mask, cleanup_scratch_, &Keyer::shows_backing<Px>, this);
     frame_ = nullptr;
   } else {
-    clean_mask(raw_, options_.cleanup, mask, cleanup_scratch_);
+    clean_mask(*keyed, options_.cleanup, mask, cleanup_scratch_);
   }
   return {};
 }

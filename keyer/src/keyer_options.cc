@@ -31,6 +31,10 @@ Expected<void> KeyerOptions::validate() const {
     return fail("diff_high: must be in (diff_low, 255]");
   if (!finite(matte_threshold) || matte_threshold <= 0.0f || matte_threshold > 1.0f)
     return fail("matte_threshold: must be in (0, 1]");
+  if (!finite(edge.threshold) || edge.threshold <= 0.0f || edge.threshold >= 1.0f)
+    return fail("edge.threshold: must be in (0, 1)");
+  if (!finite(edge.min_contrast) || edge.min_contrast < 0.0f)
+    return fail("edge.min_contrast: must be >= 0");
   if (cleanup.min_component_area < 0) return fail("cleanup.min_component_area: must be >= 0");
   if (cleanup.max_hole_area < 0) return fail("cleanup.max_hole_area: must be >= 0");
   if (!finite(spill_strength) || spill_strength < 0.0f || spill_strength > 1.0f)

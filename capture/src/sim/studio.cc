@@ -40,8 +40,11 @@ Expected<void> StudioOptions::validate() const {
     return fail("cloth_falloff, spill, shadow, ring_light, projection_strength and shutter must "
                 "lie in [0, 1]");
   }
-  if (blur_samples < 2 || blur_samples > 32) {
-    return fail(detail::cat("blur_samples ", blur_samples, " outside [2, 32]"));
+  if (blur_samples < 2 || blur_samples > 64) {
+    return fail(detail::cat("blur_samples ", blur_samples, " outside [2, 64]"));
+  }
+  if (aa_samples < 2 || aa_samples > 64) {
+    return fail(detail::cat("aa_samples ", aa_samples, " outside [2, 64]"));
   }
   if (threads < 1 || threads > 64) return fail(detail::cat("threads ", threads, " outside [1, 64]"));
   return {};
@@ -269,7 +272,8 @@ struct SimulatedStudio::Impl {
     return f;
   }
 
-  void render(int index, const detail::PreparedFrame& f, Image<Rgb8>* image, Mask* mask) const {
+  void render(int index, const detail::PreparedFrame& f, Image<Rgb8>* image, Mask* mask,
+              Image<uint8_t>* matte) const {
     const CameraCache& cam = caches.at(index);
     const int W = cam.camera.width, H = cam.camera.height;
     Image<Rgb8> local_image;
@@ -280,7 +284,8 @@ struct SimulatedStudio::Impl {
     if (mask->width() != W || mask->height() != H) *mask = Mask(W, H);
     std::memcpy(image->data(), cam.background.data(), sizeof(Rgb8) * W * H);
     std::memset(mask->data(), 0, static_cast<std::size_t>(W) * H);
-    detail::render_actor(options, cam, f, image, mask);
+    if (matte) *matte = Image<uint8_t>(W, H, 0);
+    detail::render_actor(options, cam, f, image, mask, matte);
     if (options.noise_sigma > 0) {
       const uint64_t key = mix(mix(options.seed, static_cast<uint64_t>(f.truth.frame)),
                                static_cast<uint64_t>(index));
@@ -373,20 +378,24 @@ FrameTruth SimulatedStudio::truth(int64_t frame) const {
   return t;
 }
 
-void SimulatedStudio::render(int camera, int64_t frame, Image<Rgb8>* image, Mask* true_mask) const {
-  impl_->render(camera, impl_->prepare(frame), image, true_mask);
+void SimulatedStudio::render(int camera, int64_t frame, Image<Rgb8>* image, Mask* true_mask,
+                             Image<uint8_t>* true_matte) const {
+  impl_->render(camera, impl_->prepare(frame), image, true_mask, true_matte);
 }
 
 FrameTruth SimulatedStudio::render_all(int64_t frame, std::vector<Image<Rgb8>>* images,
-                                       std::vector<Mask>* true_masks) const {
+                                       std::vector<Mask>* true_masks,
+                                       std::vector<Image<uint8_t>>* true_mattes) const {
   const detail::PreparedFrame f = impl_->prepare(frame);
   const int n = camera_count();
   if (images) images->resize(n);
   if (true_masks) true_masks->resize(n);
+  if (true_mattes) true_mattes->resize(n);
   std::atomic<int> next{0};
   auto work = [&] {
     for (int i; (i = next++) < n;) {
-      impl_->render(i, f, images ? &(*images)[i] : nullptr, true_masks ? &(*true_masks)[i] : nullptr);
+      impl_->render(i, f, images ? &(*images)[i] : nullptr, true_masks ? &(*true_masks)[i] : nullptr,
+                    true_mattes ? &(*true_mattes)[i] : nullptr);
     }
   };
   {

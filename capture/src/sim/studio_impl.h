@@ -68,9 +68,9 @@ inline const Eigen::Vector3d kKeyLight = Eigen::Vector3d(0.4, 1.0, 0.5).normaliz
 inline const Eigen::Vector3d kFillLight = Eigen::Vector3d(-0.5, 0.4, -0.3).normalized();
 
 ShadowMap make_shadow(const ActorBody& body, double strength);
-// Draws shadow, actor (true mask), spill, anti-aliasing or motion blur into image / mask, which
-// already hold the camera's background and zeros.
+// Draws shadow, actor (true mask, and the true matte when not null), spill, anti-aliasing or
+// motion blur into image / mask / matte, which already hold the camera's background and zeros.
 void render_actor(const StudioOptions& options, const CameraCache& cam, const PreparedFrame& frame,
-                  Image<Rgb8>* image, Mask* mask);
+                  Image<Rgb8>* image, Mask* mask, Image<uint8_t>* matte);
 
 }  // namespace studio::sim::detail

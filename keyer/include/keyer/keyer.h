@@ -4,10 +4,11 @@
 //
 // key() makes the mask row by row: a SIMD kernel (SSSE3, or AVX2 when the CPU has it, chosen at
 // run time; a scalar loop otherwise) turns a row of pixels into a bit per pixel, and the set bits
-// become runs directly, so no full-resolution intermediate image is ever written. Clean-up
-// (keyer/cleanup.h) then works on the runs. The binary decision is exactly
-// alpha >= matte_threshold of the formulas in keyer/keyer_options.h (the reference keyer in
-// keyer/reference_keyer.h computes the same mask per pixel in floating point; tests compare them).
+// become runs directly, so no full-resolution intermediate image is ever written. Edge
+// refinement (keyer/edge_refine.h) and clean-up (keyer/cleanup.h) then work on the runs. Before
+// them the binary decision is exactly alpha >= matte_threshold of the formulas in
+// keyer/keyer_options.h (the reference keyer in keyer/reference_keyer.h computes the same mask
+// per pixel in floating point; tests compare them).
 //
 // Frames are RGB8 or BGR8, including frames demosaiced from a Bayer sensor by the capture stage.
 // A Keyer is not thread-safe (it keeps scratch buffers); use one per camera.
@@ -77,6 +78,8 @@ class Keyer {
   std::vector<uint64_t> row_bits_;
   std::vector<uint8_t> plate_row_;
   RunMask raw_;
+  RunMask refined_;
+  EdgeRefineScratch edge_scratch_;
   CleanupScratch cleanup_scratch_;
 };
 

@@ -11,6 +11,10 @@
 // Difference key against a clean plate P (the paper's alternative to the chroma key):
 //   diff  = max over channels |I - P|
 //   alpha = clamp((diff - diff_low) / (diff_high - diff_low), 0, 1)
+// Edge refinement (keyer/edge_refine.h), on by default, then re-decides the pixels on either
+// side of each transition of that mask by unmixing their colour between the neighbouring actor
+// and backing colours: the binary mask follows the contour where the actor covers
+// edge.threshold of a pixel rather than where alpha crosses matte_threshold.
 // Clean-up runs on the binary mask's runs, at a cost linear in the number of runs: foreground
 // components (8-connected) smaller than min_component_area pixels are removed, then background
 // components (4-connected) that do not touch the image border and are at most max_hole_area
@@ -22,6 +26,7 @@
 #include <string_view>
 
 #include "core/error.h"
+#include "keyer/edge_refine.h"
 
 namespace studio::keyer {
 
@@ -49,6 +54,8 @@ struct KeyerOptions {
   float diff_high = 36.0f;    // difference at and above which alpha = 1
   // Binary mask = alpha >= matte_threshold, in (0, 1].
   float matte_threshold = 0.5f;
+  bool edge_refine = true;
+  EdgeRefineOptions edge;
   CleanupOptions cleanup;
   // Spill suppression for the preview image: K' = K - spill_strength * max(0, K - max(O1, O2)).
   float spill_strength = 1.0f;  // 0 = off, 1 = full (key channel limited to the larger other)

@@ -7,11 +7,18 @@
 // Contracts
 // - True mask: pixel (u, v) is 255 iff the ray through the pixel CENTRE (studio::Camera
 //   convention: pixel (0,0) is the centre of the top-left pixel; distortion honoured) hits the
-//   actor's solid at the frame's instant, 0 otherwise. Exact, not anti-aliased.
+//   actor's solid at the frame's instant, 0 otherwise. Exact, not anti-aliased: the geometric
+//   silhouette the visual hull is scored against.
+// - True matte: per pixel, the fraction (0..255) of the image's own sub-samples (over the
+//   pixel's area and, with motion blur, the shutter) that see the actor: the alpha a perfect
+//   keyer would recover from the image. It differs from the true mask only where the silhouette
+//   crosses a pixel, and where motion blur smears it (a part moving further than its own width
+//   during the exposure covers no pixel for more than half of it).
 // - Image: RGB, the cyclorama seen by the camera with realism knobs (all modest and on by
 //   default except motion blur and the projected image): sensor noise, illumination fall-off
 //   on the cloth (vignetting, distance and angle of the retro-reflection, seams), blue spill on
-//   the actor's edges, soft shadows of the actor on the floor, anti-aliased silhouette edges.
+//   the actor's edges, soft shadows of the actor on the floor, anti-aliased silhouette edges
+//   (area-integrated: see aa_samples). Motion blur integrates each pixel over the shutter.
 //   Background pixels are keyable: blue dominates (b > r + 60 and b > g + 60 before noise).
 // - Determinism: image and mask depend only on (cameras, options, frame); threads change nothing.
 // - Time: frame f shows the instant t = f / fps (motion blur integrates around it).
@@ -50,10 +57,15 @@ struct StudioOptions {
   double spill = 0.30;          // blue spill at grazing angles on the actor's edges
   double shadow = 0.40;         // darkness of the actor's soft floor shadow
   double ring_light = 0.12;     // the camera's own blue LED ring lighting the actor
-  bool antialias = true;        // supersampled silhouette edges (the mask stays exact)
+  // Image formation at the silhouette integrates over the pixel's area (and, with motion blur,
+  // over the shutter) like a sensor does, with sub-samples spread so that an edge's position
+  // is resolved to ~1/samples px in any direction (render.cc: pixel_samples).
+  bool antialias = true;        // area-integrated silhouette edges (the mask stays exact)
+  int aa_samples = 16;          // sub-samples per edge pixel, in [2, 64]
   bool motion_blur = false;     // integrate the actor over the shutter
   double shutter = 0.5;         // exposure as a fraction of the frame period
-  int blur_samples = 4;
+  int blur_samples = 16;        // instants, in [2, 64]; with antialias each has its own
+                                // sub-pixel sample where the silhouette crosses the pixel
   bool projected_image = false;  // a faint projected picture on the back wall (z = -half_width)
   double projection_strength = 0.12;
   Image<Rgb8> projection;        // the projected picture; empty = a built-in test scene
@@ -89,12 +101,14 @@ class SimulatedStudio {
 
   FrameTruth truth(int64_t frame) const;
 
-  // One camera. image and true_mask are (re)sized to the camera; either may be null.
-  void render(int camera, int64_t frame, Image<Rgb8>* image, Mask* true_mask) const;
+  // One camera. image, true_mask and true_matte are (re)sized to the camera; any may be null.
+  void render(int camera, int64_t frame, Image<Rgb8>* image, Mask* true_mask,
+              Image<uint8_t>* true_matte = nullptr) const;
   // All cameras of one frame, `threads` at a time; vectors are resized to camera_count().
   // Returns the frame's ground truth.
   FrameTruth render_all(int64_t frame, std::vector<Image<Rgb8>>* images,
-                        std::vector<Mask>* true_masks) const;
+                        std::vector<Mask>* true_masks,
+                        std::vector<Image<uint8_t>>* true_mattes = nullptr) const;
   // The empty studio as camera `camera` sees it, without noise (for difference keying).
   const Image<Rgb8>& background(int camera) const;
 
