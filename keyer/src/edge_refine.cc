@@ -10,11 +10,17 @@ namespace {
 template <class Px>
 class Refiner {
  public:
-  Refiner(ImageView<const Px> image, const RunMask& in, const EdgeRefineOptions& options,
-          std::vector<EdgeRefineScratch::Flip>& flips)
-      : image_(image), in_(in), flips_(flips),
-        threshold_(options.threshold),
+  using Flip = EdgeRefineScratch::Flip;
+  Refiner(ImageView<const Px> image, const RunMask& in, const EdgeRefineOptions& options)
+      : image_(image), in_(in), threshold_(options.threshold),
         min_contrast2_(double(options.min_contrast) * options.min_contrast) {}
+
+  // Decisions on pixels of row `row` go to `rows[0]`, of row `row + 1` to `rows[1]`.
+  void set_rows(int row, std::vector<Flip>* current, std::vector<Flip>* next) {
+    row_ = row;
+    rows_[0] = current;
+    rows_[1] = next;
+  }
 
   // Re-decides p (actor) and q = p + (dx, dy) (backing) from F = p - d and B = q + d.
   void transition(int px, int py, int dx, int dy) {
@@ -24,22 +30,29 @@ class Refiner {
     if (!in_.contains(fx, fy) || in_.contains(bx, by)) return;  // outer pixels must be pure
     const uint8_t* F = at(fx, fy);
     const uint8_t* B = at(bx, by);
-    // Integer colours: d, dd and the projections are exact in double.
-    double d[3], dd = 0;
+    int d[3], dd = 0;
     for (int k = 0; k < 3; ++k) {
-      d[k] = double(F[k]) - double(B[k]);
+      d[k] = int(F[k]) - int(B[k]);
       dd += d[k] * d[k];
     }
     if (dd < min_contrast2_) return;
     const double cut = threshold_ * dd;  // c(x) >= threshold  <=>  (I(x) - I(B)) . d >= cut
     auto projection = [&](int x, int y) {
       const uint8_t* I = at(x, y);
-      double e = 0;
-      for (int k = 0; k < 3; ++k) e += (double(I[k]) - double(B[k])) * d[k];
-      return e;
+      int e = 0;
+      for (int k = 0; k < 3; ++k) e += (int(I[k]) - int(B[k])) * d[k];
+      return double(e);
     };
-    flips_.push_back({py, px, projection(px, py) >= cut, true, dd});
-    flips_.push_back({qy, qx, projection(qx, qy) >= cut, false, dd});
+    // Along a row, push in increasing x so that each stream of a row's decisions stays sorted.
+    const Flip p{px, dd, projection(px, py) >= cut, true};
+    const Flip q{qx, dd, projection(qx, qy) >= cut, false};
+    if (dx < 0) {
+      rows_[0]->push_back(q);
+      rows_[0]->push_back(p);
+    } else {
+      rows_[py - row_]->push_back(p);
+      rows_[qy - row_]->push_back(q);
+    }
   }
 
  private:
@@ -52,8 +65,9 @@ class Refiner {
 
   ImageView<const Px> image_;
   const RunMask& in_;
-  std::vector<EdgeRefineScratch::Flip>& flips_;
   double threshold_, min_contrast2_;
+  int row_ = 0;
+  std::vector<Flip>* rows_[2] = {nullptr, nullptr};
 };
 
 // Row `runs` with the sorted flips of that row applied, into `out` (runs kept sorted, disjoint and
@@ -87,85 +101,106 @@ void apply_flips(std::span<const Run> runs, std::span<const EdgeRefineScratch::F
   }
 }
 
+// A row's decisions arrive as three runs sorted by x: [0, s1) from the transitions to the row
+// above, [s1, s2) from the row's own run ends, [s2, end) from the transitions to the row below.
+// Merges them into `out`, keeping one decision per pixel (the transition with the largest
+// contrast; ties: actor) and only the decisions that change the pixel.
+void resolve(const std::vector<EdgeRefineScratch::Flip>& row, std::size_t s1, std::size_t s2,
+             std::vector<EdgeRefineScratch::Flip>& out) {
+  using Flip = EdgeRefineScratch::Flip;
+  out.clear();
+  std::size_t i[3] = {0, s1, s2};
+  const std::size_t e[3] = {s1, s2, row.size()};
+  auto better = [](const Flip& a, const Flip& b) {
+    return a.contrast != b.contrast ? a.contrast > b.contrast : a.actor && !b.actor;
+  };
+  for (;;) {
+    int pick = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (i[k] < e[k] && (pick < 0 || row[i[k]].x < row[i[pick]].x)) pick = k;
+    }
+    if (pick < 0) break;
+    Flip best = row[i[pick]];
+    for (int k = 0; k < 3; ++k) {
+      for (; i[k] < e[k] && row[i[k]].x == best.x; ++i[k]) {
+        if (better(row[i[k]], best)) best = row[i[k]];
+      }
+    }
+    if (best.actor != best.was_actor) out.push_back(best);
+  }
+}
+
 template <class Px>
 EdgeRefineStats refine_impl(ImageView<const Px> image, const RunMask& in,
                             const EdgeRefineOptions& options, RunMask& out,
                             EdgeRefineScratch& scratch) {
   const int w = in.width(), h = in.height();
-  auto& flips = scratch.flips;
-  flips.clear();
-  Refiner<Px> refiner(image, in, options, flips);
-  for (int y = 0; y < h; ++y) {
-    // Transitions along the row: the ends of its runs.
-    for (const Run& r : in.row(y)) {
-      if (r.begin > 0) refiner.transition(r.begin, y, -1, 0);
-      if (r.end < w) refiner.transition(r.end - 1, y, 1, 0);
-    }
-    if (y + 1 == h) break;
-    // Transitions between rows y and y + 1: where exactly one of them is actor. Membership of
-    // each row toggles at its runs' ends, so the difference toggles at the merged ends.
-    const auto a = in.row(y), b = in.row(y + 1);
-    std::size_t i = 0, j = 0;
-    bool a_in = false, b_in = false;
-    int32_t from = 0;
-    while (i < 2 * a.size() || j < 2 * b.size()) {
-      auto end_at = [](std::span<const Run> r, std::size_t k) {
-        return k % 2 == 0 ? r[k / 2].begin : r[k / 2].end;
-      };
-      const int32_t xa = i < 2 * a.size() ? end_at(a, i) : INT32_MAX;
-      const int32_t xb = j < 2 * b.size() ? end_at(b, j) : INT32_MAX;
-      const int32_t x = std::min(xa, xb);
-      if (a_in != b_in) {  // [from, x) differs between the rows
-        for (int32_t u = from; u < x; ++u) {
-          if (a_in) {
-            refiner.transition(u, y, 0, 1);
-          } else {
-            refiner.transition(u, y + 1, 0, -1);
-          }
-        }
-      }
-      if (xa == x) {
-        a_in = !a_in;
-        ++i;
-      }
-      if (xb == x) {
-        b_in = !b_in;
-        ++j;
-      }
-      from = x;
-    }
-  }
-  // One decision per pixel: the transition with the largest contrast (ties: actor), then only
-  // the decisions that change the pixel.
-  std::sort(flips.begin(), flips.end(), [](const auto& a, const auto& b) {
-    if (a.y != b.y) return a.y < b.y;
-    if (a.x != b.x) return a.x < b.x;
-    if (a.contrast != b.contrast) return a.contrast > b.contrast;
-    return a.actor > b.actor;
-  });
-  flips.erase(std::unique(flips.begin(), flips.end(),
-                          [](const auto& p, const auto& q) { return p.y == q.y && p.x == q.x; }),
-              flips.end());
-  flips.erase(std::remove_if(flips.begin(), flips.end(),
-                             [](const auto& f) { return f.actor == f.was_actor; }),
-              flips.end());
-  EdgeRefineStats stats;
   if (out.width() == w && out.height() == h) {
     out.clear();
   } else {
     out = RunMask(w, h);
   }
-  std::size_t k = 0;
+  EdgeRefineStats stats;
+  Refiner<Px> refiner(image, in, options);
+  auto* current = &scratch.current;
+  auto* next = &scratch.next;
+  current->clear();
+  next->clear();
+  // Row by row: row y's decisions come from its own runs' ends and from the transitions to rows
+  // y - 1 (made in the previous step) and y + 1; once those are made, row y is final.
   for (int y = 0; y < h; ++y) {
-    const std::size_t first = k;
-    while (k < flips.size() && flips[k].y == y) ++k;
-    if (first == k) {
-      for (const Run& r : in.row(y)) out.push_run(y, r.begin, r.end);
-      continue;
+    refiner.set_rows(y, current, next);
+    const std::size_t s1 = current->size();
+    // Transitions along the row: the ends of its runs.
+    for (const Run& r : in.row(y)) {
+      if (r.begin > 0) refiner.transition(r.begin, y, -1, 0);
+      if (r.end < w) refiner.transition(r.end - 1, y, 1, 0);
     }
-    for (std::size_t f = first; f < k; ++f) (flips[f].actor ? stats.added : stats.removed) += 1;
-    apply_flips(in.row(y), {flips.data() + first, k - first}, scratch.row);
-    for (const Run& r : scratch.row) out.push_run(y, r.begin, r.end);
+    const std::size_t s2 = current->size();
+    if (y + 1 < h) {
+      // Transitions between rows y and y + 1: where exactly one of them is actor. Membership of
+      // each row toggles at its runs' ends, so the difference toggles at the merged ends.
+      const auto a = in.row(y), b = in.row(y + 1);
+      auto end_at = [](std::span<const Run> r, std::size_t k) {
+        return k % 2 == 0 ? r[k / 2].begin : r[k / 2].end;
+      };
+      std::size_t i = 0, j = 0;
+      bool a_in = false, b_in = false;
+      int32_t from = 0;
+      while (i < 2 * a.size() || j < 2 * b.size()) {
+        const int32_t xa = i < 2 * a.size() ? end_at(a, i) : INT32_MAX;
+        const int32_t xb = j < 2 * b.size() ? end_at(b, j) : INT32_MAX;
+        const int32_t x = std::min(xa, xb);
+        if (a_in != b_in) {  // [from, x) differs between the rows
+          for (int32_t u = from; u < x; ++u) {
+            if (a_in) {
+              refiner.transition(u, y, 0, 1);
+            } else {
+              refiner.transition(u, y + 1, 0, -1);
+            }
+          }
+        }
+        if (xa == x) {
+          a_in = !a_in;
+          ++i;
+        }
+        if (xb == x) {
+          b_in = !b_in;
+          ++j;
+        }
+        from = x;
+      }
+    }
+    resolve(*current, s1, s2, scratch.resolved);
+    if (scratch.resolved.empty()) {
+      for (const Run& r : in.row(y)) out.push_run(y, r.begin, r.end);
+    } else {
+      for (const auto& f : scratch.resolved) (f.actor ? stats.added : stats.removed) += 1;
+      apply_flips(in.row(y), scratch.resolved, scratch.row);
+      for (const Run& r : scratch.row) out.push_run(y, r.begin, r.end);
+    }
+    std::swap(current, next);
+    next->clear();
   }
   out.finish();
   return stats;

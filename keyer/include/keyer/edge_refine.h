@@ -40,13 +40,14 @@ struct EdgeRefineOptions {
 };
 
 struct EdgeRefineScratch {
-  struct Flip {  // a decision on pixel (x, y)
-    int32_t y, x;
-    bool actor;      // decided
-    bool was_actor;  // in the input mask
-    double contrast;  // |I(F) - I(B)|^2 of the transition that decided
+  struct Flip {  // a decision on pixel x of a row
+    int32_t x;
+    int32_t contrast;  // |I(F) - I(B)|^2 of the transition that decided
+    bool actor;        // decided
+    bool was_actor;    // in the input mask
   };
-  std::vector<Flip> flips;
+  std::vector<Flip> current, next;  // decisions on the row being finished and on the next one
+  std::vector<Flip> resolved;       // the row's changes
   std::vector<Run> row;
 };
 
