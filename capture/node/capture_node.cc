@@ -48,6 +48,8 @@ struct CaptureNode::Camera {
   std::optional<studio::Camera> calibration;
   std::optional<keyer::Keyer> keyer;
   std::thread thread;
+  int plate_remaining = 0;       // frame thread only: frames still to average into the plate
+  bool warned_no_plate = false;  // frame thread only
 
   std::mutex mutex;  // everything below
   TakeSchedule schedule;
@@ -55,6 +57,7 @@ struct CaptureNode::Camera {
   std::vector<std::unique_ptr<Recorder>> finishing;
   uint64_t source_drops_at_begin = 0;
   uint64_t recorder_drops = 0;  // queue drops of finished takes
+  int plate_request = -1;       // KeyerPlate: -1 none, 0 clear, N: the next N frames
   bool error_state = false;     // a take failed (disk full, ...): stays until restart
   bool source_error = false;    // the source fails now
   std::string error;
@@ -77,6 +80,8 @@ CaptureNode::CaptureNode(CaptureNodeOptions options, runtime::NodeContext& conte
       images_published_(context.metrics.counter("images_published")),
       frames_recorded_(context.metrics.counter("frames_recorded")),
       frames_dropped_(context.metrics.counter("frames_dropped")),
+      frames_unkeyed_(context.metrics.counter("frames_unkeyed")),
+      plates_captured_(context.metrics.counter("plates_captured")),
       controls_rejected_(context.metrics.counter("controls_rejected")),
       commands_rejected_(context.metrics.counter("commands_rejected")) {
   for (auto& setup : options_.cameras) {
@@ -236,8 +241,10 @@ void CaptureNode::capture_loop(Camera& cam) {
       Frame& frame = **next;
       source_failed = false;
       bool send_image = false, raw = false;
+      int plate_request = -1;
       {
         std::lock_guard lock(cam.mutex);
+        plate_request = std::exchange(cam.plate_request, -1);
         if (cam.source_error) {  // the source recovered
           cam.source_error = false;
           cam.error.clear();
@@ -324,8 +331,29 @@ void CaptureNode::capture_loop(Camera& cam) {
       }
 
       // Key → mask codec → AlphaMask (unless keying runs elsewhere: masks: false).
+      if (options_.publish_masks && plate_request >= 0) {
+        cam.keyer->clear_plate();
+        cam.plate_remaining = plate_request;
+        cam.warned_no_plate = false;
+      }
       if (!options_.publish_masks) {
         // studio-keyer --config keys the raw images on another machine.
+      } else if (cam.plate_remaining > 0) {  // clean plate on command: no mask meanwhile
+        if (auto r = cam.keyer->capture_plate(frame.image.view()); !r) {
+          STUDIO_LOG(warn, kLog) << cam.id << ": clean plate: " << r.error().message;
+          cam.plate_remaining = 0;
+        } else if (--cam.plate_remaining == 0) {
+          plates_captured_.add();
+          STUDIO_LOG(info, kLog) << cam.id << ": clean plate captured ("
+                                 << cam.keyer->plate_frames() << " frames)";
+        }
+      } else if (options_.keyer.mode == keyer::KeyMode::kDifference && !cam.keyer->has_plate()) {
+        frames_unkeyed_.add();
+        if (!cam.warned_no_plate) {
+          STUDIO_LOG(warn, kLog) << cam.id << ": no clean plate yet (send CameraControl "
+                                 << keyer::kPlateControl << " N); frames are not keyed";
+          cam.warned_no_plate = true;
+        }
       } else if (auto k = cam.keyer->key(frame.image.view(), mask); k) {
         encode_mask(mask, options_.coding, bytes);
         from_core(cam.id, frame.frame, frame.capture_ns, bytes, mask.width(), mask.height(),
@@ -390,7 +418,22 @@ void CaptureNode::handle_control(const CameraControlCore& c) {
     if (x->id == c.camera_id) cam = x.get();
   if (!cam) return;  // another node's camera
   std::string problem;
-  if (c.feature == "ImageRate") {
+  if (c.feature == keyer::kPlateControl) {
+    // For whichever process keys this camera: here only when it keys in-process.
+    if (!options_.publish_masks) return;
+    if (!keyer::valid_plate_request(c.value)) {
+      problem = "camera " + cam->id + ": " + std::string(keyer::kPlateControl) + " " +
+                std::to_string(c.value) + ": expected 0 (clear) or a frame count 1.." +
+                std::to_string(keyer::kMaxPlateFrames);
+    } else {
+      std::lock_guard lock(cam->mutex);
+      cam->plate_request = int(c.value);
+      STUDIO_LOG(info, kLog) << cam->id << ": "
+                             << (c.value == 0 ? std::string("clean plate cleared")
+                                              : "capturing a clean plate from the next " +
+                                                    std::to_string(int(c.value)) + " frame(s)");
+    }
+  } else if (c.feature == "ImageRate") {
     std::lock_guard lock(cam->mutex);
     cam->image_rate = std::clamp(c.value, 0.0, 1e9 / double(options_.clock.period_ns));
   } else if (c.feature == "ImageRaw") {

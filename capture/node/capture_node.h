@@ -11,7 +11,9 @@
 // A control thread waits on studio/camera/control and studio/capture/command: CameraControl for
 // an allow-listed GenICam feature (Gain, ExposureTime, Focus, Zoom, Iris) is applied through
 // FrameSource::set_feature and the read-back value is published in CameraState; ImageRate and
-// ImageRaw are the node's own pseudo-features. CaptureCommand schedules start/stop per camera.
+// ImageRaw are the node's own pseudo-features; KeyerPlate (keyer/keyer.h) captures a clean plate
+// for an in-process difference key (ignored with masks: false: the keyer node honours it then).
+// CaptureCommand schedules start/stop per camera.
 // The calibration of every camera (rig file, else the source's own) is published on
 // studio/camera/calibration (transient-local) at start.
 
@@ -81,6 +83,8 @@ class CaptureNode : public runtime::Node {
   runtime::Counter& images_published_;
   runtime::Counter& frames_recorded_;
   runtime::Counter& frames_dropped_;
+  runtime::Counter& frames_unkeyed_;   // difference key without a clean plate yet
+  runtime::Counter& plates_captured_;  // KeyerPlate requests completed
   runtime::Counter& controls_rejected_;
   runtime::Counter& commands_rejected_;
 };

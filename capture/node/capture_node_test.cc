@@ -246,6 +246,76 @@ TEST_F(CaptureNodeTest, PublishesMasksImagesStateAndAppliesControl) {
   EXPECT_EQ(p.stop(), 0) << p.log();
 }
 
+// With the difference key the node publishes no mask until a clean plate is captured on command
+// (CameraControl KeyerPlate N: the next N frames); a bad count is an error in CameraState. A node
+// that does not key (masks: false) leaves KeyerPlate to the keyer node: no error there.
+TEST_F(CaptureNodeTest, DifferenceKeyWaitsForAPlateCapturedOnCommand) {
+  auto masks = reader<studio_AlphaMask>();
+  auto states = reader<studio_CameraState>();
+  auto control = writer<studio_CameraControl>();
+  const std::string keyer_yaml = write_config("keyer.yaml", "keyer: {key: difference}\n");
+  auto& keying = spawn("capture0", "capture/studio-capture",
+                       {"--config", write_config("cap0.yaml", sim_config({0}, 176, 144,
+                                                                         "keyer: " + keyer_yaml + "\n"))});
+  auto& elsewhere = spawn("capture1", "capture/studio-capture",
+                          {"--config", write_config("cap1.yaml", sim_config({1}, 176, 144,
+                                                                            "masks: false\n"))});
+  ASSERT_TRUE(keying.wait_ready(30s)) << keying.log();
+  ASSERT_TRUE(elsewhere.wait_ready(30s)) << elsewhere.log();
+  std::map<std::string, wire::Owned<studio_CameraState>> st;
+  ASSERT_TRUE(wait_states(
+      states, st,
+      [](auto& s) {
+        return s.count("cam0") && s.count("cam1") &&
+               s.at("cam0")->state == studio_CAMERA_STREAMING &&
+               s.at("cam1")->state == studio_CAMERA_STREAMING;
+      },
+      10s));
+  std::this_thread::sleep_for(1s);  // 25 frames without a plate
+  EXPECT_TRUE(masks.take().empty());
+
+  auto set = [&](const std::string& camera, const std::string& feature, double value) {
+    wire::Owned<studio_CameraControl> c;
+    wire::set(c->camera_id, camera);
+    wire::set(c->feature, feature);
+    c->value = value;
+    ASSERT_TRUE(control.write(*c));
+  };
+  auto error_of = [](const auto& s, const char* camera) {
+    return std::string(wire::str(s.at(camera)->error));
+  };
+  ASSERT_TRUE(control.wait_for_readers(2, 10s));
+  set("cam0", "KeyerPlate", 2.5);
+  EXPECT_TRUE(wait_states(
+      states, st, [&](auto& s) { return error_of(s, "cam0").find("KeyerPlate") != std::string::npos; },
+      10s));
+  set("cam0", "KeyerPlate", 3);
+  int got = 0;
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while (got < 5 && std::chrono::steady_clock::now() < deadline) {
+    for (auto& m : masks.take()) {
+      if (!m.meta.valid_data) continue;
+      EXPECT_STREQ(m.data->camera_id, "cam0");
+      auto mask = decode_mask(wire::view(m.data->data));
+      ASSERT_TRUE(mask) << mask.error().message;
+      EXPECT_EQ(mask->width(), 176);
+      ++got;
+    }
+    std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_GE(got, 5) << "masks after the plate";
+
+  set("cam1", "KeyerPlate", 3);
+  set("cam1", "Gain", 6.0);  // after the plate request: once applied, the request was handled
+  EXPECT_TRUE(wait_states(
+      states, st, [&](auto& s) { return feature(*s.at("cam1"), "Gain") == 6.0; }, 10s));
+  EXPECT_EQ(error_of(st, "cam1"), "");
+  EXPECT_EQ(keying.stop(), 0) << keying.log();
+  EXPECT_EQ(elsewhere.stop(), 0) << elsewhere.log();
+  EXPECT_NE(keying.log().find("clean plate captured (3 frames)"), std::string::npos) << keying.log();
+  EXPECT_NE(keying.log().find("no clean plate yet"), std::string::npos);
+}
+
 // A GenICam camera through Aravis (its in-process fake camera, interface "Fake" only): the same
 // node publishes its masks and applies Gain with the device's read-back.
 TEST_F(CaptureNodeTest, AravisFakeCameraPublishesMasksAndAppliesGain) {

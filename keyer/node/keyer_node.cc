@@ -26,8 +26,6 @@ namespace studio::keyer {
 namespace {
 
 constexpr const char* kLog = "keyer";
-constexpr const char* kPlateFeature = "KeyerPlate";
-constexpr int kMaxPlateFrames = 1000;
 using SteadyClock = std::chrono::steady_clock;
 
 // One camera: its keyer, the newest frame waiting to be keyed, and the keying thread's buffers.
@@ -251,10 +249,10 @@ class KeyerNode : public runtime::Node {
   }
 
   void handle_control(const studio_CameraControl& c) {
-    if (std::string_view(c.feature) != kPlateFeature) return;  // a camera feature, for capture
-    if (!(c.value >= 0 && c.value <= kMaxPlateFrames) || c.value != double(int(c.value))) {
+    if (std::string_view(c.feature) != kPlateControl) return;  // a camera feature, for capture
+    if (!valid_plate_request(c.value)) {
       controls_rejected_.add();
-      STUDIO_LOG(warn, kLog) << c.camera_id << ": " << kPlateFeature << " " << c.value
+      STUDIO_LOG(warn, kLog) << c.camera_id << ": " << kPlateControl << " " << c.value
                              << " rejected: expected 0 (clear) or a frame count 1.."
                              << kMaxPlateFrames;
       return;
@@ -348,7 +346,7 @@ class KeyerNode : public runtime::Node {
         unkeyed_.add();
         if (!slot.warned_no_plate) {
           STUDIO_LOG(warn, kLog) << slot.id << ": no clean plate yet (send CameraControl "
-                                 << kPlateFeature
+                                 << kPlateControl
                                  << " N, or give plates: in the config); frames are not keyed";
         }
         slot.warned_no_plate = true;

@@ -14,6 +14,7 @@
 // A Keyer is not thread-safe (it keeps scratch buffers); use one per camera.
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "core/error.h"
@@ -23,6 +24,15 @@
 #include "keyer/keyer_options.h"
 
 namespace studio::keyer {
+
+// The camera control (CameraControl.feature) that captures a clean plate for the difference key,
+// honoured by whichever process keys the camera (studio-capture, or studio-keyer --config):
+// value 0 clears the plate, N in 1..kMaxPlateFrames averages the camera's next N frames.
+inline constexpr std::string_view kPlateControl = "KeyerPlate";
+inline constexpr int kMaxPlateFrames = 1000;
+inline bool valid_plate_request(double value) {
+  return value >= 0 && value <= kMaxPlateFrames && value == double(int(value));
+}
 
 class Keyer {
  public:
