@@ -203,8 +203,10 @@ TEST_F(HullNodeTest, MissingCameraWaitsForTheDeadlineThenGoesWithout) {
 
   bool got = false;
   for (int attempt = 0; attempt < 10 && !got; ++attempt) {
-    publish_masks(masks, 100 + attempt, 0, without_last);
+    // Taken before the first mask is written: the node's deadline runs from that mask's arrival
+    // (publishing 5 masks takes tens of ms under ASan).
     const auto sent = std::chrono::steady_clock::now();
+    publish_masks(masks, 100 + attempt, 0, without_last);
     while (std::chrono::steady_clock::now() - sent < 2s && !got) {
       for (auto& s : segs.take())
         if (s.meta.valid_data) {
