@@ -8,6 +8,8 @@
 
 #include "capture/take.h"
 #include "keyer/keyer.h"
+#include "yaml_io/node.h"
+#include "yaml_io/rig_yaml.h"
 
 namespace fs = std::filesystem;
 
@@ -157,6 +159,41 @@ Expected<std::unique_ptr<FrameInput>> open_mask_folder(const std::string& dir,
     }
   }
   return std::unique_ptr<FrameInput>(new MaskFolder(cameras, std::move(dirs), std::move(names)));
+}
+
+Expected<std::vector<Camera>> cameras_of_take(const std::string& dir) {
+  if (!fs::is_directory(dir)) return fail(dir + ": not a folder");
+  std::vector<fs::path> folders;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    if (e.is_directory() && fs::exists(e.path() / capture::kTakeFile)) folders.push_back(e.path());
+  }
+  if (ec) return fail(dir + ": " + ec.message());
+  if (folders.empty()) return fail("take " + dir + ": no camera folder with a " + capture::kTakeFile);
+  std::sort(folders.begin(), folders.end());
+  std::vector<Camera> cameras;
+  for (const fs::path& folder : folders) {
+    const std::string file = (folder / capture::kTakeFile).string();
+    auto root = yaml::load_file(file);
+    if (!root) return std::unexpected(root.error());
+    auto entries = root->entries();
+    if (!entries) return std::unexpected(entries.error());
+    const yaml::Node* calibration = nullptr;
+    for (const auto& [key, node] : *entries) {
+      if (key == "calibration") calibration = &node;
+    }
+    if (!calibration) {
+      return fail(file + ": camera recorded without calibration; give --rig");
+    }
+    auto camera = yaml::read_camera(*calibration);
+    if (!camera) return std::unexpected(camera.error());
+    if (camera->id != folder.filename().string()) {
+      return fail(file + ": calibration of camera '" + camera->id + "' in folder " +
+                  folder.filename().string());
+    }
+    cameras.push_back(std::move(*camera));
+  }
+  return cameras;
 }
 
 Expected<std::unique_ptr<FrameInput>> open_take(const std::string& dir,

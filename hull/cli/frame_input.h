@@ -62,4 +62,10 @@ Expected<std::unique_ptr<FrameInput>> open_take(const std::string& dir,
                                                 std::optional<FrameRange> range,
                                                 const keyer::KeyerOptions& key, int slots);
 
+// The cameras a take was recorded with: the `calibration:` of each DIR/<camera_id>/take.yaml
+// (the camera's calibration when its take began), in camera id order. Errors, one line each:
+// not a folder, no camera folder, an unreadable take.yaml, a camera recorded without
+// calibration (then a rig file is needed), a calibration whose id is not its folder's.
+Expected<std::vector<Camera>> cameras_of_take(const std::string& dir);
+
 }  // namespace studio::hull::cli

@@ -35,14 +35,17 @@ namespace {
 
 constexpr const char* kUsage =
     R"(usage: studio-hull --config hull.yaml      the real-time DDS service (keys below)
-       studio-hull offline --rig rig.yaml (--masks DIR | --take DIR) --box X0,Y0,Z0,X1,Y1,Z1
+       studio-hull offline (--rig rig.yaml --masks DIR | [--rig rig.yaml] --take DIR)
+                           --box X0,Y0,Z0,X1,Y1,Z1
                            --grid N [--axis x|y|z] [--frames A:B] --out FILE|DIR
                            [--format ply|obj|glb] [--keyer keyer.yaml | --key blue|green]
                            [--outside keep|cut] [--no-refine] [--threads N] [--timing]
                            [--progress | --quiet]
 
 Offline visual hull (line-segment representation, segment marching cubes) from silhouettes.
-  --rig FILE        rig.yaml with the calibrated cameras
+  --rig FILE        rig.yaml with the calibrated cameras; with --take the default is the
+                    calibration each camera recorded in its take.yaml (its pose when the take
+                    began: give a rig for tracked cameras that moved)
   --masks DIR       DIR/<camera_id>.png (one frame) or DIR/<frame>/<camera_id>.png (a sequence);
                     0 = background, non-zero = actor; every camera of the rig needs its mask
   --take DIR        a recorded take, takes/<take>/ holding <camera_id>/frames.raw (+ index) for
@@ -175,7 +178,7 @@ Expected<Args> parse(int argc, char** argv) {
       return fail("unknown option " + opt + " (see --help)");
     }
   }
-  if (a.rig.empty()) return fail("--rig is required");
+  if (a.rig.empty() && a.take.empty()) return fail("--rig is required with --masks");
   if (a.masks.empty() == a.take.empty())
     return fail("give exactly one of --masks DIR or --take DIR");
   if (!a.keyer_file.empty() && a.key) return fail("give --keyer FILE or --key, not both");
@@ -212,16 +215,28 @@ int run_offline(int argc, char** argv) {
     std::cerr << "studio-hull: --box/--grid: " << ok.error().message << "\n";
     return 2;
   }
-  auto rig = yaml::read_rig(args->rig);
-  if (!rig) {
-    std::cerr << "studio-hull: " << rig.error().message << "\n";
-    return 2;
+  // The cameras: the rig file, else (a take) the calibration recorded in the take.
+  Rig rig;
+  if (!args->rig.empty()) {
+    auto read = yaml::read_rig(args->rig);
+    if (!read) {
+      std::cerr << "studio-hull: " << read.error().message << "\n";
+      return 2;
+    }
+    rig = std::move(*read);
+    if (rig.cameras.empty()) {
+      std::cerr << "studio-hull: " << args->rig << ": no cameras\n";
+      return 2;
+    }
+  } else {
+    auto recorded = cli::cameras_of_take(args->take);
+    if (!recorded) {
+      std::cerr << "studio-hull: " << recorded.error().message << "\n";
+      return 2;
+    }
+    rig.cameras = std::move(*recorded);
   }
-  if (rig->cameras.empty()) {
-    std::cerr << "studio-hull: " << args->rig << ": no cameras\n";
-    return 2;
-  }
-  const std::vector<Camera>& cameras = rig->cameras;
+  const std::vector<Camera>& cameras = rig.cameras;
 
   // Where the silhouettes come from. Slots: one keyer set per worker thread.
   Expected<std::unique_ptr<cli::FrameInput>> input = fail("no input");

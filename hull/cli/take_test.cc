@@ -58,8 +58,10 @@ void write_png(const Mask& m, const fs::path& path) {
 
 // Records frames [first, last] of camera `c` into take/<camera_id>, at the camera's size or at
 // `width` x `height` when given (a wrongly configured camera).
+// The take.yaml holds the camera's calibration, as the capture node writes it, unless
+// `calibrated` is false.
 void record(const sim::SimulatedStudio& studio, int c, const fs::path& take, uint64_t first,
-            uint64_t last, int width = 0, int height = 0) {
+            uint64_t last, int width = 0, int height = 0, bool calibrated = true) {
   const Camera& cam = studio.cameras()[std::size_t(c)];
   capture::TakeInfo info;
   info.take = take.filename().string();
@@ -68,6 +70,7 @@ void record(const sim::SimulatedStudio& studio, int c, const fs::path& take, uin
   info.height = uint32_t(height ? height : cam.height);
   info.period_ns = 40'000'000;
   info.start_frame = first;
+  if (calibrated) info.calibration_yaml = yaml::format_camera(cam, 2);
   auto rec = capture::Recorder::start({.dir = (take / cam.id).string(), .queue_frames = 16}, info);
   ASSERT_TRUE(rec) << rec.error().message;
   for (uint64_t f = first; f <= last; ++f) {
@@ -264,6 +267,48 @@ TEST_F(HullCliTake, RejectsMissingCamera) {
   r = run(base() + "--take " + take.string() + " --frames 100:101 --out " + (dir_ / "x").string(),
           dir_);
   EXPECT_EQ(r.code, 0) << r.err;
+}
+
+// Without --rig the cameras come from the calibration each camera recorded in its take.yaml:
+// the same meshes as with the rig file. A camera recorded without calibration is one line that
+// asks for a rig.
+TEST_F(HullCliTake, WithoutARigUsesTheCalibrationRecordedInTheTake) {
+  const std::string box = " --grid 128 --box -1.5,0,-1.5,1.5,2.2,1.5 --frames 101:101 ";
+  Result r = run("offline --take " + (dir_ / "take").string() + box + "--out " +
+                     (dir_ / "no_rig.ply").string(),
+                 dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run(base() + "--take " + (dir_ / "take").string() + " --frames 101:101 --out " +
+              (dir_ / "with_rig.ply").string(),
+          dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto a = testing::read_ply((dir_ / "no_rig.ply").string());
+  auto b = testing::read_ply((dir_ / "with_rig.ply").string());
+  ASSERT_TRUE(a && b);
+  ASSERT_GT(a->triangles.size(), 1000u);
+  ASSERT_EQ(a->triangles.size(), b->triangles.size());
+  ASSERT_EQ(a->vertices.size(), b->vertices.size());
+  float worst = 0;
+  for (std::size_t k = 0; k < a->vertices.size(); ++k)
+    worst = std::max(worst, (a->vertices[k] - b->vertices[k]).norm());
+  EXPECT_LT(worst, 1e-6f);
+
+  const fs::path take = dir_ / "take_uncalibrated";
+  fs::copy(dir_ / "take", take, fs::copy_options::recursive);
+  fs::remove_all(take / "cam3");
+  record(*studio_, 3, take, kFirst, kLast, 0, 0, false);
+  r = run("offline --take " + take.string() + box + "--out " + (dir_ / "x.ply").string(), dir_);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("cam3/take.yaml: camera recorded without calibration; give --rig"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  // Masks carry no calibration: a rig is required.
+  r = run("offline --masks " + (dir_ / "keyed").string() + box + "--out " +
+              (dir_ / "x.ply").string(),
+          dir_);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--rig is required with --masks"), std::string::npos) << r.err;
 }
 
 TEST_F(HullCliTake, RejectsFrameOfWrongSize) {
