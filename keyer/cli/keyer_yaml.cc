@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 namespace studio::keyer {
@@ -38,6 +39,21 @@ Expected<void> read_bool(const std::string& name, const YAML::Node& n, const std
   } catch (const YAML::Exception&) {
     return fail(where(name, n) + ": " + key + ": expected true or false");
   }
+}
+
+// A nested mapping `section:`; field(key, node, "section.key") reads one entry and returns
+// nullopt for a key it does not know, which is an error line.
+template <class Field>
+Expected<void> read_section(const std::string& name, const YAML::Node& v, const std::string& section,
+                            Field&& field) {
+  if (!v.IsMap()) return fail(where(name, v) + ": " + section + ": expected a mapping");
+  for (const auto& c : v) {
+    const std::string key = c.first.as<std::string>("");
+    const std::optional<Expected<void>> r = field(key, c.second, section + "." + key);
+    if (!r) return fail(where(name, c.first) + ": " + section + ": unknown key '" + key + "'");
+    if (!*r) return *r;
+  }
+  return {};
 }
 
 }  // namespace
@@ -77,35 +93,22 @@ Expected<KeyerOptions> parse_keyer_options(const std::string& text, const std::s
     } else if (key == "edge_refine") {
       r = read_bool(name, v, key, o.edge_refine);
     } else if (key == "edge") {
-      if (!v.IsMap()) return fail(where(name, v) + ": edge: expected a mapping");
-      for (const auto& c : v) {
-        const std::string ek = c.first.as<std::string>("");
-        if (ek == "threshold") {
-          r = read_float(name, c.second, "edge.threshold", o.edge.threshold);
-        } else if (ek == "min_contrast") {
-          r = read_float(name, c.second, "edge.min_contrast", o.edge.min_contrast);
-        } else {
-          return fail(where(name, c.first) + ": edge: unknown key '" + ek + "'");
-        }
-        if (!r) return std::unexpected(r.error());
-      }
+      r = read_section(name, v, key, [&](const std::string& k, const YAML::Node& n,
+                                          const std::string& path) -> std::optional<Expected<void>> {
+        if (k == "threshold") return read_float(name, n, path, o.edge.threshold);
+        if (k == "min_contrast") return read_float(name, n, path, o.edge.min_contrast);
+        return std::nullopt;
+      });
     } else if (key == "spill_strength") {
       r = read_float(name, v, key, o.spill_strength);
     } else if (key == "cleanup") {
-      if (!v.IsMap()) return fail(where(name, v) + ": cleanup: expected a mapping");
-      for (const auto& c : v) {
-        const std::string ck = c.first.as<std::string>("");
-        if (ck == "min_component_area") {
-          r = read_int(name, c.second, "cleanup.min_component_area", o.cleanup.min_component_area);
-        } else if (ck == "max_hole_area") {
-          r = read_int(name, c.second, "cleanup.max_hole_area", o.cleanup.max_hole_area);
-        } else if (ck == "keep_backing_gaps") {
-          r = read_bool(name, c.second, "cleanup.keep_backing_gaps", o.cleanup.keep_backing_gaps);
-        } else {
-          return fail(where(name, c.first) + ": cleanup: unknown key '" + ck + "'");
-        }
-        if (!r) return std::unexpected(r.error());
-      }
+      r = read_section(name, v, key, [&](const std::string& k, const YAML::Node& n,
+                                          const std::string& path) -> std::optional<Expected<void>> {
+        if (k == "min_component_area") return read_int(name, n, path, o.cleanup.min_component_area);
+        if (k == "max_hole_area") return read_int(name, n, path, o.cleanup.max_hole_area);
+        if (k == "keep_backing_gaps") return read_bool(name, n, path, o.cleanup.keep_backing_gaps);
+        return std::nullopt;
+      });
     } else {
       return fail(where(name, kv.first) + ": unknown key '" + key + "'");
     }
