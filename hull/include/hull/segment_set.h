@@ -50,6 +50,12 @@ struct GridSpec {
   std::size_t columns() const { return std::size_t(cells_u) * std::size_t(cells_v); }
   // World point of column (i, j) at parameter t.
   Eigen::Vector3d point(double i, double j, double t) const;
+
+  // Declared here, before SegmentSet's defaulted ==, which needs it (clang rejects it otherwise).
+  friend bool operator==(const GridSpec& a, const GridSpec& b) {
+    return a.box_min == b.box_min && a.box_max == b.box_max && a.axis == b.axis &&
+           a.cells_u == b.cells_u && a.cells_v == b.cells_v;
+  }
 };
 
 class SegmentSet {
@@ -90,11 +96,6 @@ class SegmentSet {
   std::vector<Interval> intervals_;
   std::vector<uint32_t> start_;
 };
-
-inline bool operator==(const GridSpec& a, const GridSpec& b) {
-  return a.box_min == b.box_min && a.box_max == b.box_max && a.axis == b.axis &&
-         a.cells_u == b.cells_u && a.cells_v == b.cells_v;
-}
 
 // Connected components: two intervals are connected when their columns are 4-neighbours and
 // their t-ranges overlap (share a positive length). Components are returned largest volume first,
