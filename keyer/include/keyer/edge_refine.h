@@ -23,8 +23,9 @@
 // Why threshold < 1/2 by default: at a silhouette the actor's surface turns away from the camera
 // and mirrors the backing (blue spill; issue 4), so a half-covered edge pixel unmixes to ~0.4.
 //
-// Cost: linear in the number of runs and transitions (the mask's perimeter); the image is read
-// only around transitions.
+// Cost: per transition (the mask's perimeter) two look-ups in a row's runs (a few per row);
+// decisions are merged per row from three sorted streams, no sort over the frame; the image is
+// read only around transitions. About as much as the SIMD key itself (BENCHMARKS.md).
 
 #include <cstdint>
 #include <vector>
