@@ -48,6 +48,8 @@ const char* const kConfigHelp =
     "  publish_tracks: BOOL   also publish every live track as NAME/<track id> (default false)\n"
     "  publish_rate: HZ       keep-alive rate when no SegmentSet arrives: the last pose coasts\n"
     "                         with decaying confidence, 0 once lost (0.5..1000, default 10)\n"
+    "  gather_ms: MS          SegmentSets of one frame (one per actor) arriving within this\n"
+    "                         window of the first are one tracker update (0..100, default 2)\n"
     "  search:                head finder (two-box template, TCSVT 2004 IV-D), all optional:\n"
     "    head_box: [X, Y, Z]       inner box V2, metres (default [0.22, 0.24, 0.22])\n"
     "    outer_box: [X, Y, Z]      outer box V1, contains V2 (default [0.40, 0.64, 0.40])\n"
@@ -71,6 +73,7 @@ Expected<void> NodeOptions::validate() const {
     return fail("actor_id: expected a name of 1..50 characters");
   if (!(publish_rate >= 0.5 && publish_rate <= 1000))
     return fail("publish_rate: expected Hz in 0.5..1000");
+  if (!(gather_ms >= 0 && gather_ms <= 100)) return fail("gather_ms: expected 0..100 ms");
   if (auto ok = search.validate(); !ok) return ok;
   return filter.validate();
 }
@@ -93,6 +96,12 @@ Expected<NodeOptions> read_node_options(yaml::MapReader& config) {
     if (!v) return std::unexpected(v.error());
     if (!(*v >= 0.5 && *v <= 1000)) return n->fail("expected Hz in 0.5..1000");
     o.publish_rate = *v;
+  }
+  if (auto n = config.optional("gather_ms")) {
+    auto v = n->as_double();
+    if (!v) return std::unexpected(v.error());
+    if (!(*v >= 0 && *v <= 100)) return n->fail("expected 0..100 ms");
+    o.gather_ms = *v;
   }
   if (auto n = config.optional("search")) {
     auto v = search_schema().read(*n);

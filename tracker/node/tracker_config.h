@@ -7,6 +7,8 @@
 //   actor_id: actor        # key of the published studio/actor/head sample (the primary head)
 //   publish_tracks: false  # also publish every live track as <actor_id>/<track id>
 //   publish_rate: 10       # Hz: keep-alive when no SegmentSet arrives (0.5 .. 1000)
+//   gather_ms: 2           # the hull publishes each actor of a frame as its own SegmentSet: sets
+//                          # of one frame arriving within this window are one tracker update
 //   search:                # head finder, TCSVT 2004 §IV-D (tracker/head_search.h)
 //     head_box: [0.22, 0.24, 0.22]   # V2, metres
 //     outer_box: [0.40, 0.64, 0.40]  # V1 ⊇ V2, metres
@@ -38,6 +40,7 @@ struct NodeOptions {
   std::string actor_id = "actor";
   bool publish_tracks = false;
   double publish_rate = 10;
+  double gather_ms = 2;
   HeadSearchOptions search;
   HeadTrackerOptions filter;
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,19 @@ struct TrackerNode::Worker {
   runtime::Counter& empty_hulls;
   runtime::Counter& keepalives;
   runtime::Counter& rejected;
+  runtime::Counter& late_sets;
   uint64_t reader_rejects_seen = 0;
+
+  // The frame being gathered: the hull publishes each actor (connected component) of a frame as
+  // its own SegmentSet, and the tracker must see every head of a frame in one update, or each
+  // update would miss the other actors' heads.
+  struct Gathered {
+    uint64_t frame = 0;
+    int64_t capture_ns = 0;
+    std::vector<HeadDetection> heads;
+    Clock::time_point deadline;
+  };
+  std::optional<Gathered> gathering{};
 
   std::atomic<bool> running{true};
   std::atomic<uint64_t> last_frame{0};
@@ -76,6 +89,7 @@ struct TrackerNode::Worker {
     last_publish = Clock::now();
   }
 
+  // One SegmentSet: its heads join the frame being gathered (another frame first flushes that).
   void on_segments(const studio_SegmentSet& s) {
     sets_in.add();
     auto set = wire::to_core(s);
@@ -84,34 +98,50 @@ struct TrackerNode::Worker {
       STUDIO_LOG(warn, kCategory) << set.error().message;
       return;
     }
-    // A source clock that jumps back (a replay looping) would freeze the filter: start over.
-    if (have_source && s.capture_ns + int64_t(1'000'000'000) < source_ns) {
-      STUDIO_LOG(info, kCategory) << "capture time went back " << (source_ns - s.capture_ns) * 1e-9
-                                  << " s: tracks reset";
-      tracker = HeadTracker::create(options.filter).value();
+    if (gathering && (gathering->frame != s.frame || gathering->capture_ns != s.capture_ns)) {
+      flush();
     }
-    std::vector<HeadDetection> heads;
+    if (!gathering) {
+      // A set of the frame last updated came after its window closed: a separate update.
+      if (have_source && s.frame == last_frame && s.capture_ns == source_ns) late_sets.add();
+      gathering = Gathered{s.frame, s.capture_ns, {},
+                           Clock::now() + std::chrono::microseconds(
+                                              int64_t(options.gather_ms * 1000))};
+    }
     if (set->interval_count() == 0) {
       empty_hulls.add();
     } else {
       rasterise(*set, &grid);
-      heads = search.find(grid);
+      for (const HeadDetection& h : search.find(grid)) gathering->heads.push_back(h);
     }
-    tracker.update(heads, s.capture_ns);
+  }
+
+  // The gathered frame's heads as one tracker update, and its poses out.
+  void flush() {
+    if (!gathering) return;
+    Gathered g = std::move(*gathering);
+    gathering.reset();
+    // A source clock that jumps back (a replay looping) would freeze the filter: start over.
+    if (have_source && g.capture_ns + int64_t(1'000'000'000) < source_ns) {
+      STUDIO_LOG(info, kCategory) << "capture time went back " << (source_ns - g.capture_ns) * 1e-9
+                                  << " s: tracks reset";
+      tracker = HeadTracker::create(options.filter).value();
+    }
+    tracker.update(g.heads, g.capture_ns);
     have_source = true;
-    source_ns = s.capture_ns;
+    source_ns = g.capture_ns;
     source_arrival = Clock::now();
     coasted_ticks = 0;
-    last_frame = s.frame;
-    last_capture_ns = s.capture_ns;
+    last_frame = g.frame;
+    last_capture_ns = g.capture_ns;
 
     HeadPose primary = tracker.primary();
-    primary.capture_ns = s.capture_ns;
-    publish_primary(primary, s.frame);
+    primary.capture_ns = g.capture_ns;
+    publish_primary(primary, g.frame);
     if (options.publish_tracks)
       for (const HeadPose& p : tracker.poses())
-        publish(p, options.actor_id + "/" + std::to_string(p.actor_id), s.frame);
-    metrics.latency().record(realtime_ns() - s.capture_ns);
+        publish(p, options.actor_id + "/" + std::to_string(p.actor_id), g.frame);
+    metrics.latency().record(realtime_ns() - g.capture_ns);
   }
 
   void keep_alive() {
@@ -138,13 +168,16 @@ struct TrackerNode::Worker {
     const auto period = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(1.0 / options.publish_rate));
     while (running) {
-      const auto wait = std::max(Clock::duration::zero(), last_publish + period - Clock::now());
+      Clock::time_point wake = last_publish + period;
+      if (gathering) wake = std::min(wake, gathering->deadline);
+      const auto wait = std::max(Clock::duration::zero(), wake - Clock::now());
       const auto triggered = waitset.wait(wait);
       if (std::find(triggered.begin(), triggered.end(), dds_attach_t(kStop)) != triggered.end())
         break;
       segments->visit([&](const studio_SegmentSet& s, const wire::SampleMeta& meta) {
         if (meta.valid_data) on_segments(s);
       });
+      if (gathering && Clock::now() >= gathering->deadline) flush();
       const uint64_t total = segments->rejected().total();
       if (total > reader_rejects_seen) {
         rejected.add(total - reader_rejects_seen);
@@ -158,7 +191,8 @@ struct TrackerNode::Worker {
 TrackerNode::TrackerNode(NodeOptions options, runtime::NodeContext& context)
     : options_(std::move(options)), participant_(context.participant), metrics_(context.metrics) {
   // Registered up front so the status shows them at zero.
-  for (const char* name : {"segment_sets_in", "heads_out", "empty_hulls", "keepalives", "rejected"})
+  for (const char* name : {"segment_sets_in", "heads_out", "empty_hulls", "keepalives", "rejected",
+                           "late_segment_sets"})
     metrics_.counter(name);
 }
 
@@ -193,7 +227,8 @@ Expected<void> TrackerNode::start() {
                            .heads_out = metrics_.counter("heads_out"),
                            .empty_hulls = metrics_.counter("empty_hulls"),
                            .keepalives = metrics_.counter("keepalives"),
-                           .rejected = metrics_.counter("rejected")});
+                           .rejected = metrics_.counter("rejected"),
+                           .late_sets = metrics_.counter("late_segment_sets")});
   worker_->last_pose = worker_->tracker.primary();  // rest position, confidence 0
   thread_ = std::thread([w = worker_.get()] { w->run(); });
   return {};

@@ -3,9 +3,13 @@
 // studio/actor/head (HeadPose) out.
 //
 // One worker thread waits on a WaitSet holding the segments reader and a guard condition (stop).
-// For each valid SegmentSet: to_core → rasterise → HeadSearch::find → HeadTracker::update at the
-// sample's capture_ns → the primary head is published under `actor_id` with the source's frame
-// and capture_ns (and, with publish_tracks, every live track as <actor_id>/<track id>). An empty
+// For each valid SegmentSet: to_core → rasterise → HeadSearch::find. The hull publishes each
+// actor (connected component) of a frame as its own SegmentSet, so the heads of the sets of one
+// frame (same frame and capture_ns) arriving within gather_ms of the first are gathered; then
+// one HeadTracker::update at that capture_ns → the primary head is published under `actor_id`
+// with the source's frame and capture_ns (and, with publish_tracks, every live track as
+// <actor_id>/<track id>). A set of that frame arriving after the window is a separate update
+// (counter late_segment_sets). An empty
 // hull (or no head in it) is a frame without detections: the tracker coasts, its confidence
 // decays by coast_decay per frame and reaches 0 once the track is dropped after max_missed frames
 // (the fallback pose: last head position, zero velocity, confidence 0).
@@ -19,8 +23,8 @@
 // frame is filtered against the last real one.
 //
 // Metrics: counters segment_sets_in, heads_out, empty_hulls, keepalives, rejected (to_core
-// failures plus the reader's validator rejections); latency = publish time − capture_ns of real
-// frames.
+// failures plus the reader's validator rejections), late_segment_sets; latency = publish time −
+// capture_ns of real frames (includes the gather window).
 
 #include <atomic>
 #include <memory>

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <algorithm>
 #include <map>
 #include <optional>
 
@@ -98,9 +99,10 @@ class TrackerNodeTest : public testing::ProcessTest {
     return p;
   }
 
-  void send(const hull::SegmentSet& set, uint64_t frame, int64_t capture_ns) {
+  void send(const hull::SegmentSet& set, uint64_t frame, int64_t capture_ns,
+            const char* actor_id = "hull") {
     wire::Owned<studio_SegmentSet> s;
-    wire::set(s->actor_id, "hull");
+    wire::set(s->actor_id, actor_id);
     s->frame = frame;
     s->capture_ns = capture_ns;
     wire::from_core(set, *s);
@@ -319,12 +321,45 @@ TEST_F(TrackerNodeTest, PublishTracksAddsOneSamplePerLiveTrack) {
   EXPECT_LT(std::min((seen["actor"] - a).norm(), (seen["actor"] - b).norm()), 0.02);
 }
 
+// The hull publishes each actor of a frame as its own SegmentSet: the node gathers them into one
+// update, so every head is seen every frame (one update per set would miss the other actor's
+// head each time: its confidence would drop by coast_decay, 0.8, on every update).
+TEST_F(TrackerNodeTest, ActorsOfOneFrameAreOneUpdate) {
+  start_node("publish_rate: 2\npublish_tracks: true\ngather_ms: 30\n");
+  const Eigen::Vector3d a(-0.5, 1.6, 0.1), b(0.5, 1.5, -0.3);
+  const auto set_a = balls({a}), set_b = balls({b});
+  std::map<std::string, std::vector<double>> confidence;  // per track, frames >= 3
+  const int64_t t0 = realtime_ns();
+  for (uint64_t frame = 1; frame <= 10; ++frame) {
+    const int64_t capture_ns = t0 + int64_t(frame) * 40'000'000;
+    send(set_a, frame, capture_ns, "actor0");
+    send(set_b, frame, capture_ns, "actor1");
+    const auto until = std::chrono::steady_clock::now() + 150ms;
+    while (std::chrono::steady_clock::now() < until) {
+      for (auto& r : reader_->take()) {
+        if (!r.meta.valid_data || r.data->frame < 3 || r.data->capture_ns == 0) continue;
+        const std::string id = r.data->actor_id;
+        if (id != "actor") confidence[id].push_back(r.data->confidence);
+      }
+      std::this_thread::sleep_for(5ms);
+    }
+  }
+  ASSERT_EQ(confidence.size(), 2u) << "two tracks";
+  for (const auto& [id, values] : confidence) {
+    ASSERT_GE(values.size(), 4u) << id;
+    const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+    EXPECT_GT(*hi, 0.5) << id;
+    EXPECT_GE(*lo, 0.95 * *hi) << id << ": a head missed in some update";
+  }
+}
+
 TEST_F(TrackerNodeTest, BadConfigIsOneLineAndExitOne) {
   struct Case {
     std::string yaml, expect;
   } cases[] = {
       {"bogus: 1\n", "tracker.yaml:1: bogus: unknown key"},
       {"publish_rate: 0\n", "tracker.yaml:1: publish_rate: expected Hz in 0.5..1000"},
+      {"gather_ms: 500\n", "tracker.yaml:1: gather_ms: expected 0..100 ms"},
       {"search:\n  max_heads: 0\n", "tracker.yaml:2: search.max_heads"},
       {"search:\n  head_box: [0.2, 0.2]\n", "search.head_box: expected 3 numbers, got 2"},
       {"search:\n  head_box: [0.5, 0.5, 0.5]\n", "outer_box must contain head_box"},
@@ -344,7 +379,7 @@ TEST_F(TrackerNodeTest, BadConfigIsOneLineAndExitOne) {
   }
   auto& help = spawn("tracker", "tracker/studio-tracker", {"--help"});
   EXPECT_EQ(help.wait_exit(10s), 0);
-  for (const char* key : {"publish_rate", "actor_id", "head_box", "coast_decay", "locate"})
+  for (const char* key : {"publish_rate", "gather_ms", "actor_id", "head_box", "coast_decay", "locate"})
     EXPECT_NE(help.log().find(key), std::string::npos) << key;
 }
 
