@@ -1,5 +1,6 @@
 #include "image_io.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -32,6 +33,28 @@ Expected<void> write_mask_png(const std::string& path, const Mask& mask) {
     ok = false;
   }
   if (!ok) return fail("cannot write '" + path + "'");
+  return {};
+}
+
+Expected<void> write_rgb_png(const std::string& path, const Image<Rgb8>& image) {
+  const cv::Mat rgb(image.height(), image.width(), CV_8UC3, const_cast<Rgb8*>(image.data()));
+  const std::string tmp = path + ".part.png";  // OpenCV picks the format by the extension
+  bool ok = false;
+  try {
+    cv::Mat bgr;
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    ok = cv::imwrite(tmp, bgr);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok) {
+    std::remove(tmp.c_str());
+    return fail("cannot write '" + path + "'");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    return fail("cannot write '" + path + "': rename failed");
+  }
   return {};
 }
 

@@ -12,5 +12,8 @@ namespace studio::keyer {
 // file is missing or cannot be decoded.
 Expected<Image<Rgb8>> read_rgb(const std::string& path);
 Expected<void> write_mask_png(const std::string& path, const Mask& mask);
+// RGB as PNG, atomically: written beside `path` and renamed over it, so a crash never leaves a
+// torn file where a plate was.
+Expected<void> write_rgb_png(const std::string& path, const Image<Rgb8>& image);
 
 }  // namespace studio::keyer

@@ -67,12 +67,18 @@ class KeyerNode : public runtime::Node {
         missed_(ctx.metrics.counter("frames_missed")),
         unkeyed_(ctx.metrics.counter("frames_unkeyed")),
         plates_captured_(ctx.metrics.counter("plates_captured")),
+        plate_saves_failed_(ctx.metrics.counter("plate_saves_failed")),
         controls_rejected_(ctx.metrics.counter("controls_rejected")) {}
 
   ~KeyerNode() override { stop(); }
 
   // Creates the configured cameras' keyers (plates applied), so plate errors fail the start.
   Expected<void> init() {
+    if (!options_.plate_dir.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(options_.plate_dir, ec);
+      if (ec) return fail("plate_dir " + options_.plate_dir + ": " + ec.message());
+    }
     for (const std::string& id : options_.cameras)
       if (auto s = add_slot(id); !s) return std::unexpected(s.error());
     return {};
@@ -153,10 +159,28 @@ class KeyerNode : public runtime::Node {
     if (auto p = options_.plates.find(id); p != options_.plates.end()) {
       if (auto r = slot->keyer->capture_plate(p->second.view()); !r)
         return fail("plate of " + id + ": " + r.error().message);
+    } else if (const std::string kept = kept_plate(id); !kept.empty()) {
+      // A plate captured on command before a restart. Unreadable: the camera waits for a new one.
+      std::error_code ec;
+      if (std::filesystem::exists(kept, ec)) {
+        auto image = read_rgb(kept);
+        if (image && slot->keyer->capture_plate(image->view())) {
+          STUDIO_LOG(info, kLog) << id << ": clean plate from " << kept;
+        } else {
+          STUDIO_LOG(warn, kLog) << id << ": kept plate " << kept << " not used: "
+                                 << (image ? "" : image.error().message);
+        }
+      }
     }
     wire::set(slot->sample->camera_id, id);
     slots_.push_back(std::move(slot));
     return slots_.back().get();
+  }
+
+  // Where a plate captured on command is kept ("" without plate_dir).
+  std::string kept_plate(const std::string& id) const {
+    if (options_.plate_dir.empty()) return {};
+    return (std::filesystem::path(options_.plate_dir) / (id + ".png")).string();
   }
 
   Slot* find_slot(std::string_view id) {
@@ -326,6 +350,12 @@ class KeyerNode : public runtime::Node {
       keyer.clear_plate();
       slot.plate_remaining = plate_request;
       slot.warned_no_plate = false;
+      if (plate_request == 0) {
+        if (const std::string kept = kept_plate(slot.id); !kept.empty()) {
+          std::error_code ec;
+          std::filesystem::remove(kept, ec);
+        }
+      }
     }
     if (slot.plate_remaining > 0) {
       if (auto r = keyer.capture_plate(image); !r) {
@@ -338,6 +368,12 @@ class KeyerNode : public runtime::Node {
         plates_captured_.add();
         STUDIO_LOG(info, kLog) << slot.id << ": clean plate captured (" << keyer.plate_frames()
                                << " frames, " << w << "x" << h << ")";
+        if (const std::string kept = kept_plate(slot.id); !kept.empty()) {
+          if (auto r = write_rgb_png(kept, keyer.plate()); !r) {
+            plate_saves_failed_.add();
+            STUDIO_LOG(warn, kLog) << slot.id << ": clean plate not kept: " << r.error().message;
+          }
+        }
       }
       return;
     }
@@ -376,7 +412,7 @@ class KeyerNode : public runtime::Node {
   runtime::Metrics& metrics_;
   runtime::Counter &images_in_, &masks_published_, &rejected_, &rejected_malformed_,
       &rejected_format_, &rejected_keyer_, &rejected_cameras_, &images_ignored_, &dropped_,
-      &missed_, &unkeyed_, &plates_captured_, &controls_rejected_;
+      &missed_, &unkeyed_, &plates_captured_, &plate_saves_failed_, &controls_rejected_;
   std::optional<Io> io_;
   std::atomic<bool> running_{false};
   std::thread reader_;
@@ -439,6 +475,14 @@ Expected<KeyerNodeOptions> read_config(yaml::MapReader& config) {
   if (auto r = read_int(config, "max_cameras", o.max_cameras, 1, 64); !r)
     return std::unexpected(r.error());
   if (auto r = read_int(config, "threads", o.threads, 1, 16); !r) return std::unexpected(r.error());
+  if (auto n = config.optional("plate_dir")) {
+    if (o.keyer.mode != KeyMode::kDifference)
+      return n->fail("clean plates need the difference key (keyer.key)");
+    auto path = n->as_string();
+    if (!path) return std::unexpected(path.error());
+    if (path->empty()) return n->fail("expected a folder");
+    o.plate_dir = resolve(*n, *path);
+  }
   if (auto n = config.optional("plates")) {
     if (o.keyer.mode != KeyMode::kDifference)
       return n->fail("clean plates need the difference key (keyer.key)");
@@ -466,6 +510,8 @@ Expected<void> KeyerNodeOptions::validate() const {
   if (threads < 1 || threads > 16) return fail("threads: must be in [1, 16]");
   if (!plates.empty() && keyer.mode != KeyMode::kDifference)
     return fail("plates: need the difference key");
+  if (!plate_dir.empty() && keyer.mode != KeyMode::kDifference)
+    return fail("plate_dir: needs the difference key");
   return {};
 }
 
@@ -490,6 +536,7 @@ runtime::ServiceDefinition keyer_service_definition() {
       "  max_cameras: 16           cameras keyed at most when keying every camera seen (1..64)\n"
       "  threads: 1                keying threads (1..16)\n"
       "  plates: {cam0: FILE}      clean plates for the difference key (PNG/JPEG, frame size)\n"
+      "  plate_dir: DIR            keep plates captured on command as DIR/<camera>.png, load at start\n"
       "Clean plate on command: CameraControl feature KeyerPlate, value N averages the next N "
       "frames\n"
       "(0 clears). Only the newest frame per camera waits; older ones are dropped and counted.\n";

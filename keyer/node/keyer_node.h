@@ -37,6 +37,11 @@
 //   threads: 1                 keying threads (1..16); one camera is keyed by one thread at a time
 //   plates: {cam0: FILE}       clean plates (PNG/JPEG, the camera's frame size), relative to this
 //                              file (only with `key: difference`)
+//   plate_dir: DIR             keep plates captured on command as DIR/<camera>.png and load them
+//                              at start (a restarted node keys at once: with the actor on set a
+//                              clean plate cannot be shot again); `plates:` entries come first;
+//                              KeyerPlate 0 removes the file. Created if missing. Failed saves
+//                              are counted (plate_saves_failed) and logged.
 
 #include <map>
 #include <memory>
@@ -55,6 +60,7 @@ struct KeyerNodeOptions {
   int max_cameras = 16;
   int threads = 1;
   std::map<std::string, Image<Rgb8>> plates;  // clean plates by camera id
+  std::string plate_dir;                      // empty: plates on command are not kept
 
   Expected<void> validate() const;
 };

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <filesystem>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -29,6 +30,7 @@ namespace studio::keyer {
 namespace {
 
 using namespace std::chrono_literals;
+namespace fs = std::filesystem;
 using Key = std::pair<std::string, uint64_t>;  // camera id, frame
 
 // A blue-backing frame with noise and an actor rectangle (skin, dark cloth) moving with `frame`.
@@ -398,6 +400,84 @@ TEST_F(KeyerNodeTest, DifferenceKeyWithPlateFromFileAndOnCommand) {
   EXPECT_EQ(node.stop(), 0) << node.log();
 }
 
+// With plate_dir a plate captured on command survives a restart of the node (with the actor on
+// set it could not be shot again): the restarted node keys its first frame with it. KeyerPlate 0
+// removes the kept file.
+TEST_F(KeyerNodeTest, PlateCapturedOnCommandIsKeptAcrossARestart) {
+  constexpr int kW = 320, kH = 240;
+  const Image<Rgb8> plate = plate_image(kW, kH);
+  const std::string cfg =
+      write_file("keyer.yaml",
+                 "status_period: 0.2\ncameras: [cam0]\nplate_dir: plates\nkeyer: {key: "
+                 "difference, diff_low: 10, diff_high: 30}\n");
+  auto options = load_keyer_options(cfg);
+  ASSERT_TRUE(options.has_value()) << options.error().message;
+  const fs::path kept = dir_ / "plates" / "cam0.png";
+
+  auto images = writer<studio_CameraImage>();
+  auto controls = writer<studio_CameraControl>();
+  auto masks = reader<studio_AlphaMask>();
+  auto status = reader<studio_ServiceStatus>();
+  {
+    auto& node = spawn("keyer", "keyer/studio-keyer", {"--config", cfg});
+    ASSERT_TRUE(node.wait_ready(20s)) << node.log();
+    ASSERT_TRUE(images.wait_for_readers(1, 10s));
+    ASSERT_TRUE(controls.wait_for_readers(1, 10s));
+    wire::Owned<studio_CameraControl> c;
+    wire::set(c->camera_id, "cam0");
+    wire::set(c->feature, "KeyerPlate");
+    c->value = 3;
+    ASSERT_TRUE(controls.write(*c).has_value());
+    std::map<std::string, double> counters;
+    const auto t0 = std::chrono::steady_clock::now();
+    uint64_t f = 200;
+    while (std::chrono::steady_clock::now() - t0 < 20s &&
+           !(counters["plates_captured"] >= 1 && fs::exists(kept))) {
+      send_image(images, "cam0", f++, plate);
+      std::this_thread::sleep_for(60ms);
+      poll_status(status, counters);
+    }
+    ASSERT_TRUE(fs::exists(kept)) << node.log();
+    EXPECT_EQ(counters["plate_saves_failed"], 0);
+    EXPECT_EQ(node.stop(), 0) << node.log();
+  }
+  auto file = read_rgb(kept.string());
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  EXPECT_EQ(file->pixels(), plate.pixels());  // 3 equal frames average to the frame itself
+  EXPECT_FALSE(fs::exists(kept.string() + ".part.png"));
+
+  auto& node = spawn("keyer-restarted", "keyer/studio-keyer", {"--config", cfg});
+  ASSERT_TRUE(node.wait_ready(20s)) << node.log();
+  ASSERT_TRUE(images.wait_for_readers(1, 10s));
+  std::map<Key, wire::Owned<studio_AlphaMask>> got;
+  auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < 20s && !got.count({"cam0", 600})) {
+    send_image(images, "cam0", 600, actor_on(plate, 600));
+    std::this_thread::sleep_for(100ms);
+    poll_masks(masks, got);
+  }
+  ASSERT_TRUE(got.count({"cam0", 600})) << node.log();
+  auto keyer = Keyer::create(*options).value();
+  ASSERT_TRUE(keyer.capture_plate(plate.view()).has_value());
+  EXPECT_EQ(wire::to_core(*got.at({"cam0", 600})).value(),
+            key_in_process(keyer, actor_on(plate, 600)));
+
+  ASSERT_TRUE(controls.wait_for_readers(1, 10s));
+  wire::Owned<studio_CameraControl> clear;
+  wire::set(clear->camera_id, "cam0");
+  wire::set(clear->feature, "KeyerPlate");
+  clear->value = 0;
+  ASSERT_TRUE(controls.write(*clear).has_value());
+  t0 = std::chrono::steady_clock::now();
+  uint64_t f = 700;
+  while (std::chrono::steady_clock::now() - t0 < 20s && fs::exists(kept)) {
+    send_image(images, "cam0", f++, actor_on(plate, 700));  // the clear applies with a frame
+    std::this_thread::sleep_for(60ms);
+  }
+  EXPECT_FALSE(fs::exists(kept)) << node.log();
+  EXPECT_EQ(node.stop(), 0) << node.log();
+}
+
 TEST_F(KeyerNodeTest, ExampleConfigRuns) {
   auto& node = spawn("keyer", "keyer/studio-keyer",
                      {"--config", STUDIO_SOURCE_DIR "/keyer/node/keyer-node.example.yaml"});
@@ -421,6 +501,7 @@ TEST_F(KeyerNodeTest, BadConfigIsOneLine) {
       {"cameras: []\n", "cameras"},
       {"cameras: [a, a]\n", "duplicate camera id a"},
       {"plates: {cam0: p.png}\n", "difference key"},
+      {"plate_dir: plates\n", "difference key"},
       {"keyer: {key: difference}\nplates: {cam0: nowhere.png}\n", "nowhere.png"},
       {"keyer: {key: difference}\ncameras: [cam1]\nplates: {cam0: nowhere.png}\n",
        "not in cameras"},

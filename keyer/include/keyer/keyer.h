@@ -56,6 +56,7 @@ class Keyer {
   Expected<void> capture_plate(ImageView<const Bgr8> frame);
   void clear_plate();
   bool has_plate() const { return plate_frames_ > 0; }
+  const Image<Rgb8>& plate() const { return plate_; }  // the averaged plate (RGB); empty if none
   int plate_frames() const { return plate_frames_; }
 
   // Which row kernel runs on this CPU: "avx2", "ssse3" or "scalar".
