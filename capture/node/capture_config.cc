@@ -19,6 +19,8 @@ const char kConfigHelp[] =
     "  image: {rate: HZ, quality: Q, raw: BOOL}   latest-image service (default 5, 85, false)\n"
     "  masks: BOOL                       key and publish masks here (default true; false when\n"
     "                                    studio-keyer --config keys image: {rate: 1000, raw: true})\n"
+    "  plate_dir: DIR                    difference key: keep plates captured on command\n"
+    "                                    (KeyerPlate) as DIR/<camera>.png, load them at start\n"
     "  recorder: {queue_frames: N}       frames buffered before the disk (default 50)\n"
     "  state_period: S                   seconds between CameraState samples (default 1)\n"
     "  cameras:                          one entry per camera:\n"
@@ -217,6 +219,14 @@ Expected<CaptureNodeOptions> read_capture_config(yaml::MapReader& config) {
     auto k = keyer::load_keyer_options(keyer_path);
     if (!k) return Fail(k.error());
     o.keyer = *k;
+  }
+  if (auto n = config.optional("plate_dir")) {
+    auto dir = n->as_string();
+    if (!dir) return Fail(dir.error());
+    if (dir->empty()) return n->fail("expected a folder");
+    if (!o.publish_masks || o.keyer.mode != keyer::KeyMode::kDifference)
+      return n->fail("clean plates need in-process keying (masks: true) with the difference key");
+    o.plate_dir = resolve(*n, *dir);
   }
   auto cams = config.required("cameras");
   if (!cams) return Fail(cams.error());

@@ -51,6 +51,7 @@ struct CaptureNodeOptions {
   int jpeg_quality = 85;
   bool image_raw = false;
   bool publish_masks = true;  // false: no in-process keying (studio-keyer --config keys the images)
+  std::string plate_dir;      // difference key: plates captured on command kept as <id>.png
   double state_period = 1.0;  // seconds
   std::vector<CameraSetup> cameras;
 };
@@ -70,6 +71,8 @@ class CaptureNode : public runtime::Node {
   void capture_loop(Camera& cam);
   void control_loop();
   void handle_control(const struct CameraControlCore& c);
+  // Where camera `id`'s plate captured on command is kept ("" without plate_dir).
+  std::string kept_plate(const std::string& id) const;
   void handle_command(const struct CaptureCommandCore& c);
   void publish_state(Camera& cam);
 
@@ -85,6 +88,7 @@ class CaptureNode : public runtime::Node {
   runtime::Counter& frames_dropped_;
   runtime::Counter& frames_unkeyed_;   // difference key without a clean plate yet
   runtime::Counter& plates_captured_;  // KeyerPlate requests completed
+  runtime::Counter& plate_saves_failed_;  // completed plates that could not be kept in plate_dir
   runtime::Counter& controls_rejected_;
   runtime::Counter& commands_rejected_;
 };

@@ -126,6 +126,8 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
       {"image: {rate: fast}\ncameras:\n  - id: a\n    source: {type: sim}\n", "image.rate"},
       {"cameras:\n  - id: a\n    source: {type: files, path: nowhere}\n", "nowhere"},
       {"clock: {fps: 25, period_ns: 40000000}\ncameras: []\n", "not both"},
+      {"plate_dir: plates\ncameras:\n  - id: a\n    source: {type: sim}\n",
+       "plate_dir: clean plates need in-process keying (masks: true) with the difference key"},
   };
   for (const auto& c : cases) {
     auto& p =
@@ -248,15 +250,17 @@ TEST_F(CaptureNodeTest, PublishesMasksImagesStateAndAppliesControl) {
 
 // With the difference key the node publishes no mask until a clean plate is captured on command
 // (CameraControl KeyerPlate N: the next N frames); a bad count is an error in CameraState. A node
-// that does not key (masks: false) leaves KeyerPlate to the keyer node: no error there.
+// that does not key (masks: false) leaves KeyerPlate to the keyer node: no error there. With
+// plate_dir the plate is kept and a restarted node keys at once.
 TEST_F(CaptureNodeTest, DifferenceKeyWaitsForAPlateCapturedOnCommand) {
   auto masks = reader<studio_AlphaMask>();
   auto states = reader<studio_CameraState>();
   auto control = writer<studio_CameraControl>();
   const std::string keyer_yaml = write_config("keyer.yaml", "keyer: {key: difference}\n");
-  auto& keying = spawn("capture0", "capture/studio-capture",
-                       {"--config", write_config("cap0.yaml", sim_config({0}, 176, 144,
-                                                                         "keyer: " + keyer_yaml + "\n"))});
+  const std::string keying_config = write_config(
+      "cap0.yaml",
+      sim_config({0}, 176, 144, "keyer: " + keyer_yaml + "\nplate_dir: plates\n"));
+  auto& keying = spawn("capture0", "capture/studio-capture", {"--config", keying_config});
   auto& elsewhere = spawn("capture1", "capture/studio-capture",
                           {"--config", write_config("cap1.yaml", sim_config({1}, 176, 144,
                                                                             "masks: false\n"))});
@@ -314,6 +318,21 @@ TEST_F(CaptureNodeTest, DifferenceKeyWaitsForAPlateCapturedOnCommand) {
   EXPECT_EQ(elsewhere.stop(), 0) << elsewhere.log();
   EXPECT_NE(keying.log().find("clean plate captured (3 frames)"), std::string::npos) << keying.log();
   EXPECT_NE(keying.log().find("no clean plate yet"), std::string::npos);
+
+  ASSERT_TRUE(fs::exists(dir_ / "plates" / "cam0.png"));
+  auto& restarted = spawn("capture0-restarted", "capture/studio-capture", {"--config", keying_config});
+  ASSERT_TRUE(restarted.wait_ready(30s)) << restarted.log();
+  masks.take();
+  int after_restart = 0;
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  while (after_restart < 3 && std::chrono::steady_clock::now() < until) {
+    for (auto& m : masks.take()) after_restart += m.meta.valid_data;
+    std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_GE(after_restart, 3) << "masks from the kept plate, without a new KeyerPlate\n"
+                              << restarted.log();
+  EXPECT_NE(restarted.log().find("clean plate from"), std::string::npos) << restarted.log();
+  EXPECT_EQ(restarted.stop(), 0) << restarted.log();
 }
 
 // A GenICam camera through Aravis (its in-process fake camera, interface "Fake" only): the same
