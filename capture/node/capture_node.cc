@@ -9,7 +9,7 @@
 
 #include "convert.h"
 #include "core/log.h"
-#include "image_io.h"
+#include "kept_plates.h"
 #include "keyer/keyer.h"
 #include "wire/endpoint.h"
 #include "wire/pubsub.h"
@@ -116,27 +116,17 @@ Expected<void> CaptureNode::start() {
   if (auto a = wire_->waitset.attach(*wire_->commands, 2); !a) return fail_with(a.error());
   if (auto a = wire_->waitset.attach(wire_->wake, 3); !a) return fail_with(a.error());
 
-  if (!options_.plate_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(options_.plate_dir, ec);
-    if (ec) return fail("plate_dir " + options_.plate_dir + ": " + ec.message());
-  }
+  const keyer::KeptPlates kept(options_.plate_dir);
+  if (auto r = kept.prepare(); !r) return r;
   for (auto& cam : cameras_) {
     auto k = keyer::Keyer::create(options_.keyer);
     if (!k) return fail("camera " + cam->id + ": keyer: " + k.error().message);
     cam->keyer.emplace(std::move(*k));
     // A plate captured on command before a restart. Unreadable: the camera waits for a new one.
-    if (const std::string kept = kept_plate(cam->id); !kept.empty()) {
-      std::error_code ec;
-      if (std::filesystem::exists(kept, ec)) {
-        auto image = keyer::read_rgb(kept);
-        if (image && cam->keyer->capture_plate(image->view())) {
-          STUDIO_LOG(info, kLog) << cam->id << ": clean plate from " << kept;
-        } else {
-          STUDIO_LOG(warn, kLog) << cam->id << ": kept plate " << kept << " not used"
-                                 << (image ? "" : ": " + image.error().message);
-        }
-      }
+    if (auto loaded = kept.load(cam->id, *cam->keyer); !loaded) {
+      STUDIO_LOG(warn, kLog) << cam->id << ": kept plate not used: " << loaded.error().message;
+    } else if (*loaded) {
+      STUDIO_LOG(info, kLog) << cam->id << ": clean plate from " << kept.path(cam->id);
     }
     if (cam->calibration) {
       wire::Owned<studio_CameraCalibration> c;
@@ -355,10 +345,7 @@ void CaptureNode::capture_loop(Camera& cam) {
         cam.keyer->clear_plate();
         cam.plate_remaining = plate_request;
         cam.warned_no_plate = false;
-        if (const std::string kept = kept_plate(cam.id); plate_request == 0 && !kept.empty()) {
-          std::error_code ec;
-          std::filesystem::remove(kept, ec);
-        }
+        if (plate_request == 0) keyer::KeptPlates(options_.plate_dir).remove(cam.id);
       }
       if (!options_.publish_masks) {
         // studio-keyer --config keys the raw images on another machine.
@@ -370,11 +357,9 @@ void CaptureNode::capture_loop(Camera& cam) {
           plates_captured_.add();
           STUDIO_LOG(info, kLog) << cam.id << ": clean plate captured ("
                                  << cam.keyer->plate_frames() << " frames)";
-          if (const std::string kept = kept_plate(cam.id); !kept.empty()) {
-            if (auto r = keyer::write_rgb_png(kept, cam.keyer->plate()); !r) {
-              plate_saves_failed_.add();
-              STUDIO_LOG(warn, kLog) << cam.id << ": clean plate not kept: " << r.error().message;
-            }
+          if (auto r = keyer::KeptPlates(options_.plate_dir).save(cam.id, *cam.keyer); !r) {
+            plate_saves_failed_.add();
+            STUDIO_LOG(warn, kLog) << cam.id << ": clean plate not kept: " << r.error().message;
           }
         }
       } else if (options_.keyer.mode == keyer::KeyMode::kDifference && !cam.keyer->has_plate()) {
@@ -425,11 +410,6 @@ void CaptureNode::capture_loop(Camera& cam) {
     }
     if (publish) publish_state(cam);
   }
-}
-
-std::string CaptureNode::kept_plate(const std::string& id) const {
-  if (options_.plate_dir.empty()) return {};
-  return (std::filesystem::path(options_.plate_dir) / (id + ".png")).string();
 }
 
 void CaptureNode::control_loop() {

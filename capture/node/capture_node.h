@@ -71,8 +71,6 @@ class CaptureNode : public runtime::Node {
   void capture_loop(Camera& cam);
   void control_loop();
   void handle_control(const struct CameraControlCore& c);
-  // Where camera `id`'s plate captured on command is kept ("" without plate_dir).
-  std::string kept_plate(const std::string& id) const;
   void handle_command(const struct CaptureCommandCore& c);
   void publish_state(Camera& cam);
 

@@ -14,6 +14,7 @@
 #include "core/clock.h"
 #include "core/log.h"
 #include "image_io.h"
+#include "kept_plates.h"
 #include "keyer/keyer.h"
 #include "keyer_yaml.h"
 #include "wire/convert.h"
@@ -74,11 +75,7 @@ class KeyerNode : public runtime::Node {
 
   // Creates the configured cameras' keyers (plates applied), so plate errors fail the start.
   Expected<void> init() {
-    if (!options_.plate_dir.empty()) {
-      std::error_code ec;
-      std::filesystem::create_directories(options_.plate_dir, ec);
-      if (ec) return fail("plate_dir " + options_.plate_dir + ": " + ec.message());
-    }
+    if (auto r = kept_.prepare(); !r) return r;
     for (const std::string& id : options_.cameras)
       if (auto s = add_slot(id); !s) return std::unexpected(s.error());
     return {};
@@ -159,28 +156,15 @@ class KeyerNode : public runtime::Node {
     if (auto p = options_.plates.find(id); p != options_.plates.end()) {
       if (auto r = slot->keyer->capture_plate(p->second.view()); !r)
         return fail("plate of " + id + ": " + r.error().message);
-    } else if (const std::string kept = kept_plate(id); !kept.empty()) {
-      // A plate captured on command before a restart. Unreadable: the camera waits for a new one.
-      std::error_code ec;
-      if (std::filesystem::exists(kept, ec)) {
-        auto image = read_rgb(kept);
-        if (image && slot->keyer->capture_plate(image->view())) {
-          STUDIO_LOG(info, kLog) << id << ": clean plate from " << kept;
-        } else {
-          STUDIO_LOG(warn, kLog) << id << ": kept plate " << kept << " not used: "
-                                 << (image ? "" : image.error().message);
-        }
-      }
+    } else if (auto kept = kept_.load(id, *slot->keyer); !kept) {
+      // Unreadable: the camera waits for a new plate.
+      STUDIO_LOG(warn, kLog) << id << ": kept plate not used: " << kept.error().message;
+    } else if (*kept) {
+      STUDIO_LOG(info, kLog) << id << ": clean plate from " << kept_.path(id);
     }
     wire::set(slot->sample->camera_id, id);
     slots_.push_back(std::move(slot));
     return slots_.back().get();
-  }
-
-  // Where a plate captured on command is kept ("" without plate_dir).
-  std::string kept_plate(const std::string& id) const {
-    if (options_.plate_dir.empty()) return {};
-    return (std::filesystem::path(options_.plate_dir) / (id + ".png")).string();
   }
 
   Slot* find_slot(std::string_view id) {
@@ -350,12 +334,7 @@ class KeyerNode : public runtime::Node {
       keyer.clear_plate();
       slot.plate_remaining = plate_request;
       slot.warned_no_plate = false;
-      if (plate_request == 0) {
-        if (const std::string kept = kept_plate(slot.id); !kept.empty()) {
-          std::error_code ec;
-          std::filesystem::remove(kept, ec);
-        }
-      }
+      if (plate_request == 0) kept_.remove(slot.id);
     }
     if (slot.plate_remaining > 0) {
       if (auto r = keyer.capture_plate(image); !r) {
@@ -368,11 +347,9 @@ class KeyerNode : public runtime::Node {
         plates_captured_.add();
         STUDIO_LOG(info, kLog) << slot.id << ": clean plate captured (" << keyer.plate_frames()
                                << " frames, " << w << "x" << h << ")";
-        if (const std::string kept = kept_plate(slot.id); !kept.empty()) {
-          if (auto r = write_rgb_png(kept, keyer.plate()); !r) {
-            plate_saves_failed_.add();
-            STUDIO_LOG(warn, kLog) << slot.id << ": clean plate not kept: " << r.error().message;
-          }
+        if (auto r = kept_.save(slot.id, keyer); !r) {
+          plate_saves_failed_.add();
+          STUDIO_LOG(warn, kLog) << slot.id << ": clean plate not kept: " << r.error().message;
         }
       }
       return;
@@ -413,6 +390,7 @@ class KeyerNode : public runtime::Node {
   runtime::Counter &images_in_, &masks_published_, &rejected_, &rejected_malformed_,
       &rejected_format_, &rejected_keyer_, &rejected_cameras_, &images_ignored_, &dropped_,
       &missed_, &unkeyed_, &plates_captured_, &plate_saves_failed_, &controls_rejected_;
+  KeptPlates kept_{options_.plate_dir};
   std::optional<Io> io_;
   std::atomic<bool> running_{false};
   std::thread reader_;
