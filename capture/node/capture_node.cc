@@ -56,7 +56,7 @@ struct CaptureNode::Camera {
   TakeSchedule schedule;
   std::unique_ptr<Recorder> recorder;
   std::vector<std::unique_ptr<Recorder>> finishing;
-  uint64_t source_drops_at_begin = 0;
+  uint64_t take_frames_seen = 0;  // frames of the recording take the source delivered (+ missed)
   uint64_t recorder_drops = 0;  // queue drops of finished takes
   int plate_request = -1;       // KeyerPlate: -1 none, 0 clear, N: the next N frames
   bool error_state = false;     // a take failed (disk full, ...): stays until restart
@@ -265,7 +265,11 @@ void CaptureNode::capture_loop(Camera& cam) {
         // Recording (frame-accurate: TakeSchedule decides per studio frame number).
         auto d = cam.schedule.on_frame(frame.frame);
         if (d.ended && cam.recorder) {
-          cam.recorder->add_drops(cam.source->stats().drops - cam.source_drops_at_begin);
+          // The take's frames the source never delivered. (The source's own drop counter would
+          // also count frames skipped after stop_frame, before this frame.)
+          const uint64_t expected = d.ended->stop_frame.value_or(frame.frame) - d.ended->start_frame;
+          cam.recorder->add_drops(expected > cam.take_frames_seen ? expected - cam.take_frames_seen
+                                                                  : 0);
           cam.recorder->stop(d.ended->stop_frame);
           cam.finishing.push_back(std::move(cam.recorder));
           cam.dirty = true;
@@ -286,7 +290,7 @@ void CaptureNode::capture_loop(Camera& cam) {
           if (r) {
             cam.recorder = std::move(*r);
             cam.recorder->add_drops(d.missed);
-            cam.source_drops_at_begin = cam.source->stats().drops;
+            cam.take_frames_seen = d.missed;  // counted as drops already
             STUDIO_LOG(info, kLog) << cam.id << ": take " << d.take.name << " recording from frame "
                                    << frame.frame << " into " << dir;
           } else {
@@ -298,6 +302,7 @@ void CaptureNode::capture_loop(Camera& cam) {
           cam.dirty = true;
         }
         if (d.record && cam.recorder) {
+          ++cam.take_frames_seen;  // a refused push is a queue drop, counted by the recorder
           if (cam.recorder->push(frame))
             frames_recorded_.add();
           else
