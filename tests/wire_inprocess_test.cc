@@ -114,6 +114,30 @@ TEST_F(WireInProcess, ReaderWakesWaitSetAndSeesDisposal) {
   EXPECT_TRUE(ws.wait(50ms).empty());
 }
 
+// A reader's own history depth: the calibration topic keeps the last sample per camera, so a
+// reader that falls behind sees only the newest pose; with a deeper history it sees every one.
+TEST_F(WireInProcess, ReaderHistoryDepthKeepsSamplesTheTopicDepthWouldReplace) {
+  auto topic = wire::Topic<studio_CameraCalibration>::create(*p_).value();
+  auto writer = wire::Writer<studio_CameraCalibration>::create(*p_, topic).value();
+  auto shallow = wire::Reader<studio_CameraCalibration>::create(*p_, topic).value();
+  auto deep = wire::Reader<studio_CameraCalibration>::create(*p_, topic, 8).value();
+  auto sample = make<studio_CameraCalibration>(0);
+  for (uint64_t frame = 1; frame <= 5; ++frame) {
+    sample->frame = frame;
+    ASSERT_TRUE(writer.write(*sample));
+  }
+  const auto deadline = std::chrono::steady_clock::now() + 5s;
+  std::vector<uint64_t> frames;
+  while (frames.size() < 5 && std::chrono::steady_clock::now() < deadline) {
+    for (auto& s : deep.take()) frames.push_back(s.data->frame);
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_EQ(frames, (std::vector<uint64_t>{1, 2, 3, 4, 5}));
+  auto latest = shallow.take();
+  ASSERT_EQ(latest.size(), 1u);
+  EXPECT_EQ(latest[0].data->frame, 5u);
+}
+
 // The data-available callback sees every valid sample (and no rejected one), can be removed, and
 // a reader deleted while samples keep arriving neither calls into a freed callback (ASan would
 // report it) nor runs the callback on a half-deleted reader.

@@ -66,7 +66,10 @@ class HullNode : public runtime::Node {
   Expected<void> start() override {
     auto io = wire::gather([](auto&&... e) { return Io{std::move(e)...}; },
                            wire::Subscription<studio_AlphaMask>::create(participant_),
-                           wire::Subscription<studio_CameraCalibration>::create(participant_),
+                           // Every per-frame pose of a tracked camera, even when a cut
+                           // holds this node up (the topic keeps only the newest per camera).
+                           wire::Subscription<studio_CameraCalibration>::create(
+                               participant_, {}, int32_t(kTrackedHistory)),
                            wire::Publication<studio_SegmentSet>::create(participant_),
                            wire::Publication<studio_ActorMesh>::create(participant_),
                            wire::WaitSet::create(participant_),

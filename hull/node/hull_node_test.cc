@@ -303,13 +303,17 @@ TEST_F(HullNodeTest, TrackedCameraIsCutWithThePoseOfItsFrame) {
     return actors.empty() ? 0.0 : actors[0].volume();
   };
 
-  // Frames 41, 43, ... (camera 0 swung): calibration N and N+1, then the masks of N.
+  // Frames 41, 43, ... (camera 0 swung): calibration N, then N+1, then the masks of N. The topic
+  // keeps only the newest pose per camera; the node's reader keeps a history, so N is still
+  // there when the node is slow to take it (under ASan at full load it was not, before).
+  // N and N+1 written back to back did not both reach the node in a quick check (the keep-last-1
+  // writer may replace N before sending it; not investigated), so they are 50 ms apart.
   std::map<int64_t, double> got;
   for (int64_t f = 41; f < 41 + 2 * 12 && got.size() < 3; f += 2) {
     send_calibration(f);
-    std::this_thread::sleep_for(150ms);  // taken by the node before N+1 replaces it (keep-last 1)
+    std::this_thread::sleep_for(50ms);  // on the wire before N+1 replaces it in the writer
     send_calibration(f + 1);
-    std::this_thread::sleep_for(150ms);
+    std::this_thread::sleep_for(150ms);  // both poses arrive before the masks
     send_masks(f);
     const auto until = std::chrono::steady_clock::now() + 1s;
     while (std::chrono::steady_clock::now() < until && !got.count(f)) {

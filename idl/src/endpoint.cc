@@ -75,8 +75,10 @@ bool WriterBase::wait_for_readers(uint32_t count, std::chrono::milliseconds time
 
 void WriterBase::assert_liveliness() const { dds_assert_liveliness(entity_.handle()); }
 
-Expected<Entity> ReaderBase::make(const Participant& p, dds_entity_t topic, TopicId id) {
+Expected<Entity> ReaderBase::make(const Participant& p, dds_entity_t topic, TopicId id,
+                                  int32_t history_depth) {
   Qos qos = qos_for(id);
+  if (history_depth > 0) dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, history_depth);
   const dds_entity_t e = dds_create_reader(p.handle(), topic, qos.get(), nullptr);
   if (e < 0) return fail(dds_error(std::string("dds: create reader for ") + topic_row(id).name, e));
   return Entity(e);

@@ -141,7 +141,8 @@ class ReaderBase {
  protected:
   ReaderBase() = default;
   ReaderBase(Entity e, const TopicRow& row) : entity_(std::move(e)), row_(&row) {}
-  static Expected<Entity> make(const Participant& p, dds_entity_t topic, TopicId id);
+  static Expected<Entity> make(const Participant& p, dds_entity_t topic, TopicId id,
+                               int32_t history_depth);
 
   using Sink = void (*)(void* ctx, std::size_t index, void* sample, const SampleMeta& meta);
   // Owned path: takes/reads up to `max` samples into `buffers` (zeroed samples the caller
@@ -163,8 +164,13 @@ class ReaderBase {
 template <WireType T>
 class Reader : public ReaderBase {
  public:
-  static Expected<Reader> create(const Participant& p, const Topic<T>& topic) {
-    auto e = make(p, topic.handle(), TopicTraits<T>::id);
+  // history_depth > 0 keeps that many samples per instance in this reader instead of the
+  // topic's depth (types.h): a reader that must see every sample of a keep-last topic (e.g. the
+  // per-frame pose of a tracked camera) even when it falls behind. History is local to the
+  // reader; writers and other readers are unaffected.
+  static Expected<Reader> create(const Participant& p, const Topic<T>& topic,
+                                 int32_t history_depth = 0) {
+    auto e = make(p, topic.handle(), TopicTraits<T>::id, history_depth);
     if (!e) return std::unexpected(e.error());
     return Reader(std::move(*e));
   }

@@ -45,10 +45,12 @@ struct Subscription {
   Topic<T> topic;
   Reader<T> reader;
 
-  static Expected<Subscription> create(const Participant& p, const std::string& name = {}) {
+  // history_depth: see Reader::create (0: the topic's depth).
+  static Expected<Subscription> create(const Participant& p, const std::string& name = {},
+                                       int32_t history_depth = 0) {
     auto t = Topic<T>::create(p, name);
     if (!t) return std::unexpected(t.error());
-    auto r = Reader<T>::create(p, *t);
+    auto r = Reader<T>::create(p, *t, history_depth);
     if (!r) return std::unexpected(r.error());
     return Subscription{std::move(*t), std::move(*r)};
   }
