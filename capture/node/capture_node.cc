@@ -9,7 +9,6 @@
 
 #include "convert.h"
 #include "core/log.h"
-#include "kept_plates.h"
 #include "keyer/keyer.h"
 #include "wire/endpoint.h"
 #include "wire/pubsub.h"
@@ -76,6 +75,7 @@ struct CaptureNode::Camera {
 
 CaptureNode::CaptureNode(CaptureNodeOptions options, runtime::NodeContext& context)
     : options_(std::move(options)),
+      kept_plates_(options_.plate_dir),
       context_(context),
       masks_published_(context.metrics.counter("masks_published")),
       images_published_(context.metrics.counter("images_published")),
@@ -116,17 +116,16 @@ Expected<void> CaptureNode::start() {
   if (auto a = wire_->waitset.attach(*wire_->commands, 2); !a) return fail_with(a.error());
   if (auto a = wire_->waitset.attach(wire_->wake, 3); !a) return fail_with(a.error());
 
-  const keyer::KeptPlates kept(options_.plate_dir);
-  if (auto r = kept.prepare(); !r) return r;
+  if (auto r = kept_plates_.prepare(); !r) return r;
   for (auto& cam : cameras_) {
     auto k = keyer::Keyer::create(options_.keyer);
     if (!k) return fail("camera " + cam->id + ": keyer: " + k.error().message);
     cam->keyer.emplace(std::move(*k));
     // A plate captured on command before a restart. Unreadable: the camera waits for a new one.
-    if (auto loaded = kept.load(cam->id, *cam->keyer); !loaded) {
+    if (auto loaded = kept_plates_.load(cam->id, *cam->keyer); !loaded) {
       STUDIO_LOG(warn, kLog) << cam->id << ": kept plate not used: " << loaded.error().message;
     } else if (*loaded) {
-      STUDIO_LOG(info, kLog) << cam->id << ": clean plate from " << kept.path(cam->id);
+      STUDIO_LOG(info, kLog) << cam->id << ": clean plate from " << kept_plates_.path(cam->id);
     }
     if (cam->calibration) {
       wire::Owned<studio_CameraCalibration> c;
@@ -350,7 +349,7 @@ void CaptureNode::capture_loop(Camera& cam) {
         cam.keyer->clear_plate();
         cam.plate_remaining = plate_request;
         cam.warned_no_plate = false;
-        if (plate_request == 0) keyer::KeptPlates(options_.plate_dir).remove(cam.id);
+        if (plate_request == 0) kept_plates_.remove(cam.id);
       }
       if (!options_.publish_masks) {
         // studio-keyer --config keys the raw images on another machine.
@@ -362,7 +361,7 @@ void CaptureNode::capture_loop(Camera& cam) {
           plates_captured_.add();
           STUDIO_LOG(info, kLog) << cam.id << ": clean plate captured ("
                                  << cam.keyer->plate_frames() << " frames)";
-          if (auto r = keyer::KeptPlates(options_.plate_dir).save(cam.id, *cam.keyer); !r) {
+          if (auto r = kept_plates_.save(cam.id, *cam.keyer); !r) {
             plate_saves_failed_.add();
             STUDIO_LOG(warn, kLog) << cam.id << ": clean plate not kept: " << r.error().message;
           }

@@ -31,6 +31,7 @@
 #include "core/camera.h"
 #include "core/mask_codec.h"
 #include "keyer/keyer_options.h"
+#include "kept_plates.h"
 #include "runtime/service.h"
 
 namespace studio::capture::node {
@@ -75,6 +76,7 @@ class CaptureNode : public runtime::Node {
   void publish_state(Camera& cam);
 
   CaptureNodeOptions options_;
+  const keyer::KeptPlates kept_plates_;  // options_.plate_dir
   runtime::NodeContext& context_;
   std::unique_ptr<Wire> wire_;
   std::vector<std::unique_ptr<Camera>> cameras_;
