@@ -5,8 +5,8 @@
 #include "../../keyer/cli/keyer_yaml.h"
 #include "capture/aravis_source.h"
 #include "capture/file_source.h"
-#include "capture/sim/cameras.h"
 #include "capture/sim_source.h"
+#include "sim/cameras.h"
 #include "yaml_io/rig_yaml.h"
 
 namespace studio::capture::node {

@@ -5,7 +5,7 @@
 #include <array>
 #include <vector>
 
-#include "capture/sim/studio.h"
+#include "sim/studio.h"
 
 namespace studio::sim::detail {
 

@@ -1,5 +1,5 @@
-// Planar calibration targets rendered into virtual cameras (capture/sim/target.h).
-#include "capture/sim/target.h"
+// Planar calibration targets rendered into virtual cameras (sim/target.h).
+#include "sim/target.h"
 
 #include <algorithm>
 #include <cmath>

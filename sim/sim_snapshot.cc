@@ -15,9 +15,9 @@
 #include <iostream>
 #include <string>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
-#include "capture/sim/target.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
+#include "sim/target.h"
 
 namespace {
 

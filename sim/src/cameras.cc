@@ -1,5 +1,5 @@
-// Virtual camera rigs for the simulated studio (capture/sim/cameras.h).
-#include "capture/sim/cameras.h"
+// Virtual camera rigs for the simulated studio (sim/cameras.h).
+#include "sim/cameras.h"
 
 #include <cmath>
 #include <numbers>

@@ -11,8 +11,8 @@
 #include <chrono>
 #include <ctime>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 
 namespace studio::sim {
 namespace {

@@ -1,6 +1,6 @@
 // The simulated studio: options, per-camera caches (rays, cyclorama background), sensor noise,
-// and threading over cameras (capture/sim/studio.h). The per-frame actor work is in render.cc.
-#include "capture/sim/studio.h"
+// and threading over cameras (sim/studio.h). The per-frame actor work is in render.cc.
+#include "sim/studio.h"
 
 #include <algorithm>
 #include <atomic>

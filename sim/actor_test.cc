@@ -4,7 +4,7 @@
 #include <Eigen/Geometry>
 #include <random>
 
-#include "capture/sim/actor.h"
+#include "sim/actor.h"
 
 namespace studio::sim {
 namespace {

@@ -1,4 +1,4 @@
-// Geometry of the analytic body parts and of their union (capture/sim/actor.h).
+// Geometry of the analytic body parts and of their union (sim/actor.h).
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <numbers>
 #include <random>
 
-#include "capture/sim/actor.h"
+#include "sim/actor.h"
 
 namespace studio::sim {
 namespace {

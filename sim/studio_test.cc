@@ -3,8 +3,8 @@
 
 #include <random>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 
 namespace studio::sim {
 namespace {

@@ -1,6 +1,6 @@
 #pragma once
 // The simulated studio (issue 3 item 1): N calibrated virtual cameras around an animated
-// articulated actor (capture/sim/actor.h) on a blue retro-reflective cyclorama, producing per
+// articulated actor (sim/actor.h) on a blue retro-reflective cyclorama, producing per
 // frame the camera images, the TRUE masks and the true actor geometry / head centre. It is the
 // ground truth the keyer, the visual hull, the head tracker and calibration are scored against.
 //
@@ -34,10 +34,10 @@
 #include <memory>
 #include <vector>
 
-#include "capture/sim/actor.h"
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "sim/actor.h"
 
 namespace studio::sim {
 

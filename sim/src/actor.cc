@@ -5,7 +5,7 @@
 #include <numbers>
 #include <random>
 
-#include "capture/sim/actor.h"
+#include "sim/actor.h"
 
 #include "message.h"
 

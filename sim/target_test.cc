@@ -7,8 +7,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/target.h"
+#include "sim/cameras.h"
+#include "sim/target.h"
 
 namespace studio::sim {
 namespace {
