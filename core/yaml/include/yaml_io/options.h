@@ -171,25 +171,34 @@ class Schema {
   Expected<T> read(const Node& node, T defaults = T{}) const {
     Expected<MapReader> map = MapReader::from(node);
     if (!map) return std::unexpected(map.error());
+    return read_fields(*map, std::move(defaults), true);
+  }
+
+  // Reads this schema's keys out of `map`, a mapping that holds other keys too (a service
+  // config, whose common keys runtime::service_main reads): the keys are consumed and the caller
+  // finishes the map (`finish` = true finishes it here). validate() runs as in read().
+  Expected<T> read_fields(MapReader& map, T defaults = T{}, bool finish = false) const {
     T out = std::move(defaults);
     for (const Field<T>& f : fields_) {
       std::optional<Node> value;
       if (f.is_required()) {
-        Expected<Node> v = map->required(f.name());
+        Expected<Node> v = map.required(f.name());
         if (!v) return std::unexpected(v.error());
         value = *v;
       } else {
-        value = map->optional(f.name());
+        value = map.optional(f.name());
       }
       if (value) {
         if (Expected<void> ok = f.read(*value, out); !ok) return std::unexpected(ok.error());
       }
     }
-    if (Expected<void> ok = map->finish(); !ok) return std::unexpected(ok.error());
+    if (finish) {
+      if (Expected<void> ok = map.finish(); !ok) return std::unexpected(ok.error());
+    }
     if constexpr (requires(const T& t) {
                     { t.validate() } -> std::same_as<Expected<void>>;
                   }) {
-      if (Expected<void> ok = out.validate(); !ok) return node.fail(ok.error().message);
+      if (Expected<void> ok = out.validate(); !ok) return map.node().fail(ok.error().message);
     }
     return out;
   }
