@@ -2,7 +2,7 @@
 
 #include <filesystem>
 
-#include "../../keyer/cli/keyer_yaml.h"
+#include "keyer/config/keyer_yaml.h"
 #include "capture/aravis_source.h"
 #include "capture/file_source.h"
 #include "capture/sim/cameras.h"

@@ -31,7 +31,7 @@
 #include "core/camera.h"
 #include "core/mask_codec.h"
 #include "keyer/keyer_options.h"
-#include "kept_plates.h"
+#include "keyer/config/kept_plates.h"
 #include "runtime/service.h"
 
 namespace studio::capture::node {
