@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
   const Eigen::Vector4f white(1, 1, 1, 1);
   const int m_floor = w.add_material("marble_floor", white, t_marble);
   const int m_wall = w.add_material("wall_panels", white, t_panel);
-  const int m_ceiling = w.add_material("ceiling", Eigen::Vector4f(0.85f, 0.85f, 0.82f, 1), -1);
+  const int m_ceiling = w.add_material("ceiling", Eigen::Vector4f(0.45f, 0.45f, 0.45f, 1), -1);
   const int m_stone = w.add_material("stone", white, t_stone);
   const int m_landscape = w.add_material("painting_landscape", white, t_landscape);
   const int m_abstract = w.add_material("painting_abstract", white, t_abstract);
@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
        torus(0.38f, 0.14f, 160, 64).transformed(Eigen::AngleAxisf(kPi / 2, X).toRotationMatrix(), Eigen::Vector3f::Zero())},
       {"exhibit_blue_vase", {0.10f, 0.25f, 0.95f, 1},
        lathe([](float s) { return Eigen::Vector2f(0.18f + 0.22f * std::sin(kPi * s * 1.2f) + 0.05f * s, s * 1.0f - 0.5f); }, 128, 64)},
-      {"exhibit_yellow_knot", {0.95f, 0.80f, 0.05f, 1}, torus_knot(0.13f, 0.07f, 2, 3, 512, 24)},
+      {"exhibit_yellow_knot", {0.95f, 0.80f, 0.05f, 1}, torus_knot(0.15f, 0.1f, 2, 3, 512, 24)},
       {"exhibit_magenta_cone", {0.85f, 0.08f, 0.80f, 1},
        lathe([](float s) { return Eigen::Vector2f(0.45f * (1 - s) + 0.001f, s - 0.5f); }, 128, 16)},
       {"exhibit_cyan_cube", {0.05f, 0.80f, 0.85f, 1},
@@ -190,9 +190,9 @@ int main(int argc, char** argv) {
     n.light = w.add_light(name, type, colour, intensity);
     w.node(root).children.push_back(w.add_node(n));
   };
-  light("light_exhibits_left", "point", {1.0f, 0.95f, 0.85f}, 40, {-5, 5.5, -7}, Eigen::Quaterniond::Identity());
-  light("light_exhibits_right", "point", {1.0f, 0.95f, 0.85f}, 40, {5, 5.5, -7}, Eigen::Quaterniond::Identity());
-  light("light_stage", "point", {0.9f, 0.95f, 1.0f}, 30, {0, 5.5, 3}, Eigen::Quaterniond::Identity());
+  light("light_exhibits_left", "point", {1.0f, 0.97f, 0.92f}, 25, {-5, 4.3, -7}, Eigen::Quaterniond::Identity());
+  light("light_exhibits_right", "point", {1.0f, 0.97f, 0.92f}, 25, {5, 4.3, -7}, Eigen::Quaterniond::Identity());
+  light("light_stage", "point", {0.95f, 0.97f, 1.0f}, 20, {0, 4.3, 3}, Eigen::Quaterniond::Identity());
   light("light_sky", "directional", {1.0f, 1.0f, 1.0f}, 0.6f, {0, 5.9, 0},
         Eigen::Quaterniond(Eigen::AngleAxisd(-1.1, Eigen::Vector3d::UnitX())));
 

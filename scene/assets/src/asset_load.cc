@@ -177,6 +177,12 @@ Expected<Asset> load_asset(const std::string& path) {
       for (unsigned v = 0; v < m->mNumVertices; ++v)
         md.uvs[v] = {m->mTextureCoords[0][v].x, m->mTextureCoords[0][v].y};
     }
+    if (m->HasVertexColors(0)) {
+      md.colours.resize(m->mNumVertices);
+      for (unsigned v = 0; v < m->mNumVertices; ++v)
+        md.colours[v] = Eigen::Vector3f(m->mColors[0][v].r, m->mColors[0][v].g, m->mColors[0][v].b)
+                            .cwiseMax(0.0f).cwiseMin(1.0f);
+    }
     for (unsigned f = 0; f < m->mNumFaces; ++f) {
       const aiFace& face = m->mFaces[f];
       if (face.mNumIndices != 3) continue;

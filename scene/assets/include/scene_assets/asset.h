@@ -39,6 +39,7 @@ struct MeshData {
   std::vector<Eigen::Vector3f> positions;
   std::vector<Eigen::Vector3f> normals;
   std::vector<Eigen::Vector2f> uvs;
+  std::vector<Eigen::Vector3f> colours;  // empty or one RGB per vertex (PLY, glTF COLOR_0)
   std::vector<std::uint32_t> indices;
   int material = -1;
   Eigen::AlignedBox3f bounds;  // of positions, in the mesh's frame
