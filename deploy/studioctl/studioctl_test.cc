@@ -264,7 +264,7 @@ TEST_F(StudioctlTest, EveryIdlTopicEchoesAsJsonWithTheIdlMemberNames) {
 
 TEST_F(StudioctlTest, TopicListInfoAndHzShowARealCaptureService) {
   auto& capture = start_capture();
-  auto list = studioctl({"topic", "list", "--json"});
+  auto list = studioctl({"topic", "list", "--json", "--wait", "4"});
   ASSERT_EQ(list.code, 0) << list.err;
   std::map<std::string, Json> by_topic;
   for (auto& j : json_lines(list)) by_topic[j.find("topic")->string] = j;
@@ -280,7 +280,7 @@ TEST_F(StudioctlTest, TopicListInfoAndHzShowARealCaptureService) {
   auto text = studioctl({"topic", "list"});
   EXPECT_NE(text.out.find("studio/camera/state"), std::string::npos) << text.out;
 
-  auto info = studioctl({"topic", "info", "studio/camera/mask", "--json"});
+  auto info = studioctl({"topic", "info", "studio/camera/mask", "--json", "--wait", "4"});
   ASSERT_EQ(info.code, 0) << info.err;
   auto i = json_lines(info);
   ASSERT_EQ(i.size(), 1u);
@@ -289,24 +289,29 @@ TEST_F(StudioctlTest, TopicListInfoAndHzShowARealCaptureService) {
   EXPECT_EQ(int(writers->array[0].find("pid")->number), capture.pid());
   EXPECT_EQ(writers->array[0].find("reliability")->string, "best-effort");
 
-  // The capture clock runs at 25 fps: one mask per frame.
+  // The capture clock runs at 25 fps: one mask per frame (a loaded 2-core machine may drop a few
+  // frames; the bounds tell 25 Hz from any other plausible rate).
   auto hz =
       studioctl({"topic", "hz", "studio/camera/mask", "--json", "--count", "4", "--window", "3"});
   ASSERT_EQ(hz.code, 0) << hz.err;
   auto reports = json_lines(hz);
   ASSERT_EQ(reports.size(), 4u);
   const Json& last = reports.back();
-  EXPECT_NEAR(last.find("rate_hz")->number, 25.0, 6.0) << hz.out;
+  EXPECT_NEAR(last.find("rate_hz")->number, 25.0, 8.0) << hz.out;
   EXPECT_GT(last.find("max_s")->number, 0.0);
   EXPECT_LE(last.find("min_s")->number, 0.04 + 1e-9);
   ASSERT_TRUE(last.find("instances")->find("cam0")) << hz.out;
-  EXPECT_NEAR(last.find("instances")->find("cam0")->number, 25.0, 6.0);
+  EXPECT_NEAR(last.find("instances")->find("cam0")->number, 25.0, 8.0);
   auto hz_text = studioctl({"topic", "hz", "studio/camera/mask", "--count", "2"});
   EXPECT_NE(hz_text.out.find("average rate:"), std::string::npos) << hz_text.out;
 }
 
 TEST_F(StudioctlTest, StatusListsServicesAndRequireFailsForAMissingOne) {
   auto& capture = start_capture();
+  auto& tracker =
+      spawn("tracker", "tracker/studio-tracker",
+            {"--config", write_file("tracker.yaml", "instance: tracker0\nstatus_period: 0.5\n")});
+  ASSERT_TRUE(tracker.wait_ready(30s)) << tracker.log();
   auto status = studioctl({"status", "--json"});
   ASSERT_EQ(status.code, 0) << status.err;
   bool found = false;
@@ -320,16 +325,21 @@ TEST_F(StudioctlTest, StatusListsServicesAndRequireFailsForAMissingOne) {
     EXPECT_FALSE(s.find("host")->string.empty());
   }
   EXPECT_TRUE(found) << status.out;
+  bool tracker_seen = false;
+  for (const auto& s : json_lines(status))
+    if (s.find("service")->string == "tracker")
+      tracker_seen = s.find("instance")->string == "tracker0";
+  EXPECT_TRUE(tracker_seen) << status.out;
   auto text = studioctl({"status"});
   EXPECT_NE(text.out.find("capture"), std::string::npos);
   EXPECT_NE(text.out.find("running"), std::string::npos);
 
   // Positive control, then refusals.
   EXPECT_EQ(studioctl({"status", "--require", "capture:cam0"}).code, 0);
-  EXPECT_EQ(studioctl({"status", "--require", "capture"}).code, 0);
-  auto missing = studioctl({"status", "--require", "capture:cam0,hull,tracker"});
+  EXPECT_EQ(studioctl({"status", "--require", "capture,tracker:tracker0"}).code, 0);
+  auto missing = studioctl({"status", "--require", "capture:cam0,hull,tracker,keyer"});
   EXPECT_EQ(missing.code, 1);
-  EXPECT_NE(missing.err.find("required but not running: hull, tracker"), std::string::npos)
+  EXPECT_NE(missing.err.find("required but not running: hull, keyer"), std::string::npos)
       << missing.err;
   auto other = studioctl({"status", "--require", "capture:cam7"});
   EXPECT_EQ(other.code, 1);
