@@ -6,13 +6,24 @@
 #     host's own units beside them so dependencies resolve; negative control: with a service
 #     binary missing, verify fails;
 #  3. `systemd-analyze security --offline=true` rates every headless service at <= 4.9 ("OK");
-#     negative control: the same unit without its hardening is rated above 4.9.
-# usage: units_test.sh BUILD_DIR
+#     negative control: the same unit without its hardening is rated above 4.9;
+#  4. the installed services run with the installed example configs (state paths moved into the
+#     staging root, the loopback DDS profile in a domain of this test) and the installed
+#     `studioctl status --require` sees each of them; negative control: it fails for a service
+#     that was not started.
+# usage: units_test.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 build=$(cd "$1" && pwd)
+source_dir=$(cd "$2" && pwd)
 command -v systemd-analyze >/dev/null || { echo "systemd-analyze missing (Debian package systemd, deploy/debian-packages.txt)"; exit 1; }
 stage=$(mktemp -d)
-trap 'rm -rf "$stage"' EXIT
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$stage" "$stage.install.log"
+}
+trap cleanup EXIT
 fail=0
 bad() { echo "FAIL: $*"; fail=1; }
 
@@ -91,5 +102,39 @@ if [ -n "$r" ] && awk -v r="$r" 'BEGIN { exit !(r > 4.9) }'; then
   echo "ok   the same unit without hardening rates $r (> 4.9)"
 else
   bad "the unhardened unit rated '$r': the rating check cannot fail"
+fi
+
+# 4. The installed services with the installed example configs.
+examples="$stage$prefix/share/doc/studio/examples"
+run="$stage/run"
+mkdir -p "$run/var/lib/studio"
+for f in capture-cam0.yaml tracker.yaml keyer-keyer0.yaml; do
+  sed "s|/var/lib/studio|$run/var/lib/studio|g" "$examples/$f" >"$run/$f"
+done
+export CYCLONEDDS_URI="file://$source_dir/deploy/dds/loopback.xml"
+export STUDIO_DDS_DOMAIN=$((200 + RANDOM % 30))
+export STUDIO_DDS_TAG="units-test-$$-$RANDOM"
+"$stage$prefix/bin/studio-capture" --config "$run/capture-cam0.yaml" >"$run/capture.log" 2>&1 & pids+=($!)
+"$stage$prefix/bin/studio-tracker" --config "$run/tracker.yaml" >"$run/tracker.log" 2>&1 & pids+=($!)
+"$stage$prefix/bin/studio-keyer" --config "$run/keyer-keyer0.yaml" >"$run/keyer.log" 2>&1 & pids+=($!)
+ctl="$stage$prefix/bin/studioctl"
+ok=0
+for _ in $(seq 1 15); do
+  if "$ctl" status --require capture:cam0,tracker:tracker,keyer:keyer0 --wait 2 >"$run/status.txt" 2>"$run/status.err"; then
+    ok=1
+    break
+  fi
+done
+if [ $ok = 1 ]; then
+  echo "ok   the installed services run with the example configs:"
+  sed 's/^/       /' "$run/status.txt"
+else
+  bad "the example services did not all report: $(cat "$run/status.err")"
+  for l in capture tracker keyer; do echo "---- $l"; cat "$run/$l.log"; done
+fi
+if "$ctl" status --require hull --wait 1 >/dev/null 2>&1; then
+  bad "studioctl status --require hull passed without a hull running"
+else
+  echo "ok   studioctl status --require hull fails: no hull was started"
 fi
 exit $fail
