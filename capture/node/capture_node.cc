@@ -7,14 +7,20 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "convert.h"
 #include "core/log.h"
 #include "keyer/keyer.h"
+#include "wire/capture_convert.h"
 #include "wire/endpoint.h"
 #include "wire/pubsub.h"
 #include "yaml_io/rig_yaml.h"
 
 namespace studio::capture::node {
+using wire::CameraControlCore;
+using wire::CameraStateCore;
+using wire::CaptureCommandCore;
+using wire::from_core;
+using wire::to_core;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -129,7 +135,11 @@ Expected<void> CaptureNode::start() {
     }
     if (cam->calibration) {
       wire::Owned<studio_CameraCalibration> c;
-      from_core(*cam->calibration, 0, realtime_ns(), false, c);
+      auto fit = from_core(*cam->calibration, 0, realtime_ns(), false, c);  // the paper's model
+      if (!fit) return fail(fit.error().message);
+      if (fit->fitted)
+        STUDIO_LOG(info, kLog) << cam->id << ": OpenCV distortion fitted to the paper's model, residual max "
+                               << fit->max_residual_px << " px, RMS " << fit->rms_residual_px << " px";
       if (auto w = wire_->calibrations->write(*c); !w) return fail_with(w.error());
     }
     if (auto s = cam->source->start(); !s)

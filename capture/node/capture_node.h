@@ -34,6 +34,11 @@
 #include "kept_plates.h"
 #include "runtime/service.h"
 
+namespace studio::wire {
+struct CameraControlCore;  // wire/capture_convert.h
+struct CaptureCommandCore;
+}  // namespace studio::wire
+
 namespace studio::capture::node {
 
 struct CameraSetup {
@@ -71,8 +76,8 @@ class CaptureNode : public runtime::Node {
  private:
   void capture_loop(Camera& cam);
   void control_loop();
-  void handle_control(const struct CameraControlCore& c);
-  void handle_command(const struct CaptureCommandCore& c);
+  void handle_control(const wire::CameraControlCore& c);
+  void handle_command(const wire::CaptureCommandCore& c);
   void publish_state(Camera& cam);
 
   CaptureNodeOptions options_;

@@ -13,7 +13,7 @@
 #include "core/log.h"
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
-#include "segments_wire.h"
+#include "wire/actor_convert.h"
 #include "wire/convert.h"
 #include "wire/endpoint.h"
 #include "wire/pubsub.h"

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "core/log.h"
-#include "segments_wire.h"
 #include "tracker/segment_raster.h"
+#include "wire/actor_convert.h"
 #include "wire/endpoint.h"
 #include "wire/pubsub.h"
 
