@@ -8,19 +8,14 @@
 #include <opencv2/core.hpp>
 #include <random>
 
+#include "core/look_at.h"
+
 namespace studio {
 namespace {
 
 // A camera looking at the studio origin from `centre`, y up in the world appearing as -v.
-Camera look_at(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, double f, int w,
-               int h) {
-  const Eigen::Vector3d z = (target - centre).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitY()).normalized();  // right
-  const Eigen::Vector3d y = z.cross(x);                                      // down
-  Eigen::Matrix3d R;
-  R.row(0) = x.transpose();
-  R.row(1) = y.transpose();
-  R.row(2) = z.transpose();
+Camera camera_looking_at(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, double f,
+                         int w, int h) {
   Camera c;
   c.id = "cam";
   c.width = w;
@@ -30,7 +25,7 @@ Camera look_at(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, dou
   c.intrinsics.cx = w / 2.0 + 3.25;
   c.intrinsics.cy = h / 2.0 - 4.5;
   c.intrinsics.skew = 0.75;
-  c.cam_from_world = Rigid3(R, -(R * centre));
+  c.cam_from_world = look_at(centre, target);
   return c;
 }
 
@@ -41,7 +36,7 @@ std::vector<Camera> test_cameras() {
   for (int i = 0; i < 20; ++i) {
     const double angle = i * 0.7;
     const Eigen::Vector3d centre(4 * std::cos(angle), 1.5 + u(rng), 4 * std::sin(angle));
-    Camera c = look_at(centre, Eigen::Vector3d(u(rng) * 0.3, 1, u(rng) * 0.3), 700 + 100 * u(rng),
+    Camera c = camera_looking_at(centre, Eigen::Vector3d(u(rng) * 0.3, 1, u(rng) * 0.3), 700 + 100 * u(rng),
                        704, 576);
     c.intrinsics.skew = (i % 3 == 0) ? 0.0 : 2 * u(rng);
     cams.push_back(c);

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/cameras.h"
 #include "testing/synthetic.h"
 
 namespace studio::hull {
@@ -13,7 +14,7 @@ namespace {
 
 struct Fixture {
   testing::Scene scene = testing::actor();
-  std::vector<Camera> cameras = testing::camera_ring(6, 352, 288, 4.0, 1.6, {0, 0.9, 0}, 300);
+  std::vector<Camera> cameras = support::camera_ring(6, 352, 288, 4.0, 1.6, {0, 0.9, 0}, 300);
   std::vector<RunMask> masks;
   std::vector<View> views;
   GridSpec grid;

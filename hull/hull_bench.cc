@@ -10,6 +10,7 @@
 
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
+#include "support/cameras.h"
 #include "testing/synthetic.h"
 
 namespace studio::hull {
@@ -22,7 +23,7 @@ struct Studio {
   std::vector<View> views;
   Studio() {
     const testing::Scene scene = testing::actor();
-    cameras = testing::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
+    cameras = support::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
     for (const Camera& c : cameras) {
       masks.push_back(testing::render_mask(c, scene));
       images.push_back(masks.back().to_mask());

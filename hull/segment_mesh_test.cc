@@ -6,6 +6,7 @@
 #include <random>
 
 #include "hull/silhouette_cut.h"
+#include "support/cameras.h"
 #include "testing/synthetic.h"
 
 namespace studio::hull {
@@ -70,7 +71,7 @@ TEST(SegmentMesh, RandomSegmentSetsAreClosedManifolds) {
 
 TEST(SegmentMesh, HullOfAnActorIsWatertightWithTheSegmentVolume) {
   const testing::Scene scene = testing::actor();
-  auto cams = testing::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
+  auto cams = support::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
   std::vector<RunMask> masks;
   std::vector<View> views;
   for (const Camera& c : cams) masks.push_back(testing::render_mask(c, scene));
@@ -91,8 +92,8 @@ TEST(SegmentMesh, HullOfAnActorIsWatertightWithTheSegmentVolume) {
 TEST(SegmentMesh, SphereMeshVolumeMatchesSphereHull) {
   testing::Scene s;
   s.ellipsoids.push_back({Eigen::Vector3d(0, 1, 0), Eigen::Vector3d::Constant(0.5)});
-  auto cams = testing::camera_ring(12, 640, 480, 5.0, 1.0, {0, 1, 0}, 700);
-  cams.push_back(testing::look_at("top", {0, 6, 0}, {0, 1, 0}, Eigen::Vector3d::UnitZ(), 640, 480, 700));
+  auto cams = support::camera_ring(12, 640, 480, 5.0, 1.0, {0, 1, 0}, 700);
+  cams.push_back(support::look_at_camera("top", {0, 6, 0}, {0, 1, 0}, Eigen::Vector3d::UnitZ(), 640, 480, 700));
   std::vector<RunMask> masks;
   std::vector<View> views;
   for (const Camera& c : cams) masks.push_back(testing::render_mask(c, s));

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "support/cameras.h"
 #include "testing/synthetic.h"
 
 namespace studio::hull {
@@ -30,7 +31,7 @@ Rig axis_rig(const Scene& scene, double r, std::initializer_list<int> axes) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     c[a] = D;
     const Eigen::Vector3d up = a == 1 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
-    rig.cameras.push_back(testing::look_at("axis" + std::to_string(a), c, Eigen::Vector3d::Zero(),
+    rig.cameras.push_back(support::look_at_camera("axis" + std::to_string(a), c, Eigen::Vector3d::Zero(),
                                            up, 1000, 1000, f));
   }
   for (const Camera& c : rig.cameras) rig.masks.push_back(testing::render_mask(c, scene));
@@ -40,7 +41,7 @@ Rig axis_rig(const Scene& scene, double r, std::initializer_list<int> axes) {
 // The benchmark's scene: the synthetic actor seen by 8 cameras 704x576 on a 4 m ring.
 Rig actor_ring() {
   Rig rig;
-  rig.cameras = testing::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
+  rig.cameras = support::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
   const Scene s = testing::actor();
   for (const Camera& c : rig.cameras) rig.masks.push_back(testing::render_mask(c, s));
   return rig;
@@ -119,7 +120,7 @@ TEST(SilhouetteCut, RandomScenesContainTheObjectAndViewsOnlyShrink) {
     s.boxes.push_back({Eigen::Vector3d(U(rng), 0.2, U(rng)), Eigen::Vector3d::Zero()});
     s.boxes.back().max = s.boxes.back().min + Eigen::Vector3d(0.2, 0.3, 0.15);
     const Distortion dist = trial % 2 ? Distortion::radial(-0.08, 0.01) : Distortion::none();
-    auto cams = testing::camera_ring(6, 352, 288, 3.5, 1.0 + 0.3 * trial, {0, 1, 0}, 300, dist);
+    auto cams = support::camera_ring(6, 352, 288, 3.5, 1.0 + 0.3 * trial, {0, 1, 0}, 300, dist);
     GridSpec g;
     g.box_min = {-1.2, -0.1, -1.2};
     g.box_max = {1.2, 2.2, 1.2};
@@ -224,7 +225,7 @@ TEST(SilhouetteCut, OutsideImageKeptOrCut) {
   s.ellipsoids.push_back({Eigen::Vector3d(0, 1, 0), Eigen::Vector3d::Constant(0.3)});
   // A camera close enough that the top and bottom of the box leave its image.
   Camera cam =
-      testing::look_at("c", {0, 1, 2.0}, {0, 1, 0}, Eigen::Vector3d::UnitY(), 320, 240, 300);
+      support::look_at_camera("c", {0, 1, 2.0}, {0, 1, 0}, Eigen::Vector3d::UnitY(), 320, 240, 300);
   RunMask mask = testing::render_mask(cam, s);
   View v{&cam, &mask};
   GridSpec g;
@@ -244,7 +245,7 @@ TEST(SilhouetteCut, OutsideImageKeptOrCut) {
 
 TEST(SilhouetteCut, RejectsMaskOfWrongSize) {
   Camera cam =
-      testing::look_at("cam3", {0, 1, 4}, {0, 1, 0}, Eigen::Vector3d::UnitY(), 320, 240, 300);
+      support::look_at_camera("cam3", {0, 1, 4}, {0, 1, 0}, Eigen::Vector3d::UnitY(), 320, 240, 300);
   RunMask mask(100, 100);
   mask.finish();
   View v{&cam, &mask};
@@ -258,7 +259,7 @@ TEST(SilhouetteCut, TwoActorsAreTwoComponents) {
   Scene s = testing::actor(-0.7, 0);
   Scene other = testing::actor(0.7, 0.2);
   s.ellipsoids.insert(s.ellipsoids.end(), other.ellipsoids.begin(), other.ellipsoids.end());
-  auto cams = testing::camera_ring(8, 704, 576, 4.0, 2.2, {0, 1, 0}, 500);
+  auto cams = support::camera_ring(8, 704, 576, 4.0, 2.2, {0, 1, 0}, 500);
   std::vector<RunMask> masks;
   std::vector<View> views;
   for (const Camera& c : cams) masks.push_back(testing::render_mask(c, s));

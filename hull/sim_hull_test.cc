@@ -21,6 +21,7 @@
 #include "hull/silhouette_cut.h"
 #include "sim/cameras.h"
 #include "sim/studio.h"
+#include "support/masks.h"
 #include "testing/raster.h"
 
 namespace studio::hull {
@@ -80,7 +81,7 @@ Scores run(sim::Motion motion, std::initializer_list<int> frames, int columns, b
           const bool a = r(x, y) != 0, b = truth[c](x, y) != 0;
           missed += b && !a, extra += a && !b;
         }
-      const double q = testing::iou(r, truth[c]);
+      const double q = support::iou(r, truth[c]);
       std::printf(" %s %.4f (-%zu +%zu)", cam.id.c_str(), q, missed, extra);
       out.iou.push_back(q);
       out.worst = std::min(out.worst, q);

@@ -2,31 +2,22 @@
 
 #include <gtest/gtest.h>
 
+#include "support/cameras.h"
+#include "support/masks.h"
 #include "testing/synthetic.h"
 
 namespace studio::hull {
 namespace {
 
-double iou(const RunMask& a, const RunMask& b) {
-  long both = 0, any = 0;
-  for (int y = 0; y < a.height(); ++y)
-    for (int x = 0; x < a.width(); ++x) {
-      const bool p = a.contains(x, y), q = b.contains(x, y);
-      both += p && q;
-      any += p || q;
-    }
-  return any ? double(both) / double(any) : 1.0;
-}
-
 TEST(ViewpointCut, ProjectorMaskCoversTheActorWithConservativeDepth) {
   const testing::Scene scene = testing::actor();
-  auto cams = testing::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
+  auto cams = support::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
   std::vector<RunMask> masks;
   std::vector<View> views;
   for (const Camera& c : cams) masks.push_back(testing::render_mask(c, scene));
   for (std::size_t k = 0; k < cams.size(); ++k) views.push_back({&cams[k], &masks[k]});
   // A projector-like viewpoint between two cameras, higher up.
-  const Camera proj = testing::look_at("proj0", {2.5, 2.4, 2.0}, {0, 1, 0}, Eigen::Vector3d::UnitY(),
+  const Camera proj = support::look_at_camera("proj0", {2.5, 2.4, 2.0}, {0, 1, 0}, Eigen::Vector3d::UnitY(),
                                        480, 360, 420);
   const Eigen::AlignedBox3d box(Eigen::Vector3d(-1, 0, -1), Eigen::Vector3d(1, 2, 1));
   ViewpointOptions o;
@@ -34,7 +25,7 @@ TEST(ViewpointCut, ProjectorMaskCoversTheActorWithConservativeDepth) {
   auto cut = viewpoint_cut(proj, box, views, o);
   ASSERT_TRUE(cut) << cut.error().message;
   const RunMask truth = testing::render_mask(proj, scene);
-  EXPECT_GT(iou(cut->coverage, truth), 0.9);
+  EXPECT_GT(support::iou(cut->coverage, truth), 0.9);
   // The true actor is covered (hull contains the object) and the near depth is never behind the
   // true surface.
   const Eigen::Vector3d C = proj.centre_in_world();

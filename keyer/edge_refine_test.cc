@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "keyer/keyer.h"
+#include "support/masks.h"
 #include "test_frames.h"
 
 namespace studio::keyer {
@@ -178,8 +179,8 @@ TEST(EdgeRefine, KeepsTheSyntheticFramesAccurate) {
     RunMask a, b;
     ASSERT_TRUE(refined->key(f.image.view(), a));
     ASSERT_TRUE(plain->key(f.image.view(), b));
-    iou_refined += testing::iou(a.to_mask(), f.truth) / 4;
-    iou_plain += testing::iou(b.to_mask(), f.truth) / 4;
+    iou_refined += support::iou(a.to_mask(), f.truth) / 4;
+    iou_plain += support::iou(b.to_mask(), f.truth) / 4;
   }
   std::printf("synthetic frames: IoU %.4f plain, %.4f with edge refinement\n", iou_plain,
               iou_refined);

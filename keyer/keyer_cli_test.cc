@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
+#include "support/masks.h"
 #include "test_frames.h"
 
 namespace fs = std::filesystem;
@@ -64,7 +65,7 @@ TEST_F(KeyerCli, KeysAFolderIntoMasksWithTheSameNames) {
   ASSERT_FALSE(m.empty());
   Mask got(m.cols, m.rows);
   std::copy(m.datastart, m.dataend, got.data());
-  EXPECT_GT(testing::iou(got, a.truth), 0.95);  // a small frame: the boundary weighs much
+  EXPECT_GT(support::iou(got, a.truth), 0.95);  // a small frame: the boundary weighs much
   EXPECT_TRUE(fs::exists(dir_ / "out" / "cam1.png"));
 }
 

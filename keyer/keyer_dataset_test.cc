@@ -8,6 +8,7 @@
 
 #include "core/mask_codec.h"
 #include "keyer/keyer.h"
+#include "support/masks.h"
 
 namespace fs = std::filesystem;
 
@@ -70,12 +71,7 @@ TEST(KeyerDataset, DinoMasksDifferenceKeyAndCodec) {
     bytes_runs += runs.size();
     // Agreement with Middlebury's own silhouette recipe.
     const Mask ours = mask.to_mask(), theirs = recipe_mask(im);
-    std::size_t inter = 0, uni = 0;
-    for (std::size_t i = 0; i < ours.pixels().size(); ++i) {
-      inter += ours.pixels()[i] && theirs.pixels()[i];
-      uni += ours.pixels()[i] || theirs.pixels()[i];
-    }
-    iou_sum += double(inter) / double(uni);
+    iou_sum += support::iou(ours, theirs);
   }
   const double n = double(views.size());
   std::printf("dino masks 640x480: mean %.0f bytes row-delta, %.0f bytes plain runs; IoU vs recipe %.4f\n",

@@ -23,6 +23,7 @@
 #include "keyer/keyer.h"
 #include "sim/cameras.h"
 #include "sim/studio.h"
+#include "support/masks.h"
 #include "test_frames.h"
 
 namespace studio::keyer {
@@ -91,10 +92,10 @@ Score score_keyer(bool motion_blur, uint64_t actor_seed = 1, int64_t frame_step 
       EXPECT_TRUE(keyer->key(images[c].view(), mask));
       const Mask got = mask.to_mask();
       const Mask truth = matte_cut(mattes[c]);
-      const double i = testing::iou(got, truth);
+      const double i = support::iou(got, truth);
       s.iou_sum += i;
       s.worst_iou = std::min(s.worst_iou, i);
-      s.geometric_iou_sum += testing::iou(got, silhouettes[c]);
+      s.geometric_iou_sum += support::iou(got, silhouettes[c]);
       s.boundary_sum += testing::boundary_error(got, truth);
       s.bytes_sum += double(encode_mask(mask).size());
       ++s.masks;
@@ -197,7 +198,7 @@ TEST(KeyerSim, GeometricSilhouetteLimit) {
       studio->render_all(frame, nullptr, &silhouettes, &mattes);
       for (int c = 0; c < studio->camera_count(); ++c) {
         if (empty(silhouettes[c])) continue;
-        sum += testing::iou(matte_cut(mattes[c]), silhouettes[c]);
+        sum += support::iou(matte_cut(mattes[c]), silhouettes[c]);
         ++n;
       }
     }
@@ -260,7 +261,7 @@ TEST(KeyerSim, DISABLED_ErrorsPerCamera) {
         }
       std::printf(
           "frame %3d cam%d area %6ld IoU %.4f  FP near %4ld far %3ld  FN near %4ld far %3ld\n",
-          int(frame), c, area, testing::iou(got, truth), fp_near, fp_far, fn_near, fn_far);
+          int(frame), c, area, support::iou(got, truth), fp_near, fp_far, fn_near, fn_far);
     }
   }
 }

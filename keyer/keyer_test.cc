@@ -8,12 +8,12 @@
 #include "../src/key_kernels.h"
 #include "core/mask_codec.h"
 #include "keyer/reference_keyer.h"
+#include "support/masks.h"
 #include "test_frames.h"
 
 namespace studio::keyer {
 namespace {
 
-using testing::iou;
 using testing::make_frame;
 
 Image<Bgr8> to_bgr(const Image<Rgb8>& in) {
@@ -114,7 +114,7 @@ TEST(Keyer, KeysSyntheticActorAccurately) {
     ASSERT_TRUE(keyer);
     RunMask mask;
     ASSERT_TRUE(keyer->key(f.image.view(), mask));
-    EXPECT_GT(iou(mask.to_mask(), f.truth), 0.98) << (green ? "green" : "blue");
+    EXPECT_GT(support::iou(mask.to_mask(), f.truth), 0.98) << (green ? "green" : "blue");
   }
 }
 
@@ -139,7 +139,7 @@ TEST(Keyer, KeysBayerDemosaicedFrames) {
     RunMask mask;
     ASSERT_TRUE(keyer->key(view, mask));
     const Mask got = mask.to_mask();
-    EXPECT_GT(iou(got, f.truth), 0.97) << "demosaic " << code;
+    EXPECT_GT(support::iou(got, f.truth), 0.97) << "demosaic " << code;
     EXPECT_LT(testing::boundary_error(got, f.truth), 1.0) << "demosaic " << code;
   }
 }
@@ -165,7 +165,7 @@ TEST(Keyer, DifferenceKeyAgainstCleanPlate) {
   }
   EXPECT_EQ(keyer->plate_frames(), 4);
   ASSERT_TRUE(keyer->key(f.image.view(), mask));
-  EXPECT_GT(iou(mask.to_mask(), f.truth), 0.95);
+  EXPECT_GT(support::iou(mask.to_mask(), f.truth), 0.95);
   const auto other = make_frame(100, 80, 0.0);
   auto err = keyer->key(other.image.view(), mask);
   ASSERT_FALSE(err);

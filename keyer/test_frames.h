@@ -64,17 +64,6 @@ inline SyntheticFrame make_frame(int w, int h, double phase, bool green = false,
   return f;
 }
 
-// Intersection over union of two masks of equal size.
-inline double iou(const Mask& a, const Mask& b) {
-  std::size_t inter = 0, uni = 0;
-  for (std::size_t i = 0; i < a.pixels().size(); ++i) {
-    const bool p = a.pixels()[i] != 0, q = b.pixels()[i] != 0;
-    inter += p && q;
-    uni += p || q;
-  }
-  return uni ? double(inter) / double(uni) : 1.0;
-}
-
 // Foreground pixels with a 4-neighbour in the background.
 inline std::vector<std::pair<int, int>> boundary(const Mask& m) {
   std::vector<std::pair<int, int>> out;

@@ -13,6 +13,7 @@
 
 #include "sim/cameras.h"
 #include "sim/studio.h"
+#include "support/cameras.h"
 #include "yaml_io/rig_yaml.h"
 
 namespace studio::tracker {
@@ -51,16 +52,14 @@ class LocateCli : public ::testing::Test {
     sim::StudioOptions so;
     so.actor.motion = sim::Motion::raise_hand;
     auto studio = sim::SimulatedStudio::create(sim::ring_cameras(), so).value();
-    Rig rig;
-    rig.cameras = studio.cameras();
-    ASSERT_TRUE(yaml::write_rig(rig, (*dir_ / "rig.yaml").string()));
+    ASSERT_TRUE(support::write_rig_yaml(studio.cameras(), *dir_ / "rig.yaml"));
     for (int f : {0, 50}) {
       std::vector<Mask> masks;
       const auto truth = studio.render_all(f, nullptr, &masks);
       (f == 0 ? head0_ : head50_) = truth.head_centre();
       for (std::size_t c = 0; c < masks.size(); ++c) {
         const cv::Mat m(masks[c].height(), masks[c].width(), CV_8UC1, masks[c].data());
-        const std::string name = rig.cameras[c].id + ".png";
+        const std::string name = studio.cameras()[c].id + ".png";
         if (f == 50) cv::imwrite((*dir_ / name).string(), m);
         cv::imwrite((*dir_ / "seq" / (f == 0 ? "000" : "001") / name).string(), m);
       }

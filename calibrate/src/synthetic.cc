@@ -5,22 +5,9 @@
 #include <random>
 
 #include "calibrate/bundle.h"
+#include "core/look_at.h"
 
 namespace studio::calibrate {
-namespace {
-
-// cam_from_world of a camera at `centre` looking at `target`, studio y up, image v down.
-Rigid3 look_at(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - centre).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitY()).normalized();  // image right
-  const Eigen::Vector3d y = z.cross(x);                                      // image down
-  Eigen::Matrix3d world_from_cam;
-  world_from_cam << x, y, z;
-  const Eigen::Matrix3d r = world_from_cam.transpose();
-  return Rigid3(r, -(r * centre));
-}
-
-}  // namespace
 
 SyntheticStudio make_synthetic_studio(const SyntheticStudioOptions& o) {
   std::mt19937 rng(o.seed);

@@ -19,12 +19,18 @@
 #include "capture/recorder.h"
 #include "capture/take_schedule.h"
 #include "capture_node.h"
-#include "convert.h"
+#include "wire/capture_convert.h"
 #include "keyer/config/kept_plates.h"
 #include "keyer/plate_keyer.h"
 #include "runtime/service_loop.h"
 
 namespace studio::capture::node {
+
+using wire::CameraControlCore;
+using wire::CameraStateCore;
+using wire::CaptureCommandCore;
+using wire::from_core;
+using wire::to_core;
 
 // What every camera publishes through and counts into; owned by the node.
 struct CaptureIo {

@@ -16,7 +16,9 @@ namespace studio::capture::node {
 const char kConfigHelp[] =
     "  clock: {fps: 25, epoch_ns: 0}     studio clock (or period_ns instead of fps)\n"
     "  takes_dir: DIR                    where takes/<take>/<camera>/ go (default takes)\n"
-    "  rig: FILE                         rig.yaml with the calibrations to publish (optional)\n"
+    "  rig: FILE                         rig.yaml with the calibrations to publish (optional);\n"
+    "                                    OpenCV distortion is fitted to the paper's model, and\n"
+    "                                    refused when the fit is off by more than 0.5 px\n"
     "  keyer: FILE                       keyer options, see keyer.example.yaml (optional)\n"
     "  image: {rate: HZ, quality: Q, raw: BOOL}   latest-image service (default 5, 85, false)\n"
     "  masks: BOOL                       key and publish masks here (default true; false when\n"

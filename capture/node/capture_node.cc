@@ -72,7 +72,12 @@ class CaptureNode : public runtime::Node {
     for (auto& w : workers_) {
       if (w->calibration()) {
         wire::Owned<studio_CameraCalibration> c;
-        from_core(*w->calibration(), 0, realtime_ns(), false, c);
+        // The wire carries the paper's model: OpenCV distortion is fitted or refused here.
+        auto fit = from_core(*w->calibration(), 0, realtime_ns(), false, c);
+        if (!fit) return std::unexpected(Error{w->id() + ": " + fit.error().message});
+        if (fit->fitted)
+          STUDIO_LOG(info, kLog) << w->id() << ": OpenCV distortion fitted to the paper's model, residual max "
+                                 << fit->max_residual_px << " px, RMS " << fit->rms_residual_px << " px";
         if (auto r = calibrations_->write(*c); !r) return r;
       }
       w->publish_state();

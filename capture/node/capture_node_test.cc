@@ -642,5 +642,52 @@ TEST_F(CaptureNodeTest, SixCamerasWhileRecordingRate) {
   EXPECT_EQ(p.stop(std::chrono::seconds(10)), 0);
 }
 
+// The calibration the node publishes carries the paper's model: a rig camera with OpenCV
+// distortion is converted by the documented fit (radial-only k1 k2: exactly) or, when the fit's
+// residual is too large (tangential terms), the node refuses to start with one clear line.
+TEST_F(CaptureNodeTest, OpenCvCalibrationIsConvertedOrRefused) {
+  auto rig = [&](const std::string& name, const std::string& opencv) {
+    return write_config(
+        name,
+        "units: metres\ncameras:\n  - id: cam0\n    width: 176\n    height: 144\n"
+        "    K: [150, 0, 87.5, 0, 150, 71.5, 0, 0, 1]\n    opencv: [" +
+            opencv + "]\n    cam_from_world: {R: [1, 0, 0, 0, 1, 0, 0, 0, 1], t: [0, -1, 4]}\n");
+  };
+  auto calibrations = reader<studio_CameraCalibration>();
+  {
+    auto& p = spawn(
+        "capture", "capture/studio-capture",
+        {"--config",
+         write_config(
+             "cap.yaml",
+             sim_config({0}, 176, 144, "rig: " + rig("rig.yaml", "-0.2, 0.03, 0, 0, 0") + "\n"))});
+    ASSERT_TRUE(p.wait_ready(30s)) << p.log();
+    std::vector<wire::Received<studio_CameraCalibration>> cal;
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (cal.empty() && std::chrono::steady_clock::now() < deadline) {
+      cal = calibrations.take();
+      std::this_thread::sleep_for(20ms);
+    }
+    ASSERT_FALSE(cal.empty());
+    EXPECT_STREQ(cal[0].data->camera_id, "cam0");
+    EXPECT_NEAR(cal[0].data->rd3, -0.2, 1e-9);
+    EXPECT_NEAR(cal[0].data->rd5, 0.03, 1e-9);
+    EXPECT_EQ(p.stop(std::chrono::seconds(10)), 0);
+  }
+  auto& p = spawn(
+      "capture-refused", "capture/studio-capture",
+      {"--config",
+       write_config(
+           "bad.yaml",
+           sim_config({0}, 176, 144,
+                      "rig: " + rig("tangential.yaml", "-0.2, 0.03, 0.02, -0.02, 0") + "\n"))});
+  auto rc = p.wait_exit(30s);
+  ASSERT_TRUE(rc.has_value()) << p.log();
+  EXPECT_NE(*rc, 0) << p.log();
+  const std::string log = p.log();
+  EXPECT_NE(log.find("does not fit the paper's radial model"), std::string::npos) << log;
+  EXPECT_NE(log.find("cam0"), std::string::npos) << log;
+}
+
 }  // namespace
 }  // namespace studio::capture

@@ -148,7 +148,8 @@ void write_matrix(std::ostringstream& out, const char* name, int rows, int cols,
 }  // namespace
 
 Expected<Rig> parse_opencv_yaml(std::string_view text, const std::string& name, int width,
-                                int height, std::string_view id_prefix) {
+                                int height, std::string_view id_prefix,
+                                const OpencvImport& options) {
   // cv::FileStorage writes "%YAML:1.0", which is not a valid YAML directive; "%YAML 1.0" is.
   std::string source(text);
   if (source.rfind("%YAML:", 0) == 0) source[5] = ' ';
@@ -178,6 +179,12 @@ Expected<Rig> parse_opencv_yaml(std::string_view text, const std::string& name, 
     if (!d) return std::unexpected(d.error());
     camera.distortion = *d;
     camera.cam_from_world = pose;
+    if (options.paper_model) {
+      Expected<PaperModelFit> fit = to_paper_model(camera, options.fit);
+      if (!fit) return fail(name + ": " + fit.error().message);
+      camera = fit->camera;
+      if (options.fits != nullptr) options.fits->push_back(std::move(*fit));
+    }
     rig.cameras.push_back(std::move(camera));
     return {};
   };
@@ -216,13 +223,13 @@ Expected<Rig> parse_opencv_yaml(std::string_view text, const std::string& name, 
 }
 
 Expected<Rig> import_opencv_yaml(const std::string& path, int width, int height,
-                                 std::string_view id_prefix) {
+                                 std::string_view id_prefix, const OpencvImport& options) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(path + ": cannot open file");
   std::ostringstream buffer;
   buffer << in.rdbuf();
   if (in.bad()) return fail(path + ": read error");
-  return parse_opencv_yaml(buffer.str(), path, width, height, id_prefix);
+  return parse_opencv_yaml(buffer.str(), path, width, height, id_prefix, options);
 }
 
 std::string format_opencv_yaml(const Camera& c) {

@@ -120,6 +120,93 @@ TEST(OpenCvYaml, ImportsFilesWrittenByCvFileStorage) {
   EXPECT_EQ(pair->cameras[1].distortion.k1, -0.1);
 }
 
+// A file written by cv::FileStorage with distortion `coefficients` (k1 k2 p1 p2 k3).
+std::string write_cv_file(const Camera& cam, const cv::Mat& coefficients, const std::string& name) {
+  const std::string path = testing::TempDir() + "/" + name;
+  cv::FileStorage fs(path, cv::FileStorage::WRITE);
+  fs << "image_width" << cam.width << "image_height" << cam.height;
+  fs << "camera_matrix" << to_cv(cam.intrinsics.K()) << "distortion_coefficients" << coefficients;
+  fs << "R" << to_cv(cam.cam_from_world.R()) << "T" << to_cv(cam.cam_from_world.translation);
+  return path;
+}
+
+// Worst pixel distance between cv::projectPoints (the file's model, as OpenCV applies it) and the
+// imported camera, over points in front of the camera that land in the image.
+double worst_vs_opencv(const Camera& imported, const cv::Mat& coefficients) {
+  std::vector<cv::Point3d> points;
+  for (int i = 0; i < 25; ++i)
+    for (int j = 0; j < 25; ++j) {
+      // Rays through a grid beyond the image corners, at 2 to 5 m.
+      const Eigen::Vector3d n((i - 12) * 0.06, (j - 12) * 0.05, 1.0);
+      const Eigen::Vector3d x_in_cam = n * (2.0 + 0.12 * i);
+      const Eigen::Vector3d x = imported.cam_from_world.inverse() * x_in_cam;
+      points.emplace_back(x.x(), x.y(), x.z());
+    }
+  cv::Mat rvec;
+  cv::Rodrigues(to_cv(imported.cam_from_world.R()), rvec);
+  std::vector<cv::Point2d> expected;
+  cv::projectPoints(points, rvec, to_cv(imported.cam_from_world.translation),
+                    to_cv(imported.intrinsics.K()), coefficients, expected);
+  double worst = 0;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (expected[k].x < 0 || expected[k].y < 0 || expected[k].x > imported.width - 1 ||
+        expected[k].y > imported.height - 1)
+      continue;
+    Eigen::Vector2d px;
+    EXPECT_TRUE(imported.project({points[k].x, points[k].y, points[k].z}, &px));
+    worst = std::max(worst, (px - Eigen::Vector2d(expected[k].x, expected[k].y)).norm());
+  }
+  return worst;
+}
+
+TEST(OpenCvYaml, PaperModelImportFitsOrRefusesNeverRenames) {
+  Camera cam = sample_camera();
+  cam.intrinsics.skew = 0;  // cv::projectPoints has no skew
+  // Radial-only k1, k2: the paper's model holds it exactly (both map ideal -> observed).
+  const cv::Mat radial = (cv::Mat_<double>(1, 5) << -0.2345, 0.0789, 0, 0, 0);
+  std::vector<PaperModelFit> fits;
+  Expected<Rig> rig = import_opencv_yaml(write_cv_file(cam, radial, "cv_radial.yaml"), 0, 0, "cam",
+                                         {.paper_model = true, .fits = &fits});
+  ASSERT_TRUE(rig) << rig.error().message;
+  const Camera& c = rig->cameras[0];
+  EXPECT_EQ(c.distortion.model, Distortion::Model::radial);
+  ASSERT_EQ(fits.size(), 1u);
+  EXPECT_TRUE(fits[0].fitted);
+  EXPECT_LT(fits[0].max_residual_px, 1e-6);
+  const double exact = worst_vs_opencv(c, radial);
+  std::printf("[ measured ] k1 k2 only -> paper model: fit max %.3g px, vs cv::projectPoints %.3g px\n",
+              fits[0].max_residual_px, exact);
+  EXPECT_LT(exact, 1e-6);
+
+  // A small k3: fitted, residual reported and within tolerance; OpenCV agrees within it.
+  const cv::Mat k3 = (cv::Mat_<double>(1, 5) << -0.2345, 0.0789, 0, 0, -0.004);
+  fits.clear();
+  rig = import_opencv_yaml(write_cv_file(cam, k3, "cv_k3.yaml"), 0, 0, "cam",
+                           {.paper_model = true, .fits = &fits});
+  ASSERT_TRUE(rig) << rig.error().message;
+  ASSERT_EQ(fits.size(), 1u);
+  const double fitted = worst_vs_opencv(rig->cameras[0], k3);
+  std::printf("[ measured ] k3 -0.004 -> paper model: fit max %.3g px RMS %.3g px, vs "
+              "cv::projectPoints %.3g px\n",
+              fits[0].max_residual_px, fits[0].rms_residual_px, fitted);
+  EXPECT_GT(fits[0].max_residual_px, 1e-4);
+  EXPECT_LE(fitted, fits[0].max_residual_px * 1.05 + 1e-9);
+
+  // Strong tangential terms: refused, naming the file and the camera.
+  const cv::Mat tangential = (cv::Mat_<double>(1, 5) << -0.2345, 0.0789, 0.004, -0.003, 0);
+  const std::string path = write_cv_file(cam, tangential, "cv_tangential.yaml");
+  rig = import_opencv_yaml(path, 0, 0, "cam", {.paper_model = true});
+  ASSERT_FALSE(rig);
+  EXPECT_NE(rig.error().message.find(path + ": camera cam0"), std::string::npos)
+      << rig.error().message;
+  EXPECT_NE(rig.error().message.find("does not fit the paper's radial model"), std::string::npos);
+  // Without paper_model the same file keeps OpenCV's model exactly.
+  rig = import_opencv_yaml(path);
+  ASSERT_TRUE(rig) << rig.error().message;
+  EXPECT_EQ(rig->cameras[0].distortion.model, Distortion::Model::opencv);
+  EXPECT_LT(worst_vs_opencv(rig->cameras[0], tangential), 1e-6);
+}
+
 std::string error_of(const std::string& text, int w = 640, int h = 480) {
   Expected<Rig> rig = parse_opencv_yaml(text, "cv.yaml", w, h);
   return rig ? std::string("<ok>") : rig.error().message;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/rig.h"
+#include "support/cameras.h"
 #include "testing/synthetic.h"
 #include "yaml_io/rig_yaml.h"
 
@@ -41,10 +42,9 @@ class HullCli : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("hull_cli_test_" + std::to_string(::getpid()));
     fs::create_directories(dir_ / "masks");
     const testing::Scene scene = testing::actor();
-    Rig rig;
-    rig.cameras = testing::camera_ring(4, 352, 288, 4.0, 1.6, {0, 1, 0}, 300);
-    ASSERT_TRUE(yaml::write_rig(rig, (dir_ / "rig.yaml").string()));
-    for (const Camera& c : rig.cameras) {
+    const auto cameras = support::camera_ring(4, 352, 288, 4.0, 1.6, {0, 1, 0}, 300);
+    ASSERT_TRUE(support::write_rig_yaml(cameras, dir_ / "rig.yaml"));
+    for (const Camera& c : cameras) {
       const Mask m = testing::render_mask(c, scene).to_mask();
       cv::Mat img(m.height(), m.width(), CV_8U, const_cast<uint8_t*>(m.data()));
       for (const char* frame : {"", "7/", "8/"}) {

@@ -18,6 +18,8 @@
 #include "keyer/keyer.h"
 #include "sim/cameras.h"
 #include "sim/studio.h"
+#include "support/cameras.h"
+#include "support/masks.h"
 #include "testing/mesh_read.h"
 #include "testing/raster.h"
 #include "yaml_io/rig_yaml.h"
@@ -106,9 +108,7 @@ class HullCliTake : public ::testing::Test {
     auto studio = sim::SimulatedStudio::create(sim::ring_cameras(ring), so);
     ASSERT_TRUE(studio) << studio.error().message;
     studio_ = new sim::SimulatedStudio(std::move(*studio));
-    Rig rig;
-    rig.cameras = studio_->cameras();
-    ASSERT_TRUE(yaml::write_rig(rig, (dir_ / "rig.yaml").string()));
+    ASSERT_TRUE(support::write_rig_yaml(studio_->cameras(), dir_ / "rig.yaml"));
     // The take, and beside it the masks the same (default blue) keyer makes of its frames and
     // the true masks of the simulator.
     for (int c = 0; c < studio_->camera_count(); ++c) {
@@ -121,7 +121,7 @@ class HullCliTake : public ::testing::Test {
         studio_->render(c, int64_t(f), &image, &truth);
         RunMask keyed;
         ASSERT_TRUE(keyer->key(image.view(), keyed));
-        const std::string name = std::to_string(f) + "/" + rig.cameras[std::size_t(c)].id + ".png";
+        const std::string name = std::to_string(f) + "/" + studio_->cameras()[std::size_t(c)].id + ".png";
         write_png(keyed.to_mask(), dir_ / "keyed" / name);
         write_png(truth, dir_ / "truth" / name);
       }
@@ -143,7 +143,7 @@ class HullCliTake : public ::testing::Test {
       Mask truth;
       studio_->render(c, int64_t(frame), nullptr, &truth);
       const Camera& cam = studio_->cameras()[std::size_t(c)];
-      worst = std::min(worst, testing::iou(testing::rasterise(mesh, cam), truth));
+      worst = std::min(worst, support::iou(testing::rasterise(mesh, cam), truth));
     }
     return worst;
   }

@@ -10,7 +10,7 @@
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "runtime/service_loop.h"
-#include "segments_wire.h"
+#include "wire/actor_convert.h"
 #include "wire/convert.h"
 #include "wire/sample.h"
 

@@ -14,9 +14,10 @@
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
-#include "segments_wire.h"
 #include "sim/cameras.h"
 #include "sim/studio.h"
+#include "support/cameras.h"
+#include "wire/actor_convert.h"
 #include "wire/convert.h"
 #include "wire/endpoint.h"
 #include "wire/sample.h"
@@ -36,9 +37,7 @@ class HullNodeTest : public testing::ProcessTest {
     ring.height = 288;
     ring.focal_px = 280;
     cameras_ = sim::ring_cameras(ring);
-    Rig rig;
-    rig.cameras = cameras_;
-    ASSERT_TRUE(yaml::write_rig(rig, (dir_ / "rig.yaml").string()).has_value());
+    ASSERT_TRUE(support::write_rig_yaml(cameras_, dir_ / "rig.yaml").has_value());
     sim::StudioOptions so;
     so.actor.motion = sim::Motion::walk;
     studio_.emplace(sim::SimulatedStudio::create(cameras_, so).value());

@@ -60,17 +60,4 @@ Mask rasterise(const Mesh& mesh, const Camera& camera) {
   return out;
 }
 
-double iou(const Mask& a, const Mask& b) {
-  if (a.width() != b.width() || a.height() != b.height()) throw std::invalid_argument("iou: size");
-  std::size_t inter = 0, uni = 0;
-  for (int y = 0; y < a.height(); ++y) {
-    for (int x = 0; x < a.width(); ++x) {
-      const bool p = a(x, y) != 0, q = b(x, y) != 0;
-      inter += p && q;
-      uni += p || q;
-    }
-  }
-  return uni == 0 ? 1.0 : double(inter) / double(uni);
-}
-
 }  // namespace studio::hull::testing

@@ -14,7 +14,4 @@ namespace studio::hull::testing {
 // 255 where the mesh covers the pixel centre, 0 elsewhere; camera.width x camera.height.
 Mask rasterise(const Mesh& mesh, const Camera& camera);
 
-// |a ∧ b| / |a ∨ b| over non-zero pixels (1 when both are empty). Sizes must match.
-double iou(const Mask& a, const Mask& b);
-
 }  // namespace studio::hull::testing

@@ -85,42 +85,6 @@ double Scene::volume_estimate(const Eigen::Vector3d& lo, const Eigen::Vector3d& 
   return count * step.prod();
 }
 
-Camera look_at(const std::string& id, const Eigen::Vector3d& centre, const Eigen::Vector3d& target,
-               const Eigen::Vector3d& up, int width, int height, double focal_px,
-               const Distortion& distortion) {
-  const Eigen::Vector3d z = (target - centre).normalized();
-  const Eigen::Vector3d y = (-up + up.dot(z) * z).normalized();
-  const Eigen::Vector3d x = y.cross(z);
-  Eigen::Matrix3d R;
-  R.row(0) = x;
-  R.row(1) = y;
-  R.row(2) = z;
-  Camera c;
-  c.id = id;
-  c.width = width;
-  c.height = height;
-  c.intrinsics.fx = c.intrinsics.fy = focal_px;
-  c.intrinsics.cx = 0.5 * (width - 1);
-  c.intrinsics.cy = 0.5 * (height - 1);
-  c.distortion = distortion;
-  c.cam_from_world = Rigid3(R, -(R * centre));
-  return c;
-}
-
-std::vector<Camera> camera_ring(int n, int width, int height, double radius, double height_m,
-                                const Eigen::Vector3d& target, double focal_px,
-                                const Distortion& distortion) {
-  std::vector<Camera> out;
-  for (int k = 0; k < n; ++k) {
-    const double a = 2 * M_PI * (k + 0.25) / n;
-    const Eigen::Vector3d c(target.x() + radius * std::cos(a), height_m,
-                            target.z() + radius * std::sin(a));
-    out.push_back(look_at("cam" + std::to_string(k), c, target, Eigen::Vector3d::UnitY(), width,
-                          height, focal_px, distortion));
-  }
-  return out;
-}
-
 RunMask render_mask(const Camera& camera, const Scene& scene) {
   RunMask m(camera.width, camera.height);
   const Eigen::Vector3d o = camera.centre_in_world();

@@ -1,7 +1,8 @@
 #pragma once
-// Synthetic scenes for hull tests and benchmarks: analytic solids (ellipsoids, boxes), cameras
-// placed by look-at, and exact masks rendered by casting every pixel centre's ray (distortion
-// included, through Camera::pixel_ray_in_world). Not part of the library.
+// Synthetic scenes for hull tests and benchmarks: analytic solids (ellipsoids, boxes) and exact
+// masks rendered by casting every pixel centre's ray (distortion included, through
+// Camera::pixel_ray_in_world). Not part of the library. Cameras by look-at and camera rings are
+// the shared test helpers' (tests/support: support/cameras.h).
 
 #include <Eigen/Core>
 #include <random>
@@ -29,16 +30,6 @@ struct Scene {
   std::vector<Eigen::Vector3d> surface_samples(int per_solid, std::mt19937& rng) const;
   double volume_estimate(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int n) const;
 };
-
-// A camera at `centre` looking at `target`; `up` is the world direction that appears up.
-Camera look_at(const std::string& id, const Eigen::Vector3d& centre, const Eigen::Vector3d& target,
-               const Eigen::Vector3d& up, int width, int height, double focal_px,
-               const Distortion& distortion = Distortion::none());
-
-// n cameras on a ring of `radius` at `height`, looking at `target` (the studio layout).
-std::vector<Camera> camera_ring(int n, int width, int height, double radius, double height_m,
-                                const Eigen::Vector3d& target, double focal_px,
-                                const Distortion& distortion = Distortion::none());
 
 RunMask render_mask(const Camera& camera, const Scene& scene);
 

@@ -79,7 +79,8 @@ Expected<Camera> to_core(const studio_CameraCalibration& s) {
 
 Expected<bool> from_core(const Camera& c, studio_CameraCalibration& s) {
   if (c.distortion.model == Distortion::Model::opencv)
-    return fail("camera " + c.id + ": OpenCV distortion cannot travel on studio/camera/calibration");
+    return fail("camera " + c.id + ": OpenCV distortion cannot travel on studio/camera/calibration; "
+                "convert it explicitly with to_paper_model (core/distortion_fit.h)");
   set(s.camera_id, c.id);
   s.width = uint32_t(c.width);
   s.height = uint32_t(c.height);

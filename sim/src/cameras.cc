@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/look_at.h"
 #include "message.h"
 
 namespace studio::sim {
@@ -19,19 +20,6 @@ Expected<void> RingOptions::validate() const {
     return fail("ring camera height must be > 0 and the overhead camera above 3 m");
   }
   return {};
-}
-
-Rigid3 look_at(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - centre).normalized();
-  Eigen::Vector3d down(0, -1, 0);
-  if (std::abs(z.dot(down)) > 0.999) down = Eigen::Vector3d(0, 0, 1);
-  const Eigen::Vector3d x = down.cross(z).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  Eigen::Matrix3d R;
-  R.row(0) = x;
-  R.row(1) = y;
-  R.row(2) = z;
-  return Rigid3(R, -(R * centre));
 }
 
 std::vector<Camera> ring_cameras(const RingOptions& o) {

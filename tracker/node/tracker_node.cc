@@ -7,7 +7,7 @@
 
 #include "core/log.h"
 #include "runtime/service_loop.h"
-#include "segments_wire.h"
+#include "wire/actor_convert.h"
 #include "tracker/keep_alive.h"
 #include "tracker/segment_raster.h"
 

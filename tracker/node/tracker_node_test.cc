@@ -17,9 +17,9 @@
 #include "core/run_mask.h"
 #include "harness/fixture.h"
 #include "hull/silhouette_cut.h"
-#include "segments_wire.h"
 #include "sim/cameras.h"
 #include "sim/studio.h"
+#include "wire/actor_convert.h"
 #include "wire/endpoint.h"
 
 namespace studio::tracker {

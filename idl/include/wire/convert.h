@@ -26,7 +26,7 @@ void from_core(const RunMask& mask, studio_MaskEncoding encoding, studio_AlphaMa
 // CameraCalibration → Camera (id, size, K, the paper's radial model, cam_from_world).
 Expected<Camera> to_core(const studio_CameraCalibration& sample);
 // Camera → CameraCalibration. Fails for a distortion the wire cannot carry (OpenCV's model:
-// convert the camera to the paper's radial model first).
+// convert the camera explicitly with to_paper_model, core/distortion_fit.h, first).
 Expected<bool> from_core(const Camera& camera, studio_CameraCalibration& sample);
 
 }  // namespace studio::wire

@@ -21,13 +21,10 @@ struct RingOptions {
   Expected<void> validate() const;
 };
 
-// A camera at `centre` looking at `target`, image y pointing as close to world -y (down) as
-// possible (for a camera looking straight down, image y points to world +z).
-Rigid3 look_at(const Eigen::Vector3d& centre, const Eigen::Vector3d& target);
-
 // Pinhole cameras (no distortion) with ids cam0..cam<N-1>: count-1 (or count) on a ring around
 // the acting area, evenly spaced in azimuth and looking at its centre, plus one overhead camera
-// looking straight down (the paper's layout). Principal point at the image centre.
+// looking straight down (the paper's layout; poses by core/look_at.h, y up: the overhead camera's
+// image y points to world +z). Principal point at the image centre.
 std::vector<Camera> ring_cameras(const RingOptions& options = {});
 
 }  // namespace studio::sim

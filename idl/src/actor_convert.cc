@@ -1,4 +1,4 @@
-#include "segments_wire.h"
+#include "wire/actor_convert.h"
 
 #include <algorithm>
 #include <cmath>

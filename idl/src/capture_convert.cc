@@ -1,9 +1,11 @@
-#include "convert.h"
+#include "wire/capture_convert.h"
 
 #include <algorithm>
 #include <span>
 
-namespace studio::capture::node {
+#include "wire/convert.h"
+
+namespace studio::wire {
 
 void from_core(const std::string& camera_id, uint64_t frame, int64_t capture_ns,
                const std::vector<uint8_t>& codec_bytes, int width, int height,
@@ -19,29 +21,16 @@ void from_core(const std::string& camera_id, uint64_t frame, int64_t capture_ns,
   wire::assign(out->data, codec_bytes);
 }
 
-void from_core(const Camera& camera, uint64_t frame, int64_t capture_ns, bool tracked,
-               wire::Owned<studio_CameraCalibration>& out) {
-  wire::set(out->camera_id, camera.id);
+Expected<PaperModelFit> from_core(const Camera& camera, uint64_t frame, int64_t capture_ns,
+                                  bool tracked, wire::Owned<studio_CameraCalibration>& out,
+                                  const PaperModelOptions& options) {
+  auto fit = to_paper_model(camera, options);
+  if (!fit) return std::unexpected(fit.error());
+  if (auto ok = from_core(fit->camera, *out); !ok) return std::unexpected(ok.error());
   out->frame = frame;
   out->capture_ns = capture_ns;
-  out->width = uint32_t(camera.width);
-  out->height = uint32_t(camera.height);
-  const Eigen::Matrix3d K = camera.intrinsics.K();
-  const Eigen::Matrix3d R = camera.cam_from_world.R();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) {
-      out->K[3 * r + c] = K(r, c);
-      out->R[3 * r + c] = R(r, c);
-    }
-  for (int i = 0; i < 3; ++i) out->t[i] = camera.cam_from_world.translation[i];
-  const auto& d = camera.distortion;
-  out->rd3 = d.model == Distortion::Model::radial   ? d.rd3
-             : d.model == Distortion::Model::opencv ? d.k1
-                                                    : 0;
-  out->rd5 = d.model == Distortion::Model::radial   ? d.rd5
-             : d.model == Distortion::Model::opencv ? d.k2
-                                                    : 0;
   out->tracked = tracked;
+  return fit;
 }
 
 void from_core(const std::string& camera_id, uint64_t frame, int64_t capture_ns, int width,
@@ -100,4 +89,4 @@ CameraControlCore to_core(const studio_CameraControl& c) {
   return {std::string(wire::str(c.camera_id)), std::string(wire::str(c.feature)), c.value};
 }
 
-}  // namespace studio::capture::node
+}  // namespace studio::wire

@@ -6,9 +6,10 @@
 //   studio/actor/head      studio_HeadPose   <-> tracker::HeadPose  (tracker node writes,
 //                                                                      projector/scene/preview
 //                                                                      read)
-// Library `studio_segments_wire` (links studio_wire, studio_hull, studio_tracker); include as
-// "segments_wire.h". As in wire/convert.h, the key and `frame` are the caller's; these convert the
-// payload (HeadPose's capture_ns is part of the core value and is converted).
+// Library `studio_wire_actor` (links studio_wire, studio_hull, studio_tracker: the pure types
+// these topics carry), the one conversion of these topics. As in wire/convert.h, the key and
+// `frame` are the caller's; these convert the payload (HeadPose's capture_ns is part of the core
+// value and is converted).
 //
 // Wire SegmentSet layout (idl/studio.idl): nu x nv columns over [box_min, box_max] (float),
 // column c = i + j*nu holds pairs intervals[2k], intervals[2k+1] for k in

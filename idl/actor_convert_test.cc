@@ -1,6 +1,6 @@
 // Actor-topic conversions: SegmentSet and HeadPose round trips through the wire types, the wire
 // validator accepts what from_core writes, and to_core turns malformed payloads into one line.
-#include "segments_wire.h"
+#include "wire/actor_convert.h"
 
 #include <gtest/gtest.h>
 
