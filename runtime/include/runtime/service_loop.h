@@ -233,7 +233,8 @@ class OutputBase {
 };
 
 // A declared publication. write() and dispose() are thread-safe (DDS writers are); before
-// start() and after stop() they fail with a one-line error.
+// start() and after stop() they fail with a one-line error. Threads the loop does not own must
+// stop writing before stop() (the loop's own threads and at_stop() hooks may write throughout).
 template <wire::WireType T>
 class Output : public OutputBase {
  public:
