@@ -166,6 +166,17 @@ Field<T> enum_field(std::string name, E T::*member, std::vector<std::pair<std::s
                   });
 }
 
+// A parser for field(..., parse): a number in [lo, hi]; out of range the error reads
+// "expected <what>" (e.g. number_in(0.5, 1000, "Hz in 0.5..1000")), where range() would say
+// "must be in [lo, hi], got v".
+inline auto number_in(double lo, double hi, std::string what) {
+  return [lo, hi, what = std::move(what)](const Node& n) -> Expected<double> {
+    Expected<double> v = n.as_double();
+    if (v && !(*v >= lo && *v <= hi)) return n.fail("expected " + what);
+    return v;
+  };
+}
+
 template <class T>
 class Schema {
  public:
