@@ -129,6 +129,7 @@ struct Renderer::Impl {
   std::vector<float> vertex_scratch;
   std::vector<std::uint32_t> index_scratch;
   int draw_calls = 0;
+  bool culling = false;
 
   ~Impl() {
     for (auto& [p, a] : assets) release(a);
@@ -313,6 +314,9 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CCW);
+  r.culling = false;
   glDisable(GL_BLEND);
   glUseProgram(r.program);
 
@@ -354,6 +358,12 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
           emissive = md.emissive;
           if (!texture && md.texture >= 0) texture = a.textures[static_cast<std::size_t>(md.texture)];
         }
+        bool cull = false;
+        if (mesh.material >= 0) cull = !a.materials[static_cast<std::size_t>(mesh.material)].double_sided;
+        if (cull != r.culling) {
+          cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+          r.culling = cull;
+        }
         glUniform4fv(r.u.base, 1, base.data());
         glUniform3fv(r.u.emissive, 1, emissive.data());
         glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
@@ -368,6 +378,8 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
     } else if (n.kind == scene::NodeKind::actor) {
       auto it = r.actors.find(n.actor_id);
       if (it == r.actors.end() || it->second.index_count == 0) continue;
+      if (r.culling) glDisable(GL_CULL_FACE);  // actor meshes are drawn two-sided
+      r.culling = false;
       r.set_matrices(r.world[i]);
       glUniform4fv(r.u.base, 1, n.material.colour.data());
       const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
@@ -378,6 +390,8 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
     }
   }
   glBindVertexArray(0);
+  glDisable(GL_CULL_FACE);
+  r.culling = false;
 }
 
 void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, float inflate_m,

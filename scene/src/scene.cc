@@ -38,6 +38,7 @@ Scene::Scene(const Scene& o)
     : options_(o.options_), frame_(o.frame_), nodes_(o.nodes_), animations_(o.animations_),
       updated_(o.updated_), removed_(o.removed_) {
   rebuild_order();
+  rebuild_targets();
 }
 
 Scene& Scene::operator=(const Scene& o) {
@@ -222,9 +223,14 @@ void Scene::mutate(const Command& c) {
               if (t.path == TrackPath::rotation)
                 for (auto& v : t.values) v.normalize();
             e.clock.anchor_frame = f;
+            std::vector<Node*>& targets = targets_[x.animation.name];
+            for (const Track& t : e.animation.tracks) targets.push_back(&nodes_.at(t.node));
             animations_.emplace(x.animation.name, std::move(e));
           },
-          [&](const RemoveAnimation& x) { animations_.erase(x.name); },
+          [&](const RemoveAnimation& x) {
+            animations_.erase(x.name);
+            targets_.erase(x.name);
+          },
           [&](const Play& x) {
             for_clocks(x.animation, [&](AnimationEntry& e) {
               e.clock.anchor_time = x.from_time ? *x.from_time
@@ -281,11 +287,14 @@ Expected<void> Scene::apply(const Command& c) {
 
 void Scene::evaluate(std::int64_t f) {
   frame_ = f;
+  auto targets = targets_.begin();
   for (auto& [name, entry] : animations_) {
     const double t = animation_time(entry.clock.clock_time(f, options_.frame_period),
                                     entry.animation.duration(), entry.animation.mode);
-    for (const Track& track : entry.animation.tracks) {
-      Node& n = nodes_.at(track.node);
+    const std::vector<Node*>& driven = (targets++)->second;
+    for (std::size_t k = 0; k < entry.animation.tracks.size(); ++k) {
+      const Track& track = entry.animation.tracks[k];
+      Node& n = *driven[k];
       const Eigen::Vector4d v = sample(track, t);
       bool changed = false;
       switch (track.path) {
@@ -304,7 +313,10 @@ void Scene::evaluate(std::int64_t f) {
           n.local.scale = v.head<3>();
           break;
       }
-      if (changed) touch(n, f);
+      if (changed) {
+        n.frame = f;
+        if (!updated_.contains(n.id)) updated_.emplace_hint(updated_.end(), n.id);
+      }
     }
   }
 }
@@ -329,6 +341,14 @@ void Scene::rebuild_order() {
     order_.push_back(n);
     parent_index_.push_back(p);
     push_children(n->id, static_cast<int>(order_.size()) - 1);
+  }
+}
+
+void Scene::rebuild_targets() {
+  targets_.clear();
+  for (const auto& [name, entry] : animations_) {
+    std::vector<Node*>& targets = targets_[name];
+    for (const Track& t : entry.animation.tracks) targets.push_back(&nodes_.at(t.node));
   }
 }
 

@@ -249,6 +249,7 @@ Expected<Scene> deserialize(const std::vector<std::uint8_t>& bytes) {
   if (r.remaining() != 0) return fail("scene state: " + std::to_string(r.remaining()) + " trailing bytes");
   scene.rebuild_order();
   if (auto ok = scene.check_invariants(); !ok) return fail("scene state: " + ok.error().message);
+  scene.rebuild_targets();
   // A restored scene publishes every node once.
   for (const auto& [id, n] : scene.nodes_) scene.updated_.insert(id);
   return scene;

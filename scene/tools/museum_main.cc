@@ -135,12 +135,12 @@ int main(int argc, char** argv) {
     MeshBuild mesh;
   };
   const Exhibit exhibits[] = {
-      {"exhibit_red_sphere", {0.90f, 0.08f, 0.08f, 1}, uv_sphere(0.5f, 160, 96)},
+      {"exhibit_red_sphere", {0.90f, 0.08f, 0.08f, 1}, uv_sphere(0.5f, 128, 72)},
       {"exhibit_green_torus", {0.08f, 0.80f, 0.15f, 1},
-       torus(0.38f, 0.14f, 160, 64).transformed(Eigen::AngleAxisf(kPi / 2, X).toRotationMatrix(), Eigen::Vector3f::Zero())},
+       torus(0.38f, 0.14f, 128, 48).transformed(Eigen::AngleAxisf(kPi / 2, X).toRotationMatrix(), Eigen::Vector3f::Zero())},
       {"exhibit_blue_vase", {0.10f, 0.25f, 0.95f, 1},
-       lathe([](float s) { return Eigen::Vector2f(0.18f + 0.22f * std::sin(kPi * s * 1.2f) + 0.05f * s, s * 1.0f - 0.5f); }, 128, 64)},
-      {"exhibit_yellow_knot", {0.95f, 0.80f, 0.05f, 1}, torus_knot(0.15f, 0.1f, 2, 3, 512, 24)},
+       lathe([](float s) { return Eigen::Vector2f(0.18f + 0.22f * std::sin(kPi * s * 1.2f) + 0.05f * s, s * 1.0f - 0.5f); }, 96, 48)},
+      {"exhibit_yellow_knot", {0.95f, 0.80f, 0.05f, 1}, torus_knot(0.15f, 0.1f, 2, 3, 384, 16)},
       {"exhibit_magenta_cone", {0.85f, 0.08f, 0.80f, 1},
        lathe([](float s) { return Eigen::Vector2f(0.45f * (1 - s) + 0.001f, s - 0.5f); }, 128, 16)},
       {"exhibit_cyan_cube", {0.05f, 0.80f, 0.85f, 1},

@@ -142,6 +142,8 @@ Expected<Asset> load_asset(const std::string& path) {
     aiColor3D e;
     if (m->Get(AI_MATKEY_COLOR_EMISSIVE, e) == AI_SUCCESS)
       md.emissive = Eigen::Vector3f(e.r, e.g, e.b).cwiseMax(0.0f);
+    int two_sided = 0;
+    if (m->Get(AI_MATKEY_TWOSIDED, two_sided) == AI_SUCCESS) md.double_sided = two_sided != 0;
     aiString tex;
     if (m->GetTexture(aiTextureType_BASE_COLOR, 0, &tex) == AI_SUCCESS ||
         m->GetTexture(aiTextureType_DIFFUSE, 0, &tex) == AI_SUCCESS) {

@@ -93,6 +93,7 @@ class Scene {
   void mutate(const Command& c);
   void evaluate(std::int64_t frame);
   void rebuild_order();
+  void rebuild_targets();
   void touch(Node& node, std::int64_t frame);
   bool in_subtree(const NodeId& id, const NodeId& root) const;
 
@@ -102,6 +103,10 @@ class Scene {
   std::map<std::string, AnimationEntry> animations_;
   std::vector<const Node*> order_;
   std::vector<int> parent_index_;
+  // The node each track drives, per animation (same keys and order as animations_). std::map
+  // keeps node addresses across inserts, moves and the removal of other nodes, and a driven node
+  // cannot be removed, so these stay valid until the animation is removed.
+  std::map<std::string, std::vector<Node*>> targets_;
   std::set<NodeId> updated_, removed_;
 };
 
