@@ -391,6 +391,8 @@ std::uint64_t Scene::state_hash() const {
   return fnv1a64(bytes.data(), bytes.size());
 }
 
+std::uint64_t Scene::nodes_hash() const { return hash_nodes(nodes_); }
+
 Expected<void> Scene::check_invariants() const {
   if (auto ok = options_.validate(); !ok) return ok;
   for (const auto& [id, n] : nodes_) {

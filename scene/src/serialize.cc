@@ -172,6 +172,13 @@ std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
   return h;
 }
 
+std::uint64_t hash_nodes(const std::map<NodeId, Node>& nodes) {
+  Writer w;
+  w.u32(static_cast<std::uint32_t>(nodes.size()));
+  for (const auto& [id, n] : nodes) write_node(w, n);
+  return fnv1a64(w.bytes.data(), w.bytes.size());
+}
+
 std::vector<std::uint8_t> serialize(const Scene& scene) {
   Writer w;
   w.bytes.insert(w.bytes.end(), kMagic, kMagic + 8);

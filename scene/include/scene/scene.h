@@ -83,6 +83,9 @@ class Scene {
   // A 64-bit hash of the whole state: options, frame, every node, every animation and its clock
   // (the bytes of serialize()). Equal states give equal hashes on every host.
   std::uint64_t state_hash() const;
+  // A hash of the nodes alone (serialize.h: hash_nodes), comparable with what a reader of the
+  // published nodes computes.
+  std::uint64_t nodes_hash() const;
 
   Expected<void> check_invariants() const;
 
