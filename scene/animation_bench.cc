@@ -76,7 +76,8 @@ void BM_SceneEvaluate(benchmark::State& state) {
     benchmark::DoNotOptimize(world.data());
   }
   state.counters["nodes_changed_per_frame"] = static_cast<double>(changed) / state.iterations();
-  state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["frames_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_SceneEvaluate)->Arg(1000)->Unit(benchmark::kMicrosecond);
 
@@ -91,7 +92,8 @@ void BM_NaiveEvaluate(benchmark::State& state) {
   const double period = s.options().frame_period;
   for (auto _ : state) {
     for (const auto& [name, e] : s.animations()) {
-      const double t = animation_time(e.clock.clock_time(frame, period), e.animation.duration(), e.animation.mode);
+      const double t = animation_time(e.clock.clock_time(frame, period), e.animation.duration(),
+                                      e.animation.mode);
       for (const Track& track : e.animation.tracks) {
         const Eigen::Vector4d v = sample_linear_scan(track, t);
         Transform& tr = local[track.node];
@@ -114,7 +116,8 @@ void BM_NaiveEvaluate(benchmark::State& state) {
     ++frame;
     benchmark::DoNotOptimize(world.size());
   }
-  state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["frames_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_NaiveEvaluate)->Arg(1000)->Unit(benchmark::kMicrosecond);
 

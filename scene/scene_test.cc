@@ -1,12 +1,13 @@
 // Scene: commands (each refusal beside a positive control), world transforms, change tracking,
 // animation on the scene clock, serialisation.
+#include "scene/scene.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <numbers>
 
-#include "scene/scene.h"
 #include "scene/serialize.h"
 
 using namespace studio::scene;

@@ -45,7 +45,8 @@ Fixture& fixture() {
 View view_for(const scene_assets::ViewSpec& v, int w, int h) {
   View out;
   out.cam_from_world = scene::look_at({v.eye[0], v.eye[1], v.eye[2]}, {v.at[0], v.at[1], v.at[2]});
-  out.clip_from_cam = scene::perspective(v.fov_deg * std::numbers::pi / 180, double(w) / h, 0.05, 200);
+  out.clip_from_cam =
+      scene::perspective(v.fov_deg * std::numbers::pi / 180, double(w) / h, 0.05, 200);
   return out;
 }
 
@@ -76,7 +77,8 @@ void run(benchmark::State& state, Work work) {
     else
       glFinish();
   }
-  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.SetLabel(f.context.renderer());
 }
 

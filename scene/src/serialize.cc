@@ -214,7 +214,8 @@ Expected<Scene> deserialize(const std::vector<std::uint8_t>& bytes) {
   if (!r.magic()) return fail("scene state: not a scene state (bad magic)");
   SceneOptions options;
   options.frame_period = r.f64();
-  if (auto ok = options.validate(); r.ok() && !ok) return fail("scene state: " + ok.error().message);
+  if (auto ok = options.validate(); r.ok() && !ok)
+    return fail("scene state: " + ok.error().message);
   Scene scene(options);
   scene.frame_ = r.i64();
   const std::size_t n_nodes = r.count(64);
@@ -253,7 +254,8 @@ Expected<Scene> deserialize(const std::vector<std::uint8_t>& bytes) {
       return fail("scene state: animation '" + name + "' appears twice");
   }
   if (!r.ok()) return fail("scene state: truncated or corrupt");
-  if (r.remaining() != 0) return fail("scene state: " + std::to_string(r.remaining()) + " trailing bytes");
+  if (r.remaining() != 0)
+    return fail("scene state: " + std::to_string(r.remaining()) + " trailing bytes");
   scene.rebuild_order();
   if (auto ok = scene.check_invariants(); !ok) return fail("scene state: " + ok.error().message);
   scene.rebuild_targets();

@@ -74,7 +74,8 @@ class Renderer {
   // the output pixel at normalised coordinates p in [0,1]^2 samples the texture at
   // dehomogenised tex_from_screen * (p, 1) (identity: a plain copy; the projector passes its
   // homography). Depth test off.
-  void draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen = Eigen::Matrix3f::Identity());
+  void draw_texture(unsigned texture,
+                    const Eigen::Matrix3f& tex_from_screen = Eigen::Matrix3f::Identity());
 
   int draw_calls_last_frame() const;
 
