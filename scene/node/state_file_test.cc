@@ -1,0 +1,91 @@
+// The scene server's state file (state_file.h): round trip, atomic replace, and corrupt or
+// truncated files refused with an error naming the file (never a crash, never a half scene).
+#include "state_file.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "scene_testing/random_commands.h"
+
+namespace studio::scene::node {
+namespace {
+
+namespace fs = std::filesystem;
+
+Scene random_scene(std::uint64_t seed, int commands) {
+  Scene scene;
+  testing::RandomCommandSource source(seed);
+  for (int i = 0; i < commands; ++i) (void)scene.apply(source.next(scene));
+  (void)scene.take_changes();
+  return scene;
+}
+
+fs::path scratch_dir(const std::string& name) {
+  fs::path dir =
+      fs::temp_directory_path() / ("scene_state_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+TEST(StateFile, RoundTripKeepsSceneHashAndPublishedIds) {
+  const Scene scene = random_scene(7, 2000);
+  ASSERT_GT(scene.nodes().size(), 20u);
+  std::set<NodeId> published;
+  for (const auto& [id, n] : scene.nodes()) published.insert(id);
+  published.insert("removed-but-not-disposed");
+  const fs::path dir = scratch_dir("roundtrip");
+  ASSERT_TRUE(write_state(dir.string(), scene, published).has_value());
+  EXPECT_FALSE(fs::exists(dir / "scene.state.tmp"));
+  auto back = read_state(dir.string());
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  ASSERT_TRUE(back->has_value());
+  EXPECT_EQ((*back)->scene.state_hash(), scene.state_hash());
+  EXPECT_EQ((*back)->scene.nodes(), scene.nodes());
+  EXPECT_EQ((*back)->scene.animations(), scene.animations());
+  EXPECT_EQ((*back)->published, published);
+
+  // A second write replaces the first completely.
+  const Scene other = random_scene(8, 300);
+  ASSERT_TRUE(write_state(dir.string(), other, {}).has_value());
+  back = read_state(dir.string());
+  ASSERT_TRUE(back.has_value() && back->has_value());
+  EXPECT_EQ((*back)->scene.state_hash(), other.state_hash());
+  EXPECT_TRUE((*back)->published.empty());
+  fs::remove_all(dir);
+}
+
+TEST(StateFile, MissingFileIsNoState) {
+  const fs::path dir = scratch_dir("missing");
+  auto s = read_state(dir.string());
+  ASSERT_TRUE(s.has_value());
+  EXPECT_FALSE(s->has_value());
+}
+
+TEST(StateFile, CorruptOrTruncatedFilesAreRefused) {
+  const Scene scene = random_scene(9, 500);
+  const auto bytes = encode_state(scene, {"a", "b"});
+  ASSERT_TRUE(decode_state(bytes).has_value());  // positive control
+  // Every truncation and a flip of every 7th byte: an error, never a crash.
+  for (std::size_t n = 0; n < bytes.size(); n += 13) {
+    auto cut = std::vector<std::uint8_t>(bytes.begin(), bytes.begin() + std::ptrdiff_t(n));
+    EXPECT_FALSE(decode_state(cut).has_value()) << "truncated at " << n;
+  }
+  for (std::size_t i = 0; i < bytes.size(); i += 7) {
+    auto flipped = bytes;
+    flipped[i] ^= 0x5a;
+    EXPECT_FALSE(decode_state(flipped).has_value()) << "flipped byte " << i;
+  }
+  const fs::path dir = scratch_dir("corrupt");
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.state") << "not a state file";
+  auto s = read_state(dir.string());
+  ASSERT_FALSE(s.has_value());
+  EXPECT_NE(s.error().message.find("scene.state: corrupt state file"), std::string::npos)
+      << s.error().message;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace studio::scene::node
