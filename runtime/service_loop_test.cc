@@ -228,6 +228,7 @@ TEST_F(ServiceLoopTest, StopEndsABlockedWaitAndInterruptsThreads) {
   std::condition_variable cv;
   std::atomic<int> rounds{0};
   std::atomic<bool> interrupted{false};
+  std::atomic<bool> worker_ended{false}, hook_ran{false}, hook_wrote{false}, hook_saw_worker{false};
   loop.thread(
       "worker",
       [&] {
@@ -236,12 +237,23 @@ TEST_F(ServiceLoopTest, StopEndsABlockedWaitAndInterruptsThreads) {
           ++rounds;
           cv.wait(lock);  // blocks until interrupted
         }
+        worker_ended = true;
       },
       [&] {
         interrupted = true;
         std::lock_guard lock(mutex);
         cv.notify_all();
       });
+  // at_stop: after every thread ended, while the outputs still write (a last state).
+  auto& last = loop.output<studio_CameraControl>({.counter = "last", .topic = "test/loop/last"});
+  loop.at_stop([&] {
+    hook_ran = true;
+    hook_saw_worker = !worker_ended;
+    wire::Owned<studio_CameraControl> c;
+    wire::set(c->camera_id, "cam0");
+    wire::set(c->feature, "last");
+    hook_wrote = last.write(*c).has_value();
+  });
   ASSERT_TRUE(loop.start().has_value());
   EXPECT_TRUE(loop.running());
   ASSERT_TRUE(eventually([&] { return rounds >= 1; }));
@@ -252,6 +264,10 @@ TEST_F(ServiceLoopTest, StopEndsABlockedWaitAndInterruptsThreads) {
   EXPECT_LT(Clock::now() - t0, 5s);
   EXPECT_TRUE(interrupted);
   EXPECT_FALSE(loop.running());
+  EXPECT_TRUE(hook_ran);
+  EXPECT_FALSE(hook_saw_worker);  // the worker had ended
+  EXPECT_TRUE(hook_wrote);
+  EXPECT_EQ(count("last"), 1u);
   loop.stop();  // idempotent
   // A stopped loop can be destroyed; its DDS entities are gone (a new loop starts cleanly).
   ServiceLoop again(*context_, "test");

@@ -40,6 +40,20 @@ std::string take_status(const fs::path& dir) {
   return "unknown";
 }
 
+// takes/<take>/<camera> itself, or the camera folders of takes/<take>, in name order.
+std::vector<fs::path> camera_dirs(const fs::path& root) {
+  std::vector<fs::path> dirs;
+  std::error_code ec;
+  if (fs::exists(root / kFramesFile, ec)) {
+    dirs.push_back(root);
+  } else if (fs::is_directory(root, ec)) {
+    for (const auto& e : fs::directory_iterator(root, ec))
+      if (e.is_directory() && fs::exists(e.path() / kFramesFile)) dirs.push_back(e.path());
+    std::sort(dirs.begin(), dirs.end());
+  }
+  return dirs;
+}
+
 }  // namespace
 
 int verify_take_main(int argc, char** argv) {
@@ -58,15 +72,7 @@ int verify_take_main(int argc, char** argv) {
     return 2;
   }
   const fs::path root = argv[2];
-  std::vector<fs::path> dirs;
-  std::error_code ec;
-  if (fs::exists(root / kFramesFile, ec)) {
-    dirs.push_back(root);
-  } else if (fs::is_directory(root, ec)) {
-    for (const auto& e : fs::directory_iterator(root, ec))
-      if (e.is_directory() && fs::exists(e.path() / kFramesFile)) dirs.push_back(e.path());
-    std::sort(dirs.begin(), dirs.end());
-  }
+  const std::vector<fs::path> dirs = camera_dirs(root);
   if (dirs.empty()) {
     std::fprintf(stderr, "studio-capture verify-take: %s holds no take (no %s)\n", root.c_str(),
                  kFramesFile);

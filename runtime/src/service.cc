@@ -12,6 +12,7 @@
 #include "runtime/notify.h"
 #include "runtime/signals.h"
 #include "runtime/status_publisher.h"
+#include "yaml_io/options.h"
 
 namespace studio::runtime {
 namespace {
@@ -25,7 +26,8 @@ void print_help(const ServiceDefinition& d) {
       "(READY=1, WATCHDOG=1, STOPPING=1) when $NOTIFY_SOCKET is set.\n\n"
       "Common config keys (all optional):\n"
       "  instance: NAME         instance name in studio/service/status (default: host name)\n"
-      "  domain: N              DDS domain id (default: $STUDIO_DDS_DOMAIN, else Cyclone's default)\n"
+      "  domain: N              DDS domain id (default: $STUDIO_DDS_DOMAIN, else Cyclone's "
+      "default)\n"
       "  dds_config: FILE       Cyclone DDS XML profile (default: $CYCLONEDDS_URI)\n"
       "  status_period: S       seconds between status samples, 0.1..60 (default 1)\n"
       "  log: SPEC              log levels, e.g. info,%s=debug (default: $STUDIO_LOG or info)\n\n"
@@ -33,43 +35,47 @@ void print_help(const ServiceDefinition& d) {
       d.name.c_str(), d.summary.c_str(), d.name.c_str(), d.name.c_str(), d.config_help.c_str());
 }
 
-studio_ServiceState state_of(const NodeHealth& h) { return h.degraded ? studio_SERVICE_DEGRADED : studio_SERVICE_RUNNING; }
+studio_ServiceState state_of(const NodeHealth& h) {
+  return h.degraded ? studio_SERVICE_DEGRADED : studio_SERVICE_RUNNING;
+}
 
 }  // namespace
 
 Expected<CommonOptions> read_common_options(yaml::MapReader& config) {
-  CommonOptions o;
-  if (auto n = config.optional("instance")) {
-    auto v = n->as_string();
-    if (!v) return std::unexpected(v.error());
-    if (v->empty() || v->size() > 63) return n->fail("expected a name of 1..63 characters");
-    o.instance = *v;
-  }
-  if (auto n = config.optional("domain")) {
-    auto v = n->as_int();
-    if (!v) return std::unexpected(v.error());
-    if (*v < 0 || *v > 232) return n->fail("expected a DDS domain id in 0..232");
-    o.domain = *v;
-  }
-  if (auto n = config.optional("dds_config")) {
-    auto v = n->as_string();
-    if (!v) return std::unexpected(v.error());
-    if (::access(v->c_str(), R_OK) != 0) return n->fail("cannot read '" + *v + "': " + std::strerror(errno));
-    o.dds_config = "file://" + *v;
-  }
-  if (auto n = config.optional("status_period")) {
-    auto v = n->as_double();
-    if (!v) return std::unexpected(v.error());
-    if (*v < 0.1 || *v > 60) return n->fail("expected seconds in 0.1..60");
-    o.status_period_s = *v;
-  }
-  if (auto n = config.optional("log")) {
-    auto v = n->as_string();
-    if (!v) return std::unexpected(v.error());
-    if (!log::configure(*v)) return n->fail("malformed log spec '" + *v + "' (e.g. info,hull=debug)");
-    o.log_spec = *v;
-  }
-  return o;
+  static const yaml::Schema<CommonOptions> schema{
+      yaml::field("instance", &CommonOptions::instance,
+                  [](const yaml::Node& n) -> Expected<std::string> {
+                    auto v = n.as_string();
+                    if (v && (v->empty() || v->size() > 63))
+                      return n.fail("expected a name of 1..63 characters");
+                    return v;
+                  }),
+      yaml::field("domain", &CommonOptions::domain,
+                  [](const yaml::Node& n) -> Expected<int64_t> {
+                    auto v = n.as_int();
+                    if (v && (*v < 0 || *v > 232))
+                      return n.fail("expected a DDS domain id in 0..232");
+                    return v;
+                  }),
+      yaml::field("dds_config", &CommonOptions::dds_config,
+                  [](const yaml::Node& n) -> Expected<std::string> {
+                    auto v = n.as_string();
+                    if (!v) return v;
+                    if (::access(v->c_str(), R_OK) != 0)
+                      return n.fail("cannot read '" + *v + "': " + std::strerror(errno));
+                    return "file://" + *v;
+                  }),
+      yaml::field("status_period", &CommonOptions::status_period_s,
+                  yaml::number_in(0.1, 60, "seconds in 0.1..60")),
+      yaml::field("log", &CommonOptions::log_spec,
+                  [](const yaml::Node& n) -> Expected<std::string> {
+                    auto v = n.as_string();
+                    if (v && !log::configure(*v))
+                      return n.fail("malformed log spec '" + *v + "' (e.g. info,hull=debug)");
+                    return v;
+                  }),
+  };
+  return schema.read_fields(config);
 }
 
 int service_main(int argc, char** argv, const ServiceDefinition& definition) {
@@ -117,7 +123,8 @@ int service_main(int argc, char** argv, const ServiceDefinition& definition) {
   if (common->instance.empty()) common->instance = host_name().substr(0, 63);
 
   auto participant = wire::Participant::create(
-      common->domain >= 0 ? dds_domainid_t(common->domain) : wire::default_domain(), common->dds_config);
+      common->domain >= 0 ? dds_domainid_t(common->domain) : wire::default_domain(),
+      common->dds_config);
   if (!participant) return fail(participant.error());
 
   Metrics metrics;
@@ -134,7 +141,8 @@ int service_main(int argc, char** argv, const ServiceDefinition& definition) {
   }
 
   notify("READY=1\nSTATUS=running");
-  STUDIO_LOG(info, kCategory) << definition.name << " (" << common->instance << ") running, pid " << ::getpid();
+  STUDIO_LOG(info, kCategory) << definition.name << " (" << common->instance << ") running, pid "
+                              << ::getpid();
 
   using namespace std::chrono;
   const auto status_period = duration_cast<milliseconds>(duration<double>(common->status_period_s));
@@ -152,7 +160,8 @@ int service_main(int argc, char** argv, const ServiceDefinition& definition) {
       next_status = now + status_period;
     }
     if (watchdog) notify("WATCHDOG=1");
-    const auto wait = std::min(period, duration_cast<milliseconds>(next_status - steady_clock::now()));
+    const auto wait =
+        std::min(period, duration_cast<milliseconds>(next_status - steady_clock::now()));
     if (auto s = signals.wait(std::max(wait, milliseconds(1)))) {
       signo = *s;
       break;

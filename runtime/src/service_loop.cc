@@ -91,6 +91,8 @@ void ServiceLoop::deadline(std::function<std::optional<SteadyClock::time_point>(
 
 void ServiceLoop::after_inputs(Fire hook) { hooks_.push_back(std::move(hook)); }
 
+void ServiceLoop::at_stop(std::function<void()> hook) { stop_hooks_.push_back(std::move(hook)); }
+
 void ServiceLoop::thread(std::string name, std::function<void()> body,
                          std::function<void()> interrupt) {
   threads_.push_back({std::move(name), std::move(body), std::move(interrupt), {}});
@@ -133,6 +135,7 @@ void ServiceLoop::stop() {
   if (loop_thread_.joinable()) loop_thread_.join();
   for (Thread& t : threads_)
     if (t.thread.joinable()) t.thread.join();
+  for (auto& hook : stop_hooks_) hook();
   for (auto& in : inputs_) in->release();
   for (auto& out : outputs_) out->release();
   entities_.reset();

@@ -1,5 +1,7 @@
 #include "scene/actor_mesh.h"
 
+#include <Eigen/Geometry>
+
 namespace studio::scene {
 
 Expected<void> ActorMesh::validate() const {

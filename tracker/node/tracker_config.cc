@@ -40,15 +40,6 @@ const yaml::Schema<HeadTrackerOptions>& filter_schema() {
   return schema;
 }
 
-// A number in [lo, hi]; out of range: "expected <what>".
-auto number_in(double lo, double hi, std::string what) {
-  return [lo, hi, what](const yaml::Node& n) -> Expected<double> {
-    auto v = n.as_double();
-    if (v && !(*v >= lo && *v <= hi)) return n.fail("expected " + what);
-    return v;
-  };
-}
-
 }  // namespace
 
 const char* const kConfigHelp =
@@ -98,8 +89,8 @@ Expected<NodeOptions> read_node_options(yaml::MapReader& config) {
                   }),
       yaml::field("publish_tracks", &NodeOptions::publish_tracks),
       yaml::field("publish_rate", &NodeOptions::publish_rate,
-                  number_in(0.5, 1000, "Hz in 0.5..1000")),
-      yaml::field("gather_ms", &NodeOptions::gather_ms, number_in(0, 100, "0..100 ms")),
+                  yaml::number_in(0.5, 1000, "Hz in 0.5..1000")),
+      yaml::field("gather_ms", &NodeOptions::gather_ms, yaml::number_in(0, 100, "0..100 ms")),
       yaml::field("search", &NodeOptions::search, search_schema()),
       yaml::field("filter", &NodeOptions::filter, filter_schema()),
   };

@@ -2,7 +2,6 @@
 // The tracker service node (issue 6 item 3): studio/actor/segments (SegmentSet) in,
 // studio/actor/head (HeadPose) out.
 //
-// One worker thread waits on a WaitSet holding the segments reader and a guard condition (stop).
 // For each valid SegmentSet: to_core → rasterise → HeadSearch::find. The hull publishes each
 // actor (connected component) of a frame as its own SegmentSet, so the heads of the sets of one
 // frame (same frame and capture_ns) arriving within gather_ms of the first are gathered; then

@@ -28,9 +28,9 @@
 //   };
 //
 // Contract
-// - Declaration: input(), output(), every(), deadline(), after_inputs() and thread() are called
-//   once, before start() (from the node's constructor); they create nothing yet and cannot
-//   fail. start() creates every DDS entity (readers with the topic table's QoS, or the declared
+// - Declaration: input(), output(), every(), deadline(), after_inputs(), at_stop() and thread()
+//   are called once, before start() (from the node's constructor); they create nothing yet and
+//   cannot fail. start() creates every DDS entity (readers with the topic table's QoS, or the declared
 //   history depth; writers; a WaitSet; a guard condition) and starts the loop thread and the
 //   declared threads; its error is the node's start error. The returned Output/Input references
 //   stay valid as long as the loop.
@@ -64,8 +64,9 @@
 //   returns; body loops while running() is true. stop() calls interrupt() (e.g. stop a camera
 //   source, notify a condition variable) so a blocked body returns promptly.
 // - stop(): idempotent; clears running(), triggers the stop guard (the WaitSet returns at once),
-//   interrupts and joins every thread, then releases the DDS entities. A node calls its own
-//   after-stop work (finishing recordings) after loop.stop(). The destructor stops.
+//   interrupts and joins every thread, runs the at_stop() hooks (no other thread of the loop
+//   runs then; the outputs still write: a last state, finishing recordings), then releases the
+//   DDS entities. The destructor stops.
 
 #include <atomic>
 #include <chrono>
@@ -289,6 +290,7 @@ class ServiceLoop {
   void every(SteadyClock::duration period, Fire fire);
   void deadline(std::function<std::optional<SteadyClock::time_point>()> next, Fire fire);
   void after_inputs(Fire hook);
+  void at_stop(std::function<void()> hook);
   void thread(std::string name, std::function<void()> body, std::function<void()> interrupt = {});
   // A counter (registered now) whose rate counts as NodeHealth input / output.
   void count_as_input(Counter& counter) { rate_in_.push_back({&counter, 0}); }
@@ -334,6 +336,7 @@ class ServiceLoop {
   std::vector<std::unique_ptr<OutputBase>> outputs_;
   std::vector<Timer> timers_;
   std::vector<Fire> hooks_;
+  std::vector<std::function<void()>> stop_hooks_;
   std::deque<Thread> threads_;
   std::vector<Rate> rate_in_, rate_out_;
   std::unique_ptr<Entities> entities_;

@@ -42,6 +42,10 @@ struct Constraints {
   bool relative_path = false;
 };
 
+// A path as written in the YAML file of `node`: relative ones resolve against that file's folder,
+// absolute (and empty) ones are left alone. The built-in readers apply it for relative_path().
+std::string resolve_path(const Node& node, const std::string& path);
+
 // Built-in readers (node.cc / options.cc), one per supported member type.
 Expected<void> read_value(const Node& node, bool& out, const Constraints& c);
 Expected<void> read_value(const Node& node, int& out, const Constraints& c);
@@ -162,10 +166,27 @@ Field<T> enum_field(std::string name, E T::*member, std::vector<std::pair<std::s
                   });
 }
 
+// A parser for field(..., parse): a number in [lo, hi]; out of range the error reads
+// "expected <what>" (e.g. number_in(0.5, 1000, "Hz in 0.5..1000")), where range() would say
+// "must be in [lo, hi], got v".
+inline auto number_in(double lo, double hi, std::string what) {
+  return [lo, hi, what = std::move(what)](const Node& n) -> Expected<double> {
+    Expected<double> v = n.as_double();
+    if (v && !(*v >= lo && *v <= hi)) return n.fail("expected " + what);
+    return v;
+  };
+}
+
 template <class T>
 class Schema {
  public:
   Schema(std::initializer_list<Field<T>> fields) : fields_(fields) {}
+
+  bool has_field(std::string_view name) const {
+    for (const Field<T>& f : fields_)
+      if (f.name() == name) return true;
+    return false;
+  }
 
   // Reads a mapping on top of `defaults`.
   Expected<T> read(const Node& node, T defaults = T{}) const {

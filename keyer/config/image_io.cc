@@ -1,4 +1,4 @@
-#include "image_io.h"
+#include "keyer/config/image_io.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -9,7 +9,8 @@ namespace studio::keyer {
 
 Expected<Image<Rgb8>> read_rgb(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return fail("cannot read image '" + path + "': no such file");
+  if (!std::filesystem::is_regular_file(path, ec))
+    return fail("cannot read image '" + path + "': no such file");
   cv::Mat m;
   try {
     m = cv::imread(path, cv::IMREAD_COLOR);

@@ -4,6 +4,7 @@
 // by the keyer node and by the capture node's in-process key (their `plate_dir`).
 
 #include <string>
+#include <string_view>
 
 #include "core/error.h"
 #include "keyer/keyer.h"
@@ -26,6 +27,12 @@ class KeptPlates {
   Expected<void> save(const std::string& camera, const Keyer& keyer) const;
   // Forgets the kept plate (KeyerPlate 0).
   void remove(const std::string& camera) const;
+
+  // load() at a camera's start, said in the log under `log`: the plate used, or why a kept one
+  // was not (the camera then waits for a new plate).
+  void restore(const std::string& camera, Keyer& keyer, std::string_view log) const;
+  // save() of a plate just captured; false (and a warning under `log`) when it could not be kept.
+  bool keep(const std::string& camera, const Keyer& keyer, std::string_view log) const;
 
  private:
   std::string dir_;

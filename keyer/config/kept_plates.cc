@@ -1,8 +1,9 @@
-#include "kept_plates.h"
+#include "keyer/config/kept_plates.h"
 
 #include <filesystem>
 
-#include "image_io.h"
+#include "core/log.h"
+#include "keyer/config/image_io.h"
 
 namespace studio::keyer {
 
@@ -39,6 +40,21 @@ void KeptPlates::remove(const std::string& camera) const {
   if (!enabled()) return;
   std::error_code ec;
   std::filesystem::remove(path(camera), ec);
+}
+
+void KeptPlates::restore(const std::string& camera, Keyer& keyer, std::string_view log) const {
+  if (auto loaded = load(camera, keyer); !loaded)
+    STUDIO_LOG(warn, log) << camera << ": kept plate not used: " << loaded.error().message;
+  else if (*loaded)
+    STUDIO_LOG(info, log) << camera << ": clean plate from " << path(camera);
+}
+
+bool KeptPlates::keep(const std::string& camera, const Keyer& keyer, std::string_view log) const {
+  if (auto r = save(camera, keyer); !r) {
+    STUDIO_LOG(warn, log) << camera << ": clean plate not kept: " << r.error().message;
+    return false;
+  }
+  return true;
 }
 
 }  // namespace studio::keyer
