@@ -44,6 +44,11 @@ const char* const kConfigHelp =
     "                         evaluating animations and publishing the nodes they move;\n"
     "                         commands: only SCENE_TICK commands evaluate (replays, tests,\n"
     "                         a director stepping frames)\n"
+    "  scene: FILE            the scene at first start, when state_dir holds no state: a scene\n"
+    "                         file (.yaml: set, nodes, animations, play; see studio-scene render\n"
+    "                         --help) or a set (.glb/.gltf/.obj); its fps must be the clock's.\n"
+    "                         Default: start empty. SCENE_LOAD_SET replaces the scene the same\n"
+    "                         way (relative paths from this file's folder).\n"
     "  state_dir: DIR         where the scene and its animation clocks are persisted (atomically:\n"
     "                         write, fsync, rename, fsync the directory) after every batch of\n"
     "                         accepted commands and every persist_interval; loaded on start, so\n"
@@ -56,6 +61,12 @@ const char* const kConfigHelp =
     "                         (default 16384); older ones are lost (counter commands_lost)\n"
     "Topics: studio/scene/command in; studio/scene/node (one keyed instance per node, disposed\n"
     "when removed) and studio/scene/state (hash, counts, last error) out.\n";
+
+std::string resolve_path(const std::string& base_dir, const std::string& path) {
+  std::filesystem::path p(path);
+  if (p.is_relative() && !base_dir.empty()) p = std::filesystem::path(base_dir) / p;
+  return p.lexically_normal().string();
+}
 
 int64_t NodeOptions::frame_at(int64_t now_ns) const {
   const int64_t d = now_ns - epoch_ns;
@@ -96,15 +107,19 @@ Expected<NodeOptions> read_node_options(yaml::MapReader& config) {
     }
     TRY(c->finish());
   }
-  if (auto n = config.optional("state_dir")) {
+  // Paths relative to the config file's folder, as every path in a studio config.
+  o.base_dir = std::filesystem::path(config.node().file()).parent_path().string();
+  auto path_key = [&](const char* key, std::string& out) -> Expected<void> {
+    auto n = config.optional(key);
+    if (!n) return {};
     auto v = n->as_string();
     if (!v) return std::unexpected(v.error());
-    if (v->empty()) return n->fail("expected a directory");
-    std::filesystem::path p(*v);
-    // Relative to the config file's folder, as every path in a studio config.
-    if (p.is_relative()) p = std::filesystem::path(config.node().file()).parent_path() / p;
-    o.state_dir = p.lexically_normal().string();
-  }
+    if (v->empty()) return n->fail("expected a path");
+    out = resolve_path(o.base_dir, *v);
+    return {};
+  };
+  TRY(path_key("scene", o.scene_file));
+  TRY(path_key("state_dir", o.state_dir));
   TRY(number(config, "persist_interval", o.persist_interval, 0.05, 3600, "0.05..3600 s"));
   TRY(number(config, "command_queue", o.command_queue, 32, 1'000'000, "32..1000000"));
   TRY(o.validate());

@@ -13,6 +13,7 @@
 #include "core/log.h"
 #include "runtime/service_loop.h"
 #include "scene/scene.h"
+#include "scene_loading.h"
 #include "state_file.h"
 #include "wire/scene_convert.h"
 
@@ -24,8 +25,10 @@ using Clock = std::chrono::steady_clock;
 
 class SceneServer : public runtime::Node {
  public:
-  SceneServer(NodeOptions options, PersistedState state, runtime::NodeContext& context)
+  SceneServer(NodeOptions options, PersistedState state, scene_assets::AssetCache cache,
+              runtime::NodeContext& context)
       : options_(std::move(options)),
+        cache_(std::move(cache)),
         scene_(std::move(state.scene)),
         published_(std::move(state.published)),
         instance_(context.instance.empty() ? "scene" : context.instance),
@@ -101,13 +104,27 @@ class SceneServer : public runtime::Node {
   }
 
   runtime::Outcome apply(const studio_SceneCommand& s) {
-    if (s.verb == studio_SCENE_LOAD_SET)
-      return runtime::reject(
-          "load_set", std::string("load_set '") + s.path + "': this build has no scene loader yet");
+    if (s.verb == studio_SCENE_LOAD_SET) return load_set(s);
     auto command = wire::to_core(s, now_frame());
     if (!command) return runtime::reject("convert", command.error().message);
     if (auto ok = scene_.apply(*command); !ok)
       return runtime::reject(command_name(command->op), ok.error().message);
+    return {};
+  }
+
+  // The scene file replaces the whole scene, all or nothing; nodes it lacks are disposed.
+  runtime::Outcome load_set(const studio_SceneCommand& s) {
+    const int64_t frame = s.at_frame == studio_SCENE_AT_NOW ? now_frame() : s.at_frame;
+    if (frame < 0)
+      return runtime::reject("load_set", "frame " + std::to_string(frame) + " out of range");
+    const std::string path = resolve_path(options_.base_dir, s.path);
+    auto built = load_scene_file(path, scene_.options(), frame, cache_);
+    if (!built) return runtime::reject("load_set", built.error().message);
+    for (const auto& [id, n] : scene_.nodes())
+      if (!built->find(id)) load_removed_.insert(id);
+    scene_ = std::move(*built);
+    STUDIO_LOG(info, kLog) << "loaded " << path << ": " << scene_.nodes().size() << " nodes, "
+                           << scene_.animations().size() << " animations at frame " << frame;
     return {};
   }
 
@@ -178,6 +195,9 @@ class SceneServer : public runtime::Node {
     const ChangeSet changes = scene_.take_changes();
     for (const NodeId& id : changes.updated) write(*scene_.find(id));
     for (const NodeId& id : changes.removed) dispose(id);
+    for (const NodeId& id : load_removed_)
+      if (!scene_.find(id)) dispose(id);
+    load_removed_.clear();
   }
 
   // Start: the whole scene, and a dispose for every node the persisted state says was on the
@@ -244,7 +264,9 @@ class SceneServer : public runtime::Node {
 
   NodeOptions options_;
   Scene scene_;
-  std::set<NodeId> published_;  // alive instances this server wrote
+  scene_assets::AssetCache cache_;  // assets of loaded sets, loaded once each
+  std::set<NodeId> published_;      // alive instances this server wrote
+  std::set<NodeId> load_removed_;   // nodes a LOAD_SET replaced away, disposed at the next publish
   std::string instance_;
   Clock::time_point next_tick_ = Clock::time_point::min();
   int64_t last_tick_ = std::numeric_limits<int64_t>::min();
@@ -274,6 +296,8 @@ Expected<std::unique_ptr<runtime::Node>> make_scene_server(NodeOptions options,
   if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
   PersistedState state{Scene(SceneOptions{options.frame_period()}), {}};
   if (auto ok = state.scene.options().validate(); !ok) return std::unexpected(ok.error());
+  scene_assets::AssetCache cache;
+  bool resumed = false;
   if (!options.state_dir.empty()) {
     auto loaded = read_state(options.state_dir);
     if (!loaded) return std::unexpected(loaded.error());
@@ -284,12 +308,25 @@ Expected<std::unique_ptr<runtime::Node>> make_scene_server(NodeOptions options,
                     " s, the config's clock says " + std::to_string(options.frame_period()) +
                     " s (move the file away to start empty)");
       state = std::move(**loaded);
+      resumed = true;
       STUDIO_LOG(info, kLog) << "resumed " << state.scene.nodes().size() << " nodes, "
                              << state.scene.animations().size() << " animations at frame "
                              << state.scene.frame() << " from " << state_path(options.state_dir);
     }
   }
-  return std::make_unique<SceneServer>(std::move(options), std::move(state), context);
+  // First start: the configured scene, built at the studio frame now.
+  if (!resumed && !options.scene_file.empty()) {
+    const int64_t frame = options.clock_source == ClockSource::studio
+                              ? std::max<int64_t>(0, options.frame_at(realtime_ns()))
+                              : 0;
+    auto built = load_scene_file(options.scene_file, state.scene.options(), frame, cache);
+    if (!built) return std::unexpected(built.error());
+    state.scene = std::move(*built);
+    STUDIO_LOG(info, kLog) << "loaded " << options.scene_file << ": " << state.scene.nodes().size()
+                           << " nodes, " << state.scene.animations().size() << " animations";
+  }
+  return std::make_unique<SceneServer>(std::move(options), std::move(state), std::move(cache),
+                                       context);
 }
 
 runtime::ServiceDefinition service_definition() {

@@ -21,7 +21,7 @@
 //
 // Rejections (counter `rejected`, the total, and `rejected_<reason>`): `malformed` (the
 // SceneCommand validator, wire/types.h), `convert` (no library form: e.g. ADD_ANIMATION with
-// mode KEEP), `load_set` (no scene loader in this build yet), and the name of the refused
+// mode KEEP), `load_set` (the scene file is missing or invalid), and the name of the refused
 // library command (`add_node`, `set_transform`, `set_parent`, ...) with Scene::apply's error.
 // Counters also: commands_in, commands_accepted, commands_lost (command_ids skipped in a
 // sender's sequence less the malformed samples the validator dropped), ticks, nodes_published,

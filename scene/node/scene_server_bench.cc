@@ -64,7 +64,7 @@ Stats run(bool persist, const testing::DdsDomain& dds, const std::filesystem::pa
   std::ofstream(config) << "instance: bench\nclock: {source: commands}\n"
                         << (persist ? "state_dir: " + (dir / "state").string() + "\n" : "");
   auto server = testing::Process::start({.name = persist ? "scene-persist" : "scene-memory",
-                                         .binary = testing::built_binary("scene/node/studio-scene"),
+                                         .binary = testing::built_binary("scene/studio-scene"),
                                          .args = {"--config", config.string()},
                                          .env = dds.env(),
                                          .dir = dir});

@@ -9,6 +9,8 @@
 //     and a node taken out of the state while the server was down is disposed;
 //   - bad commands (unknown node, NaN transform, cycle, ...) rejected by reason, the server keeps
 //     running, a valid command still applies;
+//   - the configured scene (the default museum scene made at build time) is what the readers get,
+//     SCENE_LOAD_SET replaces it all or nothing, a missing set file is a counted rejection;
 //   - bad configuration and a corrupt state file: one line, exit 1; --help lists the keys.
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -22,6 +24,7 @@
 
 #include "harness/fixture.h"
 #include "scene/scene.h"
+#include "scene_loading.h"
 #include "scene_testing/random_commands.h"
 #include "state_file.h"
 #include "wire/endpoint.h"
@@ -122,7 +125,7 @@ class SceneServerTest : public studio::testing::ProcessTest {
 
   studio::testing::Process& start_server(const std::string& yaml,
                                          const std::string& name = "scene") {
-    auto& p = spawn(name, "scene/node/studio-scene", {"--config", write_config(yaml)});
+    auto& p = spawn(name, "scene/studio-scene", {"--config", write_config(yaml)});
     EXPECT_TRUE(p.wait_ready(20s)) << p.log();
     dds_publication_matched_status_t m{};
     for (auto deadline = SteadyClock::now() + 10s; SteadyClock::now() < deadline;
@@ -455,6 +458,57 @@ TEST_F(SceneServerTest, BadCommandsAreRejectedByReasonAndTheServerCarriesOn) {
   EXPECT_TRUE((*ok)->last_accepted);
 }
 
+TEST_F(SceneServerTest, ConfiguredSceneThenLoadSetReplacesItAllOrNothing) {
+  const std::string museum = std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml";
+  scene_assets::AssetCache cache;
+  auto expected = node::load_scene_file(museum, SceneOptions{0.04}, 0, cache);
+  ASSERT_TRUE(expected.has_value()) << expected.error().message;
+  ASSERT_GT(expected->nodes().size(), 10u);
+  start_server("instance: s1\nstatus_period: 0.2\nclock: {source: commands}\nscene: " + museum +
+               "\n");
+  Mirror reader;
+  ASSERT_TRUE(reader.until([&] { return reader.nodes == expected->nodes(); }, 20s))
+      << reader.nodes.size() << " of " << expected->nodes().size() << " nodes";
+  auto st = state_when([](const studio_SceneState&) { return true; }, 10s);
+  ASSERT_TRUE(st.has_value());
+  EXPECT_EQ((*st)->state_hash, expected->state_hash());
+  // Models carry their asset's content hash; the flyer is drawn high-contrast.
+  int hashed = 0;
+  for (const auto& [id, n] : reader.nodes)
+    if (n.kind == NodeKind::model) hashed += n.asset.sha256.size() == 64;
+  EXPECT_GT(hashed, 5);
+  ASSERT_TRUE(reader.nodes.contains("set/flyer"));
+  EXPECT_TRUE(reader.nodes.at("set/flyer").material.high_contrast);
+
+  // A missing set: rejected and counted, the scene unchanged.
+  wire::Owned<studio_SceneCommand> load;
+  load->verb = studio_SCENE_LOAD_SET;
+  wire::set(load->path, "missing.glb");
+  load->at_frame = 5;
+  send(*load);
+  auto bad = state_when([](const studio_SceneState& x) { return x.commands_rejected == 1; }, 10s);
+  ASSERT_TRUE(bad.has_value());
+  EXPECT_NE(std::string((*bad)->last_error).find("missing.glb"), std::string::npos)
+      << (*bad)->last_error;
+  EXPECT_EQ((*bad)->state_hash, expected->state_hash());
+  auto counters = counters_when([](const auto& c) { return c.contains("rejected_load_set"); }, 10s);
+  EXPECT_EQ(counters["rejected_load_set"], 1);
+
+  // A small scene file (relative to the config's folder) replaces the whole museum.
+  std::ofstream(dir_ / "small.yaml")
+      << "fps: 25\nnodes:\n  - {id: marker, translation: [1, 0, 0]}\n"
+         "  - {id: actor, actor: actor0}\n";
+  auto small = node::load_scene_file((dir_ / "small.yaml").string(), SceneOptions{0.04}, 5, cache);
+  ASSERT_TRUE(small.has_value()) << small.error().message;
+  wire::set(load->path, "small.yaml");
+  send(*load);
+  ASSERT_TRUE(reader.until([&] { return reader.nodes == small->nodes(); }, 10s))
+      << reader.nodes.size() << " nodes";
+  auto ok = state_when([](const studio_SceneState& x) { return x.commands_accepted == 1; }, 10s);
+  ASSERT_TRUE(ok.has_value());
+  EXPECT_EQ((*ok)->state_hash, small->state_hash());
+}
+
 TEST_F(SceneServerTest, BadConfigOrCorruptStateIsOneLineAndExitOne) {
   std::filesystem::create_directories(dir_ / "corrupt");
   std::ofstream(dir_ / "corrupt" / "scene.state") << "STSRVST1 but nothing else";
@@ -468,9 +522,10 @@ TEST_F(SceneServerTest, BadConfigOrCorruptStateIsOneLineAndExitOne) {
       {"persist_interval: 0\n", "persist_interval"},
       {"command_queue: 4\n", "command_queue"},
       {"state_dir: corrupt\n", "scene.state: corrupt state file"},
+      {"scene: nowhere.glb\n", "nowhere.glb: no such set file"},
   };
   for (const auto& c : cases) {
-    auto& p = spawn("scene", "scene/node/studio-scene", {"--config", write_config(c.yaml)});
+    auto& p = spawn("scene", "scene/studio-scene", {"--config", write_config(c.yaml)});
     const auto rc = p.wait_exit(10s);
     ASSERT_TRUE(rc.has_value()) << c.yaml;
     EXPECT_EQ(*rc, 1) << c.yaml;
@@ -478,10 +533,10 @@ TEST_F(SceneServerTest, BadConfigOrCorruptStateIsOneLineAndExitOne) {
     EXPECT_NE(log.find(c.expect), std::string::npos) << c.yaml << " -> " << log;
     EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
   }
-  auto& help = spawn("scene", "scene/node/studio-scene", {"--help"});
+  auto& help = spawn("scene", "scene/studio-scene", {"--help"});
   EXPECT_EQ(help.wait_exit(10s), 0);
-  for (const char* key : {"clock", "fps", "period_ns", "epoch_ns", "source", "state_dir",
-                          "persist_interval", "command_queue", "studio/scene/node"})
+  for (const char* key : {"render", "clock", "fps", "period_ns", "epoch_ns", "source", "scene:",
+                          "state_dir", "persist_interval", "command_queue", "studio/scene/node"})
     EXPECT_NE(help.log().find(key), std::string::npos) << key;
 }
 
