@@ -2,8 +2,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -26,11 +28,13 @@ using Clock = std::chrono::steady_clock;
 class SceneServer : public runtime::Node {
  public:
   SceneServer(NodeOptions options, PersistedState state, scene_assets::AssetCache cache,
-              runtime::NodeContext& context)
+              std::optional<WriteAheadLog> wal, runtime::NodeContext& context)
       : options_(std::move(options)),
+        wal_(std::move(wal)),
         cache_(std::move(cache)),
         scene_(std::move(state.scene)),
         published_(std::move(state.published)),
+        sequence_(state.sequence),
         instance_(context.instance.empty() ? "scene" : context.instance),
         loop_(context, kLog) {
     nodes_out_ = &loop_.output<studio_SceneNode>({.counter = "nodes_published"});
@@ -45,6 +49,7 @@ class SceneServer : public runtime::Node {
     ticks_ = &loop_.counter("ticks");
     disposed_ = &loop_.counter("nodes_disposed");
     persists_ = &loop_.counter("persists");
+    syncs_ = &loop_.counter("syncs");
     persist_failures_ = &loop_.counter("persist_failures");
     publish_failures_ = &loop_.counter("publish_failures");
     loop_.after_inputs([this](Clock::time_point now) { flush(now); });
@@ -52,13 +57,20 @@ class SceneServer : public runtime::Node {
     if (options_.clock_source == ClockSource::studio)
       loop_.deadline([this] { return std::optional(next_tick_); },
                      [this](Clock::time_point now) { flush(now); });
-    // Tick-only changes persisted at a bounded interval.
-    if (!options_.state_dir.empty())
+    // Tick-only changes persisted at a bounded interval; the durable copy by the syncer.
+    if (!options_.state_dir.empty()) {
+      loop_.thread(
+          "scene-sync", [this] { sync_loop(); },
+          [this] {
+            { std::lock_guard lock(sync_mutex_); }
+            sync_wake_.notify_all();
+          });
       loop_.every(std::chrono::duration_cast<Clock::duration>(
                       std::chrono::duration<double>(options_.persist_interval)),
                   [this](Clock::time_point) {
                     if (unpersisted_) persist();
                   });
+    }
   }
   ~SceneServer() override { stop(); }
 
@@ -67,7 +79,16 @@ class SceneServer : public runtime::Node {
     loop_.wake();  // publishes the scene at once, whatever the clock source
     return {};
   }
-  void stop() override { loop_.stop(); }
+  void stop() override {
+    loop_.stop();
+    // A clean stop leaves the durable copy current.
+    std::shared_ptr<const std::vector<std::uint8_t>> bytes;
+    {
+      std::lock_guard lock(sync_mutex_);
+      bytes = std::move(to_sync_);
+    }
+    if (bytes) sync(*bytes);
+  }
   runtime::NodeHealth health() override {
     runtime::NodeHealth h = loop_.health();
     h.degraded = persist_failing_.load();  // running, but changes are not persisted
@@ -173,21 +194,60 @@ class SceneServer : public runtime::Node {
     next_tick_ = now + std::chrono::nanoseconds(std::max<int64_t>(next_ns - real, 0));
   }
 
+  // The write-ahead copy now (before anything is published), the durable one by the syncer.
   void persist() {
     if (options_.state_dir.empty()) return;
     // What may be on the wire once the pending changes are out: the published nodes, the
     // updated ones, and the removed ones until their dispose has gone out.
     std::set<NodeId> on_wire = published_;
     for (const auto& [id, n] : scene_.nodes()) on_wire.insert(id);
-    if (auto ok = write_state(options_.state_dir, scene_, on_wire); !ok) {
-      persist_failures_->add();
-      if (!persist_failing_.exchange(true))
-        STUDIO_LOG(error, kLog) << "persisting failed: " << ok.error().message;
+    auto bytes = std::make_shared<const std::vector<std::uint8_t>>(
+        encode_state(scene_, on_wire, ++sequence_));
+    if (auto ok = wal_->write(*bytes, sequence_); !ok) {
+      persist_failed(ok.error());
       return;
     }
-    if (persist_failing_.exchange(false)) STUDIO_LOG(info, kLog) << "persisting works again";
     persists_->add();
     unpersisted_ = false;
+    {
+      std::lock_guard lock(sync_mutex_);
+      to_sync_ = std::move(bytes);
+    }
+    sync_wake_.notify_one();
+  }
+
+  void persist_failed(const Error& e) {
+    persist_failures_->add();
+    if (!persist_failing_.exchange(true))
+      STUDIO_LOG(error, kLog) << "persisting failed: " << e.message;
+  }
+
+  // The syncer thread: the newest state written durably (tmp, fsync, rename, fsync the
+  // directory), at most once per persist_interval; states that arrive meanwhile are coalesced.
+  void sync_loop() {
+    while (loop_.running()) {
+      std::shared_ptr<const std::vector<std::uint8_t>> bytes;
+      {
+        std::unique_lock lock(sync_mutex_);
+        sync_wake_.wait(lock, [&] { return to_sync_ || !loop_.running(); });
+        bytes = std::move(to_sync_);
+      }
+      if (!bytes) continue;
+      sync(*bytes);
+      // At most one durable write per persist_interval: every fsync forces a journal commit
+      // that the loop's write-ahead writes would otherwise queue behind (the latency tail).
+      std::unique_lock lock(sync_mutex_);
+      sync_wake_.wait_for(lock, std::chrono::duration<double>(options_.persist_interval),
+                          [&] { return !loop_.running(); });
+    }
+  }
+  void sync(const std::vector<std::uint8_t>& bytes) {
+    if (auto ok = write_durable(options_.state_dir, bytes); !ok) {
+      persist_failed(ok.error());
+      return;
+    }
+    syncs_->add();
+    if (persist_failing_.exchange(false)) STUDIO_LOG(info, kLog) << "persisting works again";
   }
 
   void publish(bool persist_first) {
@@ -263,6 +323,7 @@ class SceneServer : public runtime::Node {
   }
 
   NodeOptions options_;
+  std::optional<WriteAheadLog> wal_;  // with state_dir
   Scene scene_;
   scene_assets::AssetCache cache_;  // assets of loaded sets, loaded once each
   std::set<NodeId> published_;      // alive instances this server wrote
@@ -273,6 +334,10 @@ class SceneServer : public runtime::Node {
   bool first_ = true, handled_ = false, state_dirty_ = true;
   bool accepted_since_persist_ = false, unpersisted_ = false;
   std::atomic<bool> persist_failing_{false};
+  std::uint64_t sequence_ = 0;  // of the last state written
+  std::mutex sync_mutex_;
+  std::condition_variable sync_wake_;
+  std::shared_ptr<const std::vector<std::uint8_t>> to_sync_;  // newest state not yet durable
   int64_t newest_capture_ns_ = 0;
   std::map<std::string, uint64_t> next_id_;  // per sender: the command_id expected next
   std::string last_sender_, last_error_;
@@ -285,7 +350,7 @@ class SceneServer : public runtime::Node {
   runtime::Input<studio_SceneCommand>* commands_ = nullptr;
   runtime::Counter *accepted_ = nullptr, *rejected_ = nullptr, *lost_ = nullptr, *ticks_ = nullptr,
                    *disposed_ = nullptr, *persists_ = nullptr, *persist_failures_ = nullptr,
-                   *publish_failures_ = nullptr, *malformed_ = nullptr;
+                   *publish_failures_ = nullptr, *malformed_ = nullptr, *syncs_ = nullptr;
   runtime::ServiceLoop loop_;  // last: stopped before the state above goes
 };
 
@@ -294,7 +359,7 @@ class SceneServer : public runtime::Node {
 Expected<std::unique_ptr<runtime::Node>> make_scene_server(NodeOptions options,
                                                            runtime::NodeContext& context) {
   if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
-  PersistedState state{Scene(SceneOptions{options.frame_period()}), {}};
+  PersistedState state{Scene(SceneOptions{options.frame_period()}), {}, 0};
   if (auto ok = state.scene.options().validate(); !ok) return std::unexpected(ok.error());
   scene_assets::AssetCache cache;
   bool resumed = false;
@@ -302,16 +367,18 @@ Expected<std::unique_ptr<runtime::Node>> make_scene_server(NodeOptions options,
     auto loaded = read_state(options.state_dir);
     if (!loaded) return std::unexpected(loaded.error());
     if (*loaded) {
-      if (!((*loaded)->scene.options() == state.scene.options()))
-        return fail(state_path(options.state_dir) + ": persisted with frame period " +
-                    std::to_string((*loaded)->scene.options().frame_period) +
+      if (!(*loaded)->warning.empty()) STUDIO_LOG(warn, kLog) << (*loaded)->warning;
+      if (!((*loaded)->state.scene.options() == state.scene.options()))
+        return fail((*loaded)->path + ": persisted with frame period " +
+                    std::to_string((*loaded)->state.scene.options().frame_period) +
                     " s, the config's clock says " + std::to_string(options.frame_period()) +
                     " s (move the file away to start empty)");
-      state = std::move(**loaded);
+      const std::string path = (*loaded)->path;
+      state = std::move((*loaded)->state);
       resumed = true;
       STUDIO_LOG(info, kLog) << "resumed " << state.scene.nodes().size() << " nodes, "
                              << state.scene.animations().size() << " animations at frame "
-                             << state.scene.frame() << " from " << state_path(options.state_dir);
+                             << state.scene.frame() << " from " << path;
     }
   }
   // First start: the configured scene, built at the studio frame now.
@@ -325,8 +392,14 @@ Expected<std::unique_ptr<runtime::Node>> make_scene_server(NodeOptions options,
     STUDIO_LOG(info, kLog) << "loaded " << options.scene_file << ": " << state.scene.nodes().size()
                            << " nodes, " << state.scene.animations().size() << " animations";
   }
+  std::optional<WriteAheadLog> wal;
+  if (!options.state_dir.empty()) {
+    auto opened = WriteAheadLog::open(options.state_dir);
+    if (!opened) return std::unexpected(opened.error());
+    wal.emplace(std::move(*opened));
+  }
   return std::make_unique<SceneServer>(std::move(options), std::move(state), std::move(cache),
-                                       context);
+                                       std::move(wal), context);
 }
 
 runtime::ServiceDefinition service_definition() {

@@ -325,7 +325,17 @@ TEST_F(SceneServerTest, BurstOf10000RandomCommandsMatchesAnIndependentReplay) {
   // The persisted state is the replay's too.
   auto persisted = node::read_state((dir_ / "state").string());
   ASSERT_TRUE(persisted.has_value() && persisted->has_value());
-  EXPECT_EQ((*persisted)->scene.state_hash(), replayed.state_hash());
+  EXPECT_EQ((*persisted)->state.scene.state_hash(), replayed.state_hash());
+  // And the durable copy (fsync'd by the server's syncer thread) catches up with it.
+  bool durable = false;
+  for (auto deadline = SteadyClock::now() + 10s; !durable && SteadyClock::now() < deadline;
+       std::this_thread::sleep_for(20ms)) {
+    std::ifstream in(node::state_path((dir_ / "state").string()), std::ios::binary);
+    std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), {});
+    auto d = node::decode_state(bytes);
+    durable = d && d->scene.state_hash() == replayed.state_hash();
+  }
+  EXPECT_TRUE(durable);
 }
 
 TEST_F(SceneServerTest, Kill9AndRestartConvergesToThePersistedStateWithoutStaleNodes) {
@@ -369,12 +379,13 @@ TEST_F(SceneServerTest, Kill9AndRestartConvergesToThePersistedStateWithoutStaleN
   const std::string state_dir = (dir_ / "state").string();
   auto persisted = node::read_state(state_dir);
   ASSERT_TRUE(persisted.has_value() && persisted->has_value()) << persisted.error().message;
-  node::PersistedState s = std::move(**persisted);
+  node::PersistedState s = std::move((*persisted)->state);
   EXPECT_FALSE(s.scene.find("b"));
   ASSERT_TRUE(s.scene.find("c"));
   EXPECT_TRUE(s.published.contains("c"));
   ASSERT_TRUE(s.scene.apply(Command{s.scene.frame(), RemoveNode{"c"}}).has_value());
-  ASSERT_TRUE(node::write_state(state_dir, s.scene, s.published).has_value());
+  // Written as the durable copy with a higher sequence: it wins over the server's write-ahead.
+  ASSERT_TRUE(node::write_state(state_dir, s.scene, s.published, s.sequence + 1).has_value());
   const int64_t persisted_frame = s.scene.frame();
   ASSERT_GT(persisted_frame, 0);  // the clock ticked and was persisted
 
@@ -511,7 +522,7 @@ TEST_F(SceneServerTest, ConfiguredSceneThenLoadSetReplacesItAllOrNothing) {
 
 TEST_F(SceneServerTest, BadConfigOrCorruptStateIsOneLineAndExitOne) {
   std::filesystem::create_directories(dir_ / "corrupt");
-  std::ofstream(dir_ / "corrupt" / "scene.state") << "STSRVST1 but nothing else";
+  std::ofstream(dir_ / "corrupt" / "scene.state") << "STSRVST2 but nothing else";
   struct Case {
     std::string yaml, expect;
   } cases[] = {

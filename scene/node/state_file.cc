@@ -8,13 +8,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <utility>
 
 #include "scene/serialize.h"
 
 namespace studio::scene::node {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'T', 'S', 'R', 'V', 'S', 'T', '1'};
+constexpr char kMagic[8] = {'S', 'T', 'S', 'R', 'V', 'S', 'T', '2'};
 
 void put_u32(std::vector<std::uint8_t>& out, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(std::uint8_t(v >> (8 * i)));
@@ -61,8 +62,10 @@ bool write_all(int fd, const std::uint8_t* data, std::size_t size) {
 
 }  // namespace
 
-std::vector<std::uint8_t> encode_state(const Scene& scene, const std::set<NodeId>& published) {
+std::vector<std::uint8_t> encode_state(const Scene& scene, const std::set<NodeId>& published,
+                                       std::uint64_t sequence) {
   std::vector<std::uint8_t> out(std::begin(kMagic), std::end(kMagic));
+  put_u64(out, sequence);
   put_u32(out, std::uint32_t(published.size()));
   for (const NodeId& id : published) {
     put_u32(out, std::uint32_t(id.size()));
@@ -76,7 +79,7 @@ std::vector<std::uint8_t> encode_state(const Scene& scene, const std::set<NodeId
 }
 
 Expected<PersistedState> decode_state(const std::vector<std::uint8_t>& bytes) {
-  if (bytes.size() < sizeof kMagic + 4 + 8 + 8 ||
+  if (bytes.size() < sizeof kMagic + 8 + 4 + 8 + 8 ||
       std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
     return fail("not a scene server state file (bad magic or too short)");
   std::uint64_t sum = 0;
@@ -84,9 +87,10 @@ Expected<PersistedState> decode_state(const std::vector<std::uint8_t>& bytes) {
   if (sum != fnv1a64(bytes.data(), bytes.size() - 8)) return fail("checksum mismatch");
   const std::vector<std::uint8_t> body(bytes.begin(), bytes.end() - 8);
   Cursor c{body, sizeof kMagic};
+  PersistedState state;
+  if (!c.u64(state.sequence)) return fail("truncated");
   std::uint32_t count = 0;
   if (!c.u32(count) || count > c.left() / 4) return fail("bad published id count");
-  PersistedState state;
   for (std::uint32_t i = 0; i < count; ++i) {
     std::uint32_t n = 0;
     if (!c.u32(n) || n > c.left()) return fail("published id " + std::to_string(i) + " truncated");
@@ -105,21 +109,28 @@ Expected<PersistedState> decode_state(const std::vector<std::uint8_t>& bytes) {
 std::string state_path(const std::string& dir) {
   return (std::filesystem::path(dir) / "scene.state").string();
 }
+std::string wal_path(const std::string& dir, int slot) {
+  return (std::filesystem::path(dir) / ("scene.wal." + std::to_string(slot))).string();
+}
 
-Expected<void> write_state(const std::string& dir, const Scene& scene,
-                           const std::set<NodeId>& published) {
+namespace {
+
+// Writes bytes to path + ".tmp" (fsync'd when `durable`) and renames it over path; with
+// `durable` the directory is fsync'd after the rename.
+Expected<void> replace_file(const std::string& dir, const std::string& path,
+                            const std::vector<std::uint8_t>& bytes, bool durable) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return fail("state_dir " + dir + ": " + ec.message());
-  const std::string path = state_path(dir), tmp = path + ".tmp";
-  const std::vector<std::uint8_t> bytes = encode_state(scene, published);
+  const std::string tmp = path + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return fail(tmp + ": " + errno_text());
-  const bool ok = write_all(fd, bytes.data(), bytes.size()) && ::fsync(fd) == 0;
+  const bool ok = write_all(fd, bytes.data(), bytes.size()) && (!durable || ::fsync(fd) == 0);
   const std::string why = ok ? "" : errno_text();
   ::close(fd);
   if (!ok) return fail(tmp + ": " + why);
   if (::rename(tmp.c_str(), path.c_str()) != 0) return fail(path + ": rename: " + errno_text());
+  if (!durable) return {};
   const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dfd < 0) return fail(dir + ": " + errno_text());
   const bool synced = ::fsync(dfd) == 0;
@@ -129,16 +140,124 @@ Expected<void> write_state(const std::string& dir, const Scene& scene,
   return {};
 }
 
-Expected<std::optional<PersistedState>> read_state(const std::string& dir) {
-  const std::string path = state_path(dir);
+// nullopt: no such file (or an empty slot); else the decoded state or why it is not one. A
+// write-ahead slot holds a u64 length, then the record (and maybe older bytes after it).
+std::optional<Expected<PersistedState>> read_one(const std::string& path, bool slot) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return std::optional<PersistedState>{};
+  if (!std::filesystem::exists(path, ec)) return std::nullopt;
   std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(path + ": cannot open");
+  if (!in) return Expected<PersistedState>(fail(path + ": cannot open"));
   std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), {});
+  if (slot) {
+    if (bytes.empty()) return std::nullopt;
+    std::uint64_t n = 0;
+    Cursor c{bytes};
+    if (!c.u64(n) || n > c.left())
+      return Expected<PersistedState>(fail(path + ": corrupt state file: bad record length"));
+    bytes = std::vector<std::uint8_t>(bytes.begin() + 8, bytes.begin() + 8 + std::ptrdiff_t(n));
+  }
   auto state = decode_state(bytes);
-  if (!state) return fail(path + ": corrupt state file: " + state.error().message);
-  return std::optional<PersistedState>(std::move(*state));
+  if (!state)
+    return Expected<PersistedState>(fail(path + ": corrupt state file: " + state.error().message));
+  return Expected<PersistedState>(std::move(*state));
+}
+
+}  // namespace
+
+Expected<WriteAheadLog> WriteAheadLog::open(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return fail("state_dir " + dir + ": " + ec.message());
+  WriteAheadLog log;
+  log.dir_ = dir;
+  for (int slot = 0; slot < 2; ++slot) {
+    const std::string path = wal_path(dir, slot);
+    log.fd_[slot] = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (log.fd_[slot] < 0) return fail(path + ": " + errno_text());
+  }
+  return log;
+}
+
+WriteAheadLog::WriteAheadLog(WriteAheadLog&& o) noexcept : dir_(std::move(o.dir_)) {
+  for (int i = 0; i < 2; ++i) fd_[i] = std::exchange(o.fd_[i], -1);
+}
+WriteAheadLog& WriteAheadLog::operator=(WriteAheadLog&& o) noexcept {
+  if (this != &o) {
+    for (int i = 0; i < 2; ++i) {
+      if (fd_[i] >= 0) ::close(fd_[i]);
+      fd_[i] = std::exchange(o.fd_[i], -1);
+    }
+    dir_ = std::move(o.dir_);
+  }
+  return *this;
+}
+WriteAheadLog::~WriteAheadLog() {
+  for (int fd : fd_)
+    if (fd >= 0) ::close(fd);
+}
+
+Expected<void> WriteAheadLog::write(const std::vector<std::uint8_t>& bytes,
+                                    std::uint64_t sequence) {
+  const int slot = int(sequence % 2);
+  std::vector<std::uint8_t> record;
+  record.reserve(bytes.size() + 8);
+  put_u64(record, bytes.size());
+  record.insert(record.end(), bytes.begin(), bytes.end());
+  const std::uint8_t* p = record.data();
+  std::size_t left = record.size();
+  off_t at = 0;
+  while (left > 0) {
+    const ssize_t n = ::pwrite(fd_[slot], p, left, at);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return fail(wal_path(dir_, slot) + ": " + errno_text());
+    }
+    p += n;
+    left -= std::size_t(n);
+    at += n;
+  }
+  return {};
+}
+
+Expected<void> write_durable(const std::string& dir, const std::vector<std::uint8_t>& bytes) {
+  return replace_file(dir, state_path(dir), bytes, true);
+}
+
+Expected<void> write_state(const std::string& dir, const Scene& scene,
+                           const std::set<NodeId>& published, std::uint64_t sequence) {
+  return write_durable(dir, encode_state(scene, published, sequence));
+}
+
+Expected<std::optional<LoadedState>> read_state(const std::string& dir) {
+  struct Copy {
+    std::string path;
+    std::optional<Expected<PersistedState>> read;
+  };
+  std::vector<Copy> copies;
+  copies.push_back({state_path(dir), read_one(state_path(dir), false)});
+  for (int slot = 0; slot < 2; ++slot)
+    copies.push_back({wal_path(dir, slot), read_one(wal_path(dir, slot), true)});
+  Copy* best = nullptr;
+  std::string errors;
+  bool any = false;
+  for (Copy& c : copies) {
+    if (!c.read) continue;
+    any = true;
+    if (!c.read->has_value()) {
+      errors += (errors.empty() ? "" : "; ") + c.read->error().message;
+      continue;
+    }
+    if (!best || (*c.read)->sequence > (*best->read)->sequence) best = &c;
+  }
+  if (!any) return std::optional<LoadedState>{};
+  if (!best) return fail(errors);
+  LoadedState out;
+  out.path = best->path;
+  out.state = std::move(**best->read);
+  const auto& durable = copies[0].read;
+  if (durable && !durable->has_value())
+    out.warning = durable->error().message + " (a write-ahead copy is used)";
+  return std::optional<LoadedState>(std::move(out));
 }
 
 }  // namespace studio::scene::node

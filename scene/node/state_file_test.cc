@@ -36,23 +36,25 @@ TEST(StateFile, RoundTripKeepsSceneHashAndPublishedIds) {
   for (const auto& [id, n] : scene.nodes()) published.insert(id);
   published.insert("removed-but-not-disposed");
   const fs::path dir = scratch_dir("roundtrip");
-  ASSERT_TRUE(write_state(dir.string(), scene, published).has_value());
+  ASSERT_TRUE(write_state(dir.string(), scene, published, 3).has_value());
   EXPECT_FALSE(fs::exists(dir / "scene.state.tmp"));
   auto back = read_state(dir.string());
   ASSERT_TRUE(back.has_value()) << back.error().message;
   ASSERT_TRUE(back->has_value());
-  EXPECT_EQ((*back)->scene.state_hash(), scene.state_hash());
-  EXPECT_EQ((*back)->scene.nodes(), scene.nodes());
-  EXPECT_EQ((*back)->scene.animations(), scene.animations());
-  EXPECT_EQ((*back)->published, published);
+  EXPECT_EQ((*back)->state.scene.state_hash(), scene.state_hash());
+  EXPECT_EQ((*back)->state.scene.nodes(), scene.nodes());
+  EXPECT_EQ((*back)->state.scene.animations(), scene.animations());
+  EXPECT_EQ((*back)->state.published, published);
+  EXPECT_EQ((*back)->state.sequence, 3u);
+  EXPECT_TRUE((*back)->warning.empty());
 
   // A second write replaces the first completely.
   const Scene other = random_scene(8, 300);
-  ASSERT_TRUE(write_state(dir.string(), other, {}).has_value());
+  ASSERT_TRUE(write_state(dir.string(), other, {}, 4).has_value());
   back = read_state(dir.string());
   ASSERT_TRUE(back.has_value() && back->has_value());
-  EXPECT_EQ((*back)->scene.state_hash(), other.state_hash());
-  EXPECT_TRUE((*back)->published.empty());
+  EXPECT_EQ((*back)->state.scene.state_hash(), other.state_hash());
+  EXPECT_TRUE((*back)->state.published.empty());
   fs::remove_all(dir);
 }
 
@@ -65,7 +67,7 @@ TEST(StateFile, MissingFileIsNoState) {
 
 TEST(StateFile, CorruptOrTruncatedFilesAreRefused) {
   const Scene scene = random_scene(9, 500);
-  const auto bytes = encode_state(scene, {"a", "b"});
+  const auto bytes = encode_state(scene, {"a", "b"}, 1);
   ASSERT_TRUE(decode_state(bytes).has_value());  // positive control
   // Every truncation and a flip of every 7th byte: an error, never a crash.
   for (std::size_t n = 0; n < bytes.size(); n += 13) {
@@ -84,6 +86,65 @@ TEST(StateFile, CorruptOrTruncatedFilesAreRefused) {
   ASSERT_FALSE(s.has_value());
   EXPECT_NE(s.error().message.find("scene.state: corrupt state file"), std::string::npos)
       << s.error().message;
+  fs::remove_all(dir);
+}
+
+// The write-ahead slots (scene.wal.0/1, no fsync) and the durable copy (scene.state): the valid
+// copy with the highest sequence wins; torn copies are ignored when another is valid.
+TEST(StateFile, NewestValidCopyWins) {
+  const Scene older = random_scene(10, 400), newer = random_scene(11, 400),
+              newest = random_scene(12, 40);
+  const fs::path dir = scratch_dir("copies");
+  const std::string d = dir.string();
+  ASSERT_TRUE(write_durable(d, encode_state(older, {}, 5)).has_value());
+  auto wal = WriteAheadLog::open(d);
+  ASSERT_TRUE(wal.has_value()) << wal.error().message;
+  ASSERT_TRUE(wal->write(encode_state(newer, {"x"}, 6), 6).has_value());  // slot 0
+  auto got = read_state(d);
+  ASSERT_TRUE(got.has_value() && got->has_value());
+  EXPECT_EQ((*got)->state.scene.state_hash(), newer.state_hash());
+  EXPECT_EQ((*got)->path, wal_path(d, 0));
+  // A smaller record overwrites the slot in place (old bytes after it are ignored).
+  ASSERT_TRUE(wal->write(encode_state(newest, {}, 8), 8).has_value());  // slot 0 again
+  got = read_state(d);
+  ASSERT_TRUE(got.has_value() && got->has_value());
+  EXPECT_EQ((*got)->state.scene.state_hash(), newest.state_hash());
+  ASSERT_TRUE(wal->write(encode_state(newer, {}, 9), 9).has_value());  // slot 1
+  got = read_state(d);
+  ASSERT_TRUE(got.has_value() && got->has_value());
+  EXPECT_EQ((*got)->path, wal_path(d, 1));
+
+  // A torn newest slot (killed mid-write): the other slot, the previous state.
+  {
+    std::fstream f(wal_path(d, 1), std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(40);
+    f.write("torn", 4);
+  }
+  got = read_state(d);
+  ASSERT_TRUE(got.has_value() && got->has_value());
+  EXPECT_EQ((*got)->state.scene.state_hash(), newest.state_hash());
+  EXPECT_EQ((*got)->state.sequence, 8u);
+
+  // A durable copy written later (higher sequence) wins over the write-ahead slots.
+  ASSERT_TRUE(write_state(d, older, {}, 10).has_value());
+  got = read_state(d);
+  ASSERT_TRUE(got.has_value() && got->has_value());
+  EXPECT_EQ((*got)->state.scene.state_hash(), older.state_hash());
+  EXPECT_TRUE((*got)->warning.empty());
+
+  // A garbage durable copy: a write-ahead slot, with a warning naming the file.
+  std::ofstream(dir / "scene.state", std::ios::trunc) << "garbage";
+  got = read_state(d);
+  ASSERT_TRUE(got.has_value() && got->has_value());
+  EXPECT_EQ((*got)->state.sequence, 8u);
+  EXPECT_NE((*got)->warning.find("scene.state: corrupt state file"), std::string::npos);
+
+  // Everything torn: an error naming the files.
+  std::ofstream(wal_path(d, 0), std::ios::trunc) << "garbage!garbage!";
+  got = read_state(d);
+  ASSERT_FALSE(got.has_value());
+  EXPECT_NE(got.error().message.find("scene.state"), std::string::npos);
+  EXPECT_NE(got.error().message.find("scene.wal.0"), std::string::npos);
   fs::remove_all(dir);
 }
 
