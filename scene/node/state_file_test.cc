@@ -7,7 +7,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "runtime/service.h"
+#include "scene_config.h"
 #include "scene_testing/random_commands.h"
+#include "yaml_io/node.h"
 
 namespace studio::scene::node {
 namespace {
@@ -146,6 +149,28 @@ TEST(StateFile, NewestValidCopyWins) {
   EXPECT_NE(got.error().message.find("scene.state"), std::string::npos);
   EXPECT_NE(got.error().message.find("scene.wal.0"), std::string::npos);
   fs::remove_all(dir);
+}
+
+// scene/node/scene.example.yaml documents every key: it reads strictly (common and server keys,
+// nothing unknown) to the values it names.
+TEST(SceneConfig, ExampleConfigReadsStrictly) {
+  const std::string path = std::string(STUDIO_SOURCE_DIR) + "/scene/node/scene.example.yaml";
+  auto doc = yaml::load_file(path);
+  ASSERT_TRUE(doc.has_value()) << doc.error().message;
+  auto map = yaml::MapReader::from(*doc);
+  ASSERT_TRUE(map.has_value());
+  ASSERT_TRUE(runtime::read_common_options(*map).has_value());
+  auto o = read_node_options(*map);
+  ASSERT_TRUE(o.has_value()) << o.error().message;
+  ASSERT_TRUE(map->finish().has_value()) << map->finish().error().message;
+  EXPECT_EQ(o->period_ns, 40'000'000);
+  EXPECT_EQ(o->clock_source, ClockSource::studio);
+  EXPECT_EQ(o->state_dir, "/var/lib/studio/scene");
+  EXPECT_EQ(o->scene_file, std::string(STUDIO_SOURCE_DIR) + "/scene/data/scene.yaml");
+  EXPECT_EQ(o->persist_interval, 1.0);
+  EXPECT_EQ(o->command_queue, 16384);
+  EXPECT_EQ(o->frame_at(o->epoch_ns + 3 * o->period_ns + 1), 3);
+  EXPECT_EQ(o->frame_at(o->epoch_ns - 1), -1);
 }
 
 }  // namespace
