@@ -93,3 +93,23 @@ TEST(PlateKeyer, ChromaKeyKeysAtOnceAndCanStillTakeAPlate) {
 
 }  // namespace
 }  // namespace studio::keyer
+
+namespace studio::keyer {
+namespace {
+
+TEST(PlateRequest, CountsAndClearAreRequestsTheRestOneLine) {
+  EXPECT_EQ(plate_request(0).value(), 0);
+  EXPECT_EQ(plate_request(3).value(), 3);
+  EXPECT_EQ(plate_request(kMaxPlateFrames).value(), kMaxPlateFrames);
+  for (double bad : {2.5, -1.0, double(kMaxPlateFrames + 1)}) {
+    auto r = plate_request(bad);
+    ASSERT_FALSE(r.has_value()) << bad;
+    EXPECT_NE(r.error().message.find("KeyerPlate"), std::string::npos);
+    EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
+  }
+  EXPECT_EQ(plate_request_text(0), "clean plate cleared");
+  EXPECT_EQ(plate_request_text(4), "capturing a clean plate from the next 4 frame(s)");
+}
+
+}  // namespace
+}  // namespace studio::keyer

@@ -1,11 +1,11 @@
 // Keyframe sampling (step, linear, slerp), play modes and the clock.
+#include "scene/animation.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <numbers>
-
-#include "scene/animation.h"
 
 using namespace studio::scene;
 

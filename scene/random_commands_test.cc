@@ -1,6 +1,8 @@
 // Randomized: long sequences of random commands, valid and invalid mixed. After every command the
 // invariants hold and a refused command left the state unchanged; replaying the log on a fresh
 // scene gives the same hash; serialise -> deserialise gives the same hash.
+#include "scene_testing/random_commands.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,7 +10,6 @@
 
 #include "scene/scene.h"
 #include "scene/serialize.h"
-#include "scene_testing/random_commands.h"
 
 using namespace studio::scene;
 
@@ -30,7 +31,8 @@ TEST_P(RandomCommands, InvariantsReplayAndRoundTrip) {
     }
     log.push_back(c);
     auto inv = scene.check_invariants();
-    ASSERT_TRUE(inv) << "after command " << i << " (" << command_name(c.op) << "): " << inv.error().message;
+    ASSERT_TRUE(inv) << "after command " << i << " (" << command_name(c.op)
+                     << "): " << inv.error().message;
     if (i % 500 == 499) {
       auto back = deserialize(serialize(scene));
       ASSERT_TRUE(back) << back.error().message;

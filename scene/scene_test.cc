@@ -1,12 +1,13 @@
 // Scene: commands (each refusal beside a positive control), world transforms, change tracking,
 // animation on the scene clock, serialisation.
+#include "scene/scene.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <numbers>
 
-#include "scene/scene.h"
 #include "scene/serialize.h"
 
 using namespace studio::scene;
@@ -221,6 +222,24 @@ TEST(Scene, HashCoversNodesAndTheAnimationClock) {
   EXPECT_NE(s.state_hash(), h0);
   ok(copy, at(0, SetVisible{"n", false}));
   EXPECT_NE(copy.state_hash(), h0);
+}
+
+TEST(Scene, NodesHashIsWhatAReaderOfTheNodesComputes) {
+  Scene s;
+  ok(s, at(0, AddNode{group("n")}));
+  ok(s, at(0, AddNode{group("m", "n", {1, 2, 3})}));
+  ok(s, at(0, AddAnimation{slide("s", "m")}));
+  // A reader keeps the nodes it received, keyed by id.
+  std::map<NodeId, Node> received;
+  for (const NodeId& id : s.take_changes().updated) received[id] = *s.find(id);
+  EXPECT_EQ(hash_nodes(received), s.nodes_hash());
+  const auto nodes_before = s.nodes_hash();
+  ok(s, at(5, Seek{"s", 1.0}));  // the clock changed, no node did
+  EXPECT_EQ(s.nodes_hash(), nodes_before);
+  ok(s, at(5, Tick{}));  // now the animated node moved
+  EXPECT_NE(s.nodes_hash(), nodes_before);
+  for (const NodeId& id : s.take_changes().updated) received[id] = *s.find(id);
+  EXPECT_EQ(hash_nodes(received), s.nodes_hash());
 }
 
 TEST(Serialize, RoundTripKeepsTheHashAndTheState) {

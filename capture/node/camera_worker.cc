@@ -155,16 +155,11 @@ std::string CameraWorker::control(const CameraControlCore& c) {
   if (c.feature == keyer::kPlateControl) {
     // For whichever process keys this camera: here only when it keys in-process.
     if (!io_.options.publish_masks) return {};
-    if (!keyer::valid_plate_request(c.value)) {
-      problem = "camera " + id_ + ": " + std::string(keyer::kPlateControl) + " " +
-                std::to_string(c.value) + ": expected 0 (clear) or a frame count 1.." +
-                std::to_string(keyer::kMaxPlateFrames);
+    if (const auto frames = keyer::plate_request(c.value); !frames) {
+      problem = "camera " + id_ + ": " + frames.error().message;
     } else {
-      keyer_->request(int(c.value));
-      STUDIO_LOG(info, kLog) << id_ << ": "
-                             << (c.value == 0 ? std::string("clean plate cleared")
-                                              : "capturing a clean plate from the next " +
-                                                    std::to_string(int(c.value)) + " frame(s)");
+      keyer_->request(*frames);
+      STUDIO_LOG(info, kLog) << id_ << ": " << keyer::plate_request_text(*frames);
     }
   } else if (c.feature == "ImageRate") {
     std::lock_guard lock(mutex_);

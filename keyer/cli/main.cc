@@ -20,9 +20,9 @@
 
 #include "core/mask_codec.h"
 #include "keyer/config/image_io.h"
+#include "keyer/config/keyer_yaml.h"
 #include "keyer/keyer.h"
 #include "keyer_node.h"
-#include "keyer/config/keyer_yaml.h"
 #include "runtime/service.h"
 
 namespace fs = std::filesystem;

@@ -145,20 +145,15 @@ class KeyerNode : public runtime::Node {
 
   runtime::Outcome on_control(const studio_CameraControl& c) {
     if (std::string_view(c.feature) != kPlateControl) return {};  // a camera feature, for capture
-    if (!valid_plate_request(c.value))
-      return runtime::reject("value", std::string(c.camera_id) + ": " + std::string(kPlateControl) +
-                                          " " + std::to_string(c.value) +
-                                          ": expected 0 (clear) or a frame count 1.." +
-                                          std::to_string(kMaxPlateFrames));
+    const auto frames = plate_request(c.value);
+    if (!frames)
+      return runtime::reject("value", std::string(c.camera_id) + ": " + frames.error().message);
     std::lock_guard lock(mutex_);
     bool ignored = false;
     Slot* slot = slot_for(c.camera_id, ignored);
     if (!slot) return {};  // another keyer node's camera (or over max_cameras, counted there)
-    slot->keyer->request(int(c.value));
-    STUDIO_LOG(info, kLog) << c.camera_id << ": "
-                           << (c.value == 0 ? std::string("clean plate cleared")
-                                            : "capturing a clean plate from the next " +
-                                                  std::to_string(int(c.value)) + " frame(s)");
+    slot->keyer->request(*frames);
+    STUDIO_LOG(info, kLog) << c.camera_id << ": " << plate_request_text(*frames);
     return {};
   }
 

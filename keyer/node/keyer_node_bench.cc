@@ -18,6 +18,7 @@
 #include <atomic>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <thread>
 
@@ -37,7 +38,9 @@ using namespace std::chrono_literals;
 
 constexpr int kFramesPerCamera = 8;
 
-const std::vector<std::vector<Image<Rgb8>>>& sim_frames() {
+using SimFrames = std::vector<std::vector<Image<Rgb8>>>;
+
+const SimFrames& sim_frames() {
   static std::vector<std::vector<Image<Rgb8>>> frames = [] {
     std::vector<std::vector<Image<Rgb8>>> out(6);
     auto studio = sim::SimulatedStudio::create(sim::ring_cameras()).value();
@@ -75,25 +78,94 @@ double percentile(std::vector<double> v, double p) {
   return v[std::min(v.size() - 1, std::size_t(p * double(v.size())))];
 }
 
+// In-process cost of the node's work per frame (key + encode), for the ratio (measured in the
+// same run, not taken from elsewhere).
+double in_process_key_ms(const SimFrames& frames) {
+  auto keyer = keyer::Keyer::create({}).value();
+  RunMask mask;
+  std::vector<uint8_t> bytes;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 480; ++i) {
+    (void)keyer.key(frames[i % 6][(i / 6) % kFramesPerCamera].view(), mask);
+    encode_mask(mask, MaskCoding::kRowDelta, bytes);
+  }
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() /
+         480;
+}
+
+// Raw RGB8 CameraImage samples, kFramesPerCamera per camera.
+std::vector<wire::Owned<studio_CameraImage>> image_samples(const SimFrames& frames, int cameras) {
+  std::vector<wire::Owned<studio_CameraImage>> samples(std::size_t(cameras) * kFramesPerCamera);
+  for (int c = 0; c < cameras; ++c)
+    for (int f = 0; f < kFramesPerCamera; ++f) {
+      auto& s = samples[std::size_t(c) * kFramesPerCamera + f];
+      const auto& img = frames[c][f];
+      wire::set(s->camera_id, "cam" + std::to_string(c));
+      s->width = uint32_t(img.width());
+      s->height = uint32_t(img.height());
+      s->format = studio_IMAGE_RGB8;
+      const auto* px = reinterpret_cast<const uint8_t*>(img.data());
+      wire::assign(s->data, std::span<const uint8_t>(px, img.pixels().size() * 3));
+    }
+
+  return samples;
+}
+
+// The node's own counters from its status samples (for 2 s): name -> value.
+std::map<std::string, double> node_counters(wire::Reader<studio_ServiceStatus>& status) {
+  std::map<std::string, double> out;
+  const auto until = std::chrono::steady_clock::now() + 2s;
+  while (std::chrono::steady_clock::now() < until) {
+    for (auto& s : status.take())
+      if (s.meta.valid_data)
+        for (const auto& c : wire::view(s.data->counters))
+          out[std::string(wire::str(c.name))] = c.value;
+    std::this_thread::sleep_for(100ms);
+  }
+  return out;
+}
+
+// One 4 s run: every camera's frame at 25 fps (raw images), the masks' latencies (ms) as they
+// come back. Returns the images sent.
+uint64_t run_4s_at_25fps(int cameras, std::vector<wire::Owned<studio_CameraImage>>& samples,
+                         const wire::Writer<studio_CameraImage>& images,
+                         wire::Reader<studio_AlphaMask>& masks, const wire::WaitSet& ws,
+                         std::vector<double>& latencies) {
+  uint64_t sent = 0;
+  std::atomic<bool> receiving{true};
+  std::thread receiver([&] {
+    while (receiving) {
+      ws.wait(20ms);
+      const int64_t now = realtime_ns();
+      masks.visit([&](const studio_AlphaMask& m, const wire::SampleMeta& meta) {
+        if (meta.valid_data && m.capture_ns > 0)
+          latencies.push_back(double(now - m.capture_ns) * 1e-6);
+      });
+    }
+  });
+  const auto start = std::chrono::steady_clock::now();
+  const auto period = std::chrono::microseconds(40000);
+  for (uint64_t tick = 0; tick < 100; ++tick) {  // 4 s at 25 fps
+    std::this_thread::sleep_until(start + tick * period);
+    for (int c = 0; c < cameras; ++c) {
+      auto& s = samples[std::size_t(c) * kFramesPerCamera + tick % kFramesPerCamera];
+      s->frame = tick;
+      s->capture_ns = realtime_ns();
+      (void)images.write(*s);
+      ++sent;
+    }
+  }
+  std::this_thread::sleep_for(300ms);
+  receiving = false;
+  receiver.join();
+  return sent;
+}
+
 void BM_NodeAt25Fps(benchmark::State& state) {
   const int cameras = int(state.range(0));
   const int threads = int(state.range(1));
   const auto& frames = sim_frames();
-  // In-process cost of the same work, for the ratio (measured here, not taken from elsewhere).
-  double key_ms = 0;
-  {
-    auto keyer = keyer::Keyer::create({}).value();
-    RunMask mask;
-    std::vector<uint8_t> bytes;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (int i = 0; i < 480; ++i) {
-      (void)keyer.key(frames[i % 6][(i / 6) % kFramesPerCamera].view(), mask);
-      encode_mask(mask, MaskCoding::kRowDelta, bytes);
-    }
-    key_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() /
-        480;
-  }
+  const double key_ms = in_process_key_ms(frames);
 
   const auto dir = testing::make_test_dir("keyer_node_bench");
   auto dds = testing::DdsDomain::unique();
@@ -125,68 +197,15 @@ void BM_NodeAt25Fps(benchmark::State& state) {
     return;
   }
 
-  std::vector<wire::Owned<studio_CameraImage>> samples(std::size_t(cameras) * kFramesPerCamera);
-  for (int c = 0; c < cameras; ++c)
-    for (int f = 0; f < kFramesPerCamera; ++f) {
-      auto& s = samples[std::size_t(c) * kFramesPerCamera + f];
-      const auto& img = frames[c][f];
-      wire::set(s->camera_id, "cam" + std::to_string(c));
-      s->width = uint32_t(img.width());
-      s->height = uint32_t(img.height());
-      s->format = studio_IMAGE_RGB8;
-      const auto* px = reinterpret_cast<const uint8_t*>(img.data());
-      wire::assign(s->data, std::span<const uint8_t>(px, img.pixels().size() * 3));
-    }
+  auto samples = image_samples(frames, cameras);
 
   std::vector<double> latencies;
   uint64_t sent = 0;
-  double dropped = 0, node_in = 0, missed = 0;
-  for (auto _ : state) {
-    std::atomic<bool> receiving{true};
-    std::thread receiver([&] {
-      while (receiving) {
-        ws.wait(20ms);
-        const int64_t now = realtime_ns();
-        masks.visit([&](const studio_AlphaMask& m, const wire::SampleMeta& meta) {
-          if (meta.valid_data && m.capture_ns > 0)
-            latencies.push_back(double(now - m.capture_ns) * 1e-6);
-        });
-      }
-    });
-    const auto start = std::chrono::steady_clock::now();
-    const auto period = std::chrono::microseconds(40000);
-    for (uint64_t tick = 0; tick < 100; ++tick) {  // 4 s at 25 fps
-      std::this_thread::sleep_until(start + tick * period);
-      for (int c = 0; c < cameras; ++c) {
-        auto& s = samples[std::size_t(c) * kFramesPerCamera + tick % kFramesPerCamera];
-        s->frame = tick;
-        s->capture_ns = realtime_ns();
-        (void)images.write(*s);
-        ++sent;
-      }
-    }
-    std::this_thread::sleep_for(300ms);
-    receiving = false;
-    receiver.join();
-  }
-  // The node's own count of replaced (dropped) frames, from its status.
-  const auto until = std::chrono::steady_clock::now() + 2s;
-  while (std::chrono::steady_clock::now() < until) {
-    for (auto& s : status.take())
-      if (s.meta.valid_data) {
-        for (const auto& c : wire::view(s.data->counters)) {
-          const std::string name(wire::str(c.name));
-          if (name == "frames_dropped") {
-            dropped = c.value;
-          } else if (name == "frames_missed") {
-            missed = c.value;
-          } else if (name == "images_in") {
-            node_in = c.value;
-          }
-        }
-      }
-    std::this_thread::sleep_for(100ms);
-  }
+  for (auto _ : state) sent += run_4s_at_25fps(cameras, samples, images, masks, ws, latencies);
+  // The node's own counts of replaced (dropped) and missed frames, from its status.
+  auto counters = node_counters(status);
+  const double dropped = counters["frames_dropped"], missed = counters["frames_missed"],
+               node_in = counters["images_in"];
   node->stop();
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);

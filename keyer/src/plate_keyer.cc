@@ -4,6 +4,19 @@
 
 namespace studio::keyer {
 
+Expected<int> plate_request(double value) {
+  if (!valid_plate_request(value))
+    return fail(std::string(kPlateControl) + " " + std::to_string(value) +
+                ": expected 0 (clear) or a frame count 1.." + std::to_string(kMaxPlateFrames));
+  return int(value);
+}
+
+std::string plate_request_text(int frames) {
+  return frames == 0
+             ? "clean plate cleared"
+             : "capturing a clean plate from the next " + std::to_string(frames) + " frame(s)";
+}
+
 PlateKeyer::Result PlateKeyer::frame(ImageView<const Rgb8> image, RunMask& mask) {
   Result r;
   if (const int n = pending_.exchange(-1, std::memory_order_acq_rel); n >= 0) {

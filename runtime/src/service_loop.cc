@@ -115,6 +115,7 @@ Expected<void> ServiceLoop::start() {
     if (auto r = out->create(p); !r) return undo(r.error());
   for (std::size_t i = 0; i < inputs_.size(); ++i) {
     if (auto r = inputs_[i]->create(p); !r) return undo(r.error());
+    inputs_[i]->validator_seen_ = 0;  // a new reader counts from 0
     if (auto r = entities->waitset.attach(inputs_[i]->reader(), dds_attach_t(i + 1)); !r)
       return undo(r.error());
   }

@@ -22,7 +22,8 @@ namespace {
 const std::string kMuseum = std::string(STUDIO_SCENE_DEFAULT_DIR) + "/museum.glb";
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("scene_assets_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path d =
+      fs::temp_directory_path() / ("scene_assets_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -34,10 +35,12 @@ TEST(ContentHash, Sha256KnownVectorsAndFiles) {
   const std::string abc = "abc";
   EXPECT_EQ(sha256_hex(reinterpret_cast<const std::uint8_t*>(abc.data()), abc.size()),
             "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
-  EXPECT_EQ(sha256_hex(nullptr, 0), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(sha256_hex(nullptr, 0),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
   const fs::path d = temp_dir("hash");
   std::ofstream(d / "f.bin") << "abc";
-  EXPECT_EQ(*sha256_file((d / "f.bin").string()), sha256_hex(reinterpret_cast<const std::uint8_t*>(abc.data()), 3));
+  EXPECT_EQ(*sha256_file((d / "f.bin").string()),
+            sha256_hex(reinterpret_cast<const std::uint8_t*>(abc.data()), 3));
   auto missing = sha256_file((d / "none.bin").string());
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("none.bin"), std::string::npos);
@@ -60,7 +63,7 @@ TEST(Museum, GeneratedSceneMeetsTheBrief) {
   EXPECT_EQ(a->sha256, *sha256_file(kMuseum));
 
   // Named exhibits with distinct colours.
-  const char* names[] = {"exhibit_red_sphere", "exhibit_green_torus", "exhibit_blue_vase",
+  const char* names[] = {"exhibit_red_sphere",  "exhibit_green_torus",  "exhibit_blue_vase",
                          "exhibit_yellow_knot", "exhibit_magenta_cone", "exhibit_cyan_cube"};
   std::vector<Eigen::Vector4f> colours;
   for (const char* name : names) {
@@ -110,11 +113,12 @@ TEST(Museum, FlyerPassesCloseToTheActorOnTheSceneClock) {
 TEST(Assets, ObjWithMaterialAndExternalTexture) {
   const fs::path d = temp_dir("obj");
   cv::Mat img(8, 8, CV_8UC3, cv::Scalar(0, 0, 255));  // red (BGR)
-  img.row(0).setTo(cv::Scalar(255, 0, 0));              // top row blue
+  img.row(0).setTo(cv::Scalar(255, 0, 0));            // top row blue
   cv::imwrite((d / "red.png").string(), img);
   std::ofstream(d / "quad.mtl") << "newmtl paint\nKd 0.5 0.25 1.0\nmap_Kd red.png\n";
-  std::ofstream(d / "quad.obj") << "mtllib quad.mtl\no quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-                                   "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl paint\nf 1/1 2/2 3/3 4/4\n";
+  std::ofstream(d / "quad.obj")
+      << "mtllib quad.mtl\no quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+         "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl paint\nf 1/1 2/2 3/3 4/4\n";
   auto a = load_asset((d / "quad.obj").string());
   ASSERT_TRUE(a) << a.error().message;
   ASSERT_EQ(a->meshes.size(), 1u);
@@ -125,8 +129,8 @@ TEST(Assets, ObjWithMaterialAndExternalTexture) {
   const Texture& t = a->textures[m.texture];
   ASSERT_EQ(t.width, 8);
   // Bottom row first: the image's top (blue) row is the last row.
-  EXPECT_EQ(t.rgba[0], 255);                          // R of the bottom-left pixel (red)
-  EXPECT_EQ(t.rgba[(7 * 8) * 4 + 2], 255);            // B of the top-left pixel (blue)
+  EXPECT_EQ(t.rgba[0], 255);                // R of the bottom-left pixel (red)
+  EXPECT_EQ(t.rgba[(7 * 8) * 4 + 2], 255);  // B of the top-left pixel (blue)
   EXPECT_EQ(a->meshes[0].uvs.size(), a->meshes[0].positions.size());
   fs::remove_all(d);
 }

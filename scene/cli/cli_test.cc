@@ -25,8 +25,8 @@ fs::path temp_dir() {
 
 Outcome run(const std::string& args) {
   const fs::path d = temp_dir();
-  const std::string cmd = std::string(STUDIO_SCENE_CLI) + " " + args + " >" + (d / "stdout").string() +
-                          " 2>" + (d / "stderr").string();
+  const std::string cmd = std::string(STUDIO_SCENE_CLI) + " " + args + " >" +
+                          (d / "stdout").string() + " 2>" + (d / "stderr").string();
   const int rc = std::system(cmd.c_str());
   auto slurp = [](const fs::path& p) {
     std::ifstream in(p);
@@ -61,14 +61,17 @@ TEST(SceneCli, ViewFrameAndMeshChangeThePicture) {
   const fs::path d = temp_dir();
   ASSERT_EQ(run("render --size 320x180 --out " + (d / "a.png").string()).status, 0);
   // An actor: an ASCII PLY tetrahedron-ish box in front of the camera.
-  std::ofstream(d / "actor.ply") << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
-                                    "property float y\nproperty float z\nelement face 4\n"
-                                    "property list uchar int vertex_indices\nend_header\n"
-                                    "-0.5 0 0\n0.5 0 0\n0 1.8 0\n0 0.9 0.5\n3 0 1 2\n3 0 1 3\n3 1 2 3\n3 0 2 3\n";
-  const Outcome with_mesh = run("render --size 320x180 --mesh " + (d / "actor.ply").string() + " --out " + (d / "b.png").string());
+  std::ofstream(d / "actor.ply")
+      << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+         "property float y\nproperty float z\nelement face 4\n"
+         "property list uchar int vertex_indices\nend_header\n"
+         "-0.5 0 0\n0.5 0 0\n0 1.8 0\n0 0.9 0.5\n3 0 1 2\n3 0 1 3\n3 1 2 3\n3 0 2 3\n";
+  const Outcome with_mesh = run("render --size 320x180 --mesh " + (d / "actor.ply").string() +
+                                " --out " + (d / "b.png").string());
   ASSERT_EQ(with_mesh.status, 0) << with_mesh.err;
-  const Outcome moved = run("render --size 320x180 --view eye=0,1.7,0,at=0,1.5,-8,fov=50 --frame 40 --out " +
-                        (d / "c.png").string());
+  const Outcome moved =
+      run("render --size 320x180 --view eye=0,1.7,0,at=0,1.5,-8,fov=50 --frame 40 --out " +
+          (d / "c.png").string());
   ASSERT_EQ(moved.status, 0) << moved.err;
   const cv::Mat a = cv::imread((d / "a.png").string()), b = cv::imread((d / "b.png").string()),
                 c = cv::imread((d / "c.png").string());
@@ -88,7 +91,8 @@ TEST(SceneCli, BadInputIsOneLineAndNonZero) {
   const std::string out = " --out " + (d / "x.png").string();
   expect_one_line_error(run("render --scene " + (d / "none.yaml").string() + out), "none.yaml");
   std::ofstream(d / "malformed.yaml") << "set: [museum.glb\nnodes: {\n";
-  expect_one_line_error(run("render --scene " + (d / "malformed.yaml").string() + out), "malformed.yaml");
+  expect_one_line_error(run("render --scene " + (d / "malformed.yaml").string() + out),
+                        "malformed.yaml");
   std::ofstream(d / "unknown.yaml") << "set_idd: x\n";
   expect_one_line_error(run("render --scene " + (d / "unknown.yaml").string() + out), "set_idd");
   std::ofstream(d / "noset.yaml") << "set: nowhere.glb\n";

@@ -26,7 +26,8 @@ using namespace studio;
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: studio-scene render [--scene FILE] [--view eye=X,Y,Z,at=X,Y,Z[,fov=DEG]]
+constexpr const char* kUsage =
+    R"(usage: studio-scene render [--scene FILE] [--view eye=X,Y,Z,at=X,Y,Z[,fov=DEG]]
                            [--size WxH] [--frame N] [--mesh FILE.ply] --out PNG
 
 Commands:
@@ -49,7 +50,6 @@ render options:
 Exit status: 0 written; 2 bad arguments or input (missing or malformed scene file, unknown set,
 bad --view); 1 rendering failed (no EGL, output not writable). Errors are one line on stderr.
 )";
-
 
 [[noreturn]] void die(const std::string& message, int status = 2) {
   std::fprintf(stderr, "studio-scene: %s\n", message.c_str());
@@ -125,7 +125,8 @@ scene_assets::ViewSpec auto_view(const scene::Scene& s, const scene_assets::Asse
   for (const auto& [id, n] : s.nodes())
     if (n.kind == scene::NodeKind::model)
       if (auto a = cache.find(n.asset.path)) box.extend(scene_assets::world_bounds(s, id, *a));
-  if (box.isEmpty()) box = Eigen::AlignedBox3d(Eigen::Vector3d(-2, 0, -2), Eigen::Vector3d(2, 2, 2));
+  if (box.isEmpty())
+    box = Eigen::AlignedBox3d(Eigen::Vector3d(-2, 0, -2), Eigen::Vector3d(2, 2, 2));
   const Eigen::Vector3d c = box.center();
   const double d = box.sizes().norm();
   scene_assets::ViewSpec v;
@@ -203,16 +204,21 @@ int render(int argc, char** argv) {
       const auto base = static_cast<std::uint32_t>(actor->vertices.size());
       actor->vertices.insert(actor->vertices.end(), m.positions.begin(), m.positions.end());
       actor->normals.insert(actor->normals.end(), m.normals.begin(), m.normals.end());
-      if (!m.colours.empty()) actor->colours.insert(actor->colours.end(), m.colours.begin(), m.colours.end());
+      if (!m.colours.empty())
+        actor->colours.insert(actor->colours.end(), m.colours.begin(), m.colours.end());
       for (std::size_t k = 0; k + 2 < m.indices.size(); k += 3)
-        actor->triangles.push_back({base + m.indices[k], base + m.indices[k + 1], base + m.indices[k + 2]});
+        actor->triangles.push_back(
+            {base + m.indices[k], base + m.indices[k + 1], base + m.indices[k + 2]});
     }
     if (actor->colours.size() != actor->vertices.size()) actor->colours.clear();
   }
 
-  const scene_assets::ViewSpec v = view ? *view : description->view ? *description->view : auto_view(s, cache);
+  const scene_assets::ViewSpec v = view                ? *view
+                                   : description->view ? *description->view
+                                                       : auto_view(s, cache);
   scene_render::View camera;
-  camera.cam_from_world = scene::look_at({v.eye[0], v.eye[1], v.eye[2]}, {v.at[0], v.at[1], v.at[2]});
+  camera.cam_from_world =
+      scene::look_at({v.eye[0], v.eye[1], v.eye[2]}, {v.at[0], v.at[1], v.at[2]});
   camera.clip_from_cam = scene::perspective(v.fov_deg * std::numbers::pi / 180,
                                             static_cast<double>(width) / height, 0.05, 200.0);
 
@@ -240,7 +246,8 @@ int render(int argc, char** argv) {
   }
   if (!written) die("cannot write '" + out + "' (a .png path in an existing folder)", 1);
   std::printf("%s: %dx%d, frame %lld, %d draw calls, %s\n", out.c_str(), width, height,
-              static_cast<long long>(frame), renderer->draw_calls_last_frame(), context->renderer().c_str());
+              static_cast<long long>(frame), renderer->draw_calls_last_frame(),
+              context->renderer().c_str());
   return 0;
 }
 

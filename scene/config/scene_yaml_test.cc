@@ -1,8 +1,9 @@
 // scene.yaml: the default scene file, strict errors naming the key, build_scene.
+#include "scene_config/scene_yaml.h"
+
 #include <gtest/gtest.h>
 
 #include "scene_assets/scene_description.h"
-#include "scene_config/scene_yaml.h"
 
 using namespace studio;
 using namespace studio::scene_assets;
@@ -47,7 +48,8 @@ animations:
       - {node: a, path: translation, interpolation: step, times: [0, 1], values: [0, 0, 0, 0, 1, 0]}
 play:
   - {animation: bob, at_frame: 10, speed: 2}
-)", "scene.yaml");
+)",
+                            "scene.yaml");
   ASSERT_TRUE(d) << d.error().message;
   AssetCache cache;
   auto s = build_scene(*d, cache, 20);
@@ -60,13 +62,17 @@ play:
 }
 
 TEST(SceneYaml, ErrorsNameFileLineAndKey) {
-  EXPECT_NE(error_of("sett: museum.glb\n").find("scene.yaml:1: sett: unknown key"), std::string::npos)
+  EXPECT_NE(error_of("sett: museum.glb\n").find("scene.yaml:1: sett: unknown key"),
+            std::string::npos)
       << error_of("sett: museum.glb\n");
   EXPECT_NE(error_of("fps: fast\n").find("fps"), std::string::npos);
-  EXPECT_NE(error_of("nodes:\n  - {id: a, colour: [1, 0, 0]}\n").find("nodes[0].colour"), std::string::npos)
+  EXPECT_NE(error_of("nodes:\n  - {id: a, colour: [1, 0, 0]}\n").find("nodes[0].colour"),
+            std::string::npos)
       << error_of("nodes:\n  - {id: a, colour: [1, 0, 0]}\n");
-  EXPECT_NE(error_of("nodes:\n  - {parent: x}\n").find("id: missing required key"), std::string::npos);
-  EXPECT_NE(error_of("play:\n  - {animation: x, mode: sideways}\n").find("mode"), std::string::npos);
+  EXPECT_NE(error_of("nodes:\n  - {parent: x}\n").find("id: missing required key"),
+            std::string::npos);
+  EXPECT_NE(error_of("play:\n  - {animation: x, mode: sideways}\n").find("mode"),
+            std::string::npos);
   EXPECT_NE(error_of("view: {eye: [0, 0, 0]}\n").find("at"), std::string::npos);
   EXPECT_NE(error_of("nodes: [\n").find("scene.yaml"), std::string::npos);
   for (const char* bad : {"sett: x\n", "fps: fast\n", "nodes: [\n"})
@@ -80,14 +86,17 @@ TEST(SceneYaml, BuildErrorsNameTheSceneFile) {
   ASSERT_TRUE(d);
   auto s = build_scene(*d, cache);
   ASSERT_FALSE(s);
-  EXPECT_NE(s.error().message.find("/tmp/scene.yaml: set:"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("/tmp/scene.yaml: set:"), std::string::npos)
+      << s.error().message;
   auto orphan = parse_scene_text("nodes:\n  - {id: a, parent: ghost}\n", "scene.yaml");
   ASSERT_TRUE(orphan);
   auto o = build_scene(*orphan, cache);
   ASSERT_FALSE(o);
-  EXPECT_NE(o.error().message.find("unknown parent 'ghost'"), std::string::npos) << o.error().message;
+  EXPECT_NE(o.error().message.find("unknown parent 'ghost'"), std::string::npos)
+      << o.error().message;
   auto bad_track = parse_scene_text(
-      "animations:\n  - {name: x, tracks: [{node: a, times: [0, 1], values: [1, 2, 3]}]}\n", "s.yaml");
+      "animations:\n  - {name: x, tracks: [{node: a, times: [0, 1], values: [1, 2, 3]}]}\n",
+      "s.yaml");
   ASSERT_TRUE(bad_track);
   EXPECT_FALSE(build_scene(*bad_track, cache));
 }

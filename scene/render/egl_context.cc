@@ -1,10 +1,11 @@
+#include "scene_render/egl_context.h"
+
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 
 #include <cstring>
 
 #include "gl.h"
-#include "scene_render/egl_context.h"
 
 namespace studio::scene_render {
 
@@ -46,13 +47,16 @@ HeadlessContext::~HeadlessContext() = default;
 Expected<HeadlessContext> HeadlessContext::create() {
   const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
   if (!has_extension(client, "EGL_MESA_platform_surfaceless"))
-    return fail("EGL: no surfaceless platform (EGL_MESA_platform_surfaceless missing; is Mesa's libegl-mesa0 installed?)");
+    return fail(
+        "EGL: no surfaceless platform (EGL_MESA_platform_surfaceless missing; is Mesa's "
+        "libegl-mesa0 installed?)");
   auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
       eglGetProcAddress("eglGetPlatformDisplayEXT"));
   if (!get_platform_display) return fail("EGL: eglGetPlatformDisplayEXT missing");
   auto impl = std::make_unique<Impl>();
   impl->display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-  if (impl->display == EGL_NO_DISPLAY) return fail(egl_error("eglGetPlatformDisplayEXT(surfaceless)"));
+  if (impl->display == EGL_NO_DISPLAY)
+    return fail(egl_error("eglGetPlatformDisplayEXT(surfaceless)"));
   EGLint major = 0, minor = 0;
   if (!eglInitialize(impl->display, &major, &minor)) {
     impl->display = EGL_NO_DISPLAY;
@@ -66,8 +70,10 @@ Expected<HeadlessContext> HeadlessContext::create() {
   EGLint count = 0;
   if (!eglChooseConfig(impl->display, config_attribs, &config, 1, &count) || count < 1)
     config = nullptr;  // EGL_KHR_no_config_context: Mesa accepts a context without a config
-  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3,
-                                    EGL_CONTEXT_MINOR_VERSION, 3,
+  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                    3,
+                                    EGL_CONTEXT_MINOR_VERSION,
+                                    3,
                                     EGL_CONTEXT_OPENGL_PROFILE_MASK,
                                     EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                     EGL_NONE};

@@ -20,7 +20,7 @@ namespace {
 
 const std::string kDefault = std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml";
 constexpr int kW = 1280, kH = 720;
-const char* kExhibits[] = {"exhibit_red_sphere", "exhibit_green_torus", "exhibit_blue_vase",
+const char* kExhibits[] = {"exhibit_red_sphere",  "exhibit_green_torus",  "exhibit_blue_vase",
                            "exhibit_yellow_knot", "exhibit_magenta_cone", "exhibit_cyan_cube"};
 
 int hue_of(const Eigen::Vector4f& rgba) {
@@ -57,8 +57,10 @@ class DefaultScene : public ::testing::Test {
     ASSERT_TRUE(t) << t.error().message;
     target_.emplace(std::move(*t));
     const auto& v = *description_.view;
-    view_.cam_from_world = scene::look_at({v.eye[0], v.eye[1], v.eye[2]}, {v.at[0], v.at[1], v.at[2]});
-    view_.clip_from_cam = scene::perspective(v.fov_deg * std::numbers::pi / 180, double(kW) / kH, 0.05, 200);
+    view_.cam_from_world =
+        scene::look_at({v.eye[0], v.eye[1], v.eye[2]}, {v.at[0], v.at[1], v.at[2]});
+    view_.clip_from_cam =
+        scene::perspective(v.fov_deg * std::numbers::pi / 180, double(kW) / kH, 0.05, 200);
     museum_ = cache_.find(description_.set);
     ASSERT_NE(museum_, nullptr);
   }
@@ -84,16 +86,21 @@ class DefaultScene : public ::testing::Test {
     Eigen::AlignedBox2d r;
     for (int c = 0; c < 8; ++c) {
       bool in_front = false;
-      r.extend(scene::project_to_pixel(clip_from_world, b.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)), kW, kH, &in_front));
+      r.extend(scene::project_to_pixel(clip_from_world,
+                                       b.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)),
+                                       kW, kH, &in_front));
       EXPECT_TRUE(in_front);
     }
-    const int x0 = std::max(0, int(std::floor(r.min().x()))), y0 = std::max(0, int(std::floor(r.min().y())));
-    const int x1 = std::min(kW, int(std::ceil(r.max().x()))), y1 = std::min(kH, int(std::ceil(r.max().y())));
+    const int x0 = std::max(0, int(std::floor(r.min().x()))),
+              y0 = std::max(0, int(std::floor(r.min().y())));
+    const int x1 = std::min(kW, int(std::ceil(r.max().x()))),
+              y1 = std::min(kH, int(std::ceil(r.max().y())));
     return {x0, y0, std::max(0, x1 - x0), std::max(0, y1 - y0)};
   }
   int expected_hue(const std::string& name) {
     const int i = museum_->find_node(name);
-    return hue_of(museum_->materials[museum_->meshes[museum_->nodes[i].meshes[0]].material].base_colour);
+    return hue_of(
+        museum_->materials[museum_->meshes[museum_->nodes[i].meshes[0]].material].base_colour);
   }
   // Saturated pixels (S > 120 of 255) of hue within 6 (OpenCV units, 12 degrees) of `hue`.
   static cv::Mat matches(const cv::Mat& bgr, int hue) {
@@ -145,7 +152,8 @@ TEST_F(DefaultScene, ExhibitsAppearWhereTheCameraModelPutsThemInTheirColours) {
     // No other exhibit's colour rivals it there.
     for (const char* other : kExhibits) {
       if (std::string(other) == name) continue;
-      EXPECT_LT(cv::countNonZero(matches(image, expected_hue(other))(box)), inside / 3) << name << " vs " << other;
+      EXPECT_LT(cv::countNonZero(matches(image, expected_hue(other))(box)), inside / 3)
+          << name << " vs " << other;
     }
   }
 }
@@ -175,11 +183,14 @@ TEST_F(DefaultScene, ActorMaskIsFlatBlackWithoutDepthTest) {
   scene::ActorMesh actor;
   actor.actor_id = "actor0";
   const Eigen::Vector3d sphere(-7.5, 1.55, -8), eye(description_.view->eye.data());
-  const Eigen::Vector3f c = (sphere + 0.8 * (sphere - eye).normalized()).cast<float>(), h(0.3f, 0.3f, 0.1f);
+  const Eigen::Vector3f c = (sphere + 0.8 * (sphere - eye).normalized()).cast<float>(),
+                        h(0.3f, 0.3f, 0.1f);
   for (int k = 0; k < 8; ++k)
-    actor.vertices.push_back(c + Eigen::Vector3f(k & 1 ? h.x() : -h.x(), k & 2 ? h.y() : -h.y(), k & 4 ? h.z() : -h.z()));
-  const std::array<std::uint32_t, 3> tris[] = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5}, {0, 4, 5}, {0, 5, 1},
-                                               {2, 3, 7}, {2, 7, 6}, {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
+    actor.vertices.push_back(c + Eigen::Vector3f(k & 1 ? h.x() : -h.x(), k & 2 ? h.y() : -h.y(),
+                                                 k & 4 ? h.z() : -h.z()));
+  const std::array<std::uint32_t, 3> tris[] = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5},
+                                               {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6},
+                                               {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
   actor.triangles.assign(std::begin(tris), std::end(tris));
   ASSERT_TRUE(renderer_->set_actor_mesh(actor));
   const cv::Rect box = box_of("exhibit_red_sphere");

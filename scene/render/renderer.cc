@@ -39,7 +39,8 @@ void release(GpuMesh& m) {
 
 void release(GpuAsset& a) {
   for (GpuMesh& m : a.meshes) release(m);
-  if (!a.textures.empty()) glDeleteTextures(static_cast<GLsizei>(a.textures.size()), a.textures.data());
+  if (!a.textures.empty())
+    glDeleteTextures(static_cast<GLsizei>(a.textures.size()), a.textures.data());
   a = GpuAsset{};
 }
 
@@ -48,7 +49,8 @@ GLuint upload_texture(int width, int height, const std::uint8_t* rgba_bottom_fir
   glGenTextures(1, &t);
   glBindTexture(GL_TEXTURE_2D, t);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba_bottom_first);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+               rgba_bottom_first);
   glGenerateMipmap(GL_TEXTURE_2D);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -65,15 +67,19 @@ void set_layout() {
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(0));
   glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(3 * sizeof(float)));
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
+                        reinterpret_cast<void*>(3 * sizeof(float)));
   glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(6 * sizeof(float)));
+  glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
+                        reinterpret_cast<void*>(6 * sizeof(float)));
   glEnableVertexAttribArray(3);
-  glVertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(8 * sizeof(float)));
+  glVertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, stride,
+                        reinterpret_cast<void*>(8 * sizeof(float)));
 }
 
 // Writes vertices into `mesh`'s buffers, growing them when needed (never shrinking).
-void fill(GpuMesh& mesh, const std::vector<float>& vertices, const std::vector<std::uint32_t>& indices) {
+void fill(GpuMesh& mesh, const std::vector<float>& vertices,
+          const std::vector<std::uint32_t>& indices) {
   if (!mesh.vao) {
     glGenVertexArrays(1, &mesh.vao);
     glGenBuffers(1, &mesh.vbo);
@@ -84,17 +90,20 @@ void fill(GpuMesh& mesh, const std::vector<float>& vertices, const std::vector<s
     set_layout();
   }
   glBindVertexArray(mesh.vao);
-  const std::size_t vb = vertices.size() * sizeof(float), ib = indices.size() * sizeof(std::uint32_t);
+  const std::size_t vb = vertices.size() * sizeof(float),
+                    ib = indices.size() * sizeof(std::uint32_t);
   glBindBuffer(GL_ARRAY_BUFFER, mesh.vbo);
   if (vb > mesh.vbo_bytes) {
     mesh.vbo_bytes = std::max(vb, mesh.vbo_bytes * 3 / 2);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vbo_bytes), nullptr, GL_DYNAMIC_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vbo_bytes), nullptr,
+                 GL_DYNAMIC_DRAW);
   }
   glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(vb), vertices.data());
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.ebo);
   if (ib > mesh.ebo_bytes) {
     mesh.ebo_bytes = std::max(ib, mesh.ebo_bytes * 3 / 2);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.ebo_bytes), nullptr, GL_DYNAMIC_DRAW);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.ebo_bytes), nullptr,
+                 GL_DYNAMIC_DRAW);
   }
   glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(ib), indices.data());
   mesh.index_count = static_cast<GLsizei>(indices.size());
@@ -129,6 +138,7 @@ struct Renderer::Impl {
   std::vector<float> vertex_scratch;
   std::vector<std::uint32_t> index_scratch;
   int draw_calls = 0;
+  bool culling = false;
 
   ~Impl() {
     for (auto& [p, a] : assets) release(a);
@@ -180,7 +190,8 @@ struct Renderer::Impl {
         for (int k = 0; k < 3; ++k) position[4 * count + k] = static_cast<float>(origin[k]);
         position[4 * count + 3] = 1;
       }
-      for (int k = 0; k < 3; ++k) radiance[3 * count + k] = l.colour[k] * l.intensity * options.exposure;
+      for (int k = 0; k < 3; ++k)
+        radiance[3 * count + k] = l.colour[k] * l.intensity * options.exposure;
       for (int k = 0; k < 3; ++k) spot[4 * count + k] = static_cast<float>(axis[k]);
       spot[4 * count + 3] = l.type == scene::LightType::spot ? std::cos(l.outer_cone) : -2.0f;
       inner[count] = std::cos(l.inner_cone);
@@ -222,11 +233,23 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
   impl->quad_program = *quad;
   const GLuint p = impl->program;
   auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
-  impl->u = Uniforms{loc("u_clip_from_world"), loc("u_world_from_model"), loc("u_normal_matrix"),
-                     loc("u_inflate"), loc("u_base"), loc("u_textured"), loc("u_texture"),
-                     loc("u_emissive"), loc("u_unlit"), loc("u_eye"), loc("u_ambient"),
-                     loc("u_light_count"), loc("u_light_position[0]"), loc("u_light_radiance[0]"),
-                     loc("u_light_spot[0]"), loc("u_light_spot_inner[0]"), loc("u_light_range[0]")};
+  impl->u = Uniforms{loc("u_clip_from_world"),
+                     loc("u_world_from_model"),
+                     loc("u_normal_matrix"),
+                     loc("u_inflate"),
+                     loc("u_base"),
+                     loc("u_textured"),
+                     loc("u_texture"),
+                     loc("u_emissive"),
+                     loc("u_unlit"),
+                     loc("u_eye"),
+                     loc("u_ambient"),
+                     loc("u_light_count"),
+                     loc("u_light_position[0]"),
+                     loc("u_light_radiance[0]"),
+                     loc("u_light_spot[0]"),
+                     loc("u_light_spot_inner[0]"),
+                     loc("u_light_range[0]")};
   impl->quad_texture = glGetUniformLocation(impl->quad_program, "u_texture");
   impl->quad_tex_from_screen = glGetUniformLocation(impl->quad_program, "u_tex_from_screen");
   glGenVertexArrays(1, &impl->quad_vao);
@@ -241,7 +264,8 @@ Expected<void> Renderer::upload(const scene_assets::Asset& asset) {
   g.sha256 = asset.sha256;
   g.materials = asset.materials;
   for (const scene_assets::Texture& t : asset.textures) {
-    if (t.width < 1 || t.height < 1 || t.rgba.size() != static_cast<std::size_t>(t.width) * t.height * 4)
+    if (t.width < 1 || t.height < 1 ||
+        t.rgba.size() != static_cast<std::size_t>(t.width) * t.height * 4)
       return fail(asset.path + ": texture '" + t.name + "' has a bad size");
     g.textures.push_back(upload_texture(t.width, t.height, t.rgba.data()));
   }
@@ -251,8 +275,9 @@ Expected<void> Renderer::upload(const scene_assets::Asset& asset) {
     for (std::size_t i = 0; i < m.positions.size(); ++i) {
       const Eigen::Vector2f uv = m.uvs.empty() ? Eigen::Vector2f::Zero() : m.uvs[i];
       const Eigen::Vector3f c = m.colours.empty() ? Eigen::Vector3f::Ones() : m.colours[i];
-      v.insert(v.end(), {m.positions[i].x(), m.positions[i].y(), m.positions[i].z(), m.normals[i].x(),
-                         m.normals[i].y(), m.normals[i].z(), uv.x(), uv.y(), c.x(), c.y(), c.z()});
+      v.insert(v.end(),
+               {m.positions[i].x(), m.positions[i].y(), m.positions[i].z(), m.normals[i].x(),
+                m.normals[i].y(), m.normals[i].z(), uv.x(), uv.y(), c.x(), c.y(), c.z()});
     }
     GpuMesh gm;
     fill(gm, v, m.indices);
@@ -297,7 +322,8 @@ std::vector<AssetStatus> Renderer::check_assets(const scene::Scene& scene) const
     if (it == impl_->assets.end())
       out[n.asset.path] = {n.asset.path, n.asset.sha256, "", AssetStatus::State::missing};
     else if (it->second.sha256 != n.asset.sha256)
-      out[n.asset.path] = {n.asset.path, n.asset.sha256, it->second.sha256, AssetStatus::State::different};
+      out[n.asset.path] = {n.asset.path, n.asset.sha256, it->second.sha256,
+                           AssetStatus::State::different};
   }
   std::vector<AssetStatus> v;
   for (auto& [p, s] : out) v.push_back(std::move(s));
@@ -313,6 +339,9 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CCW);
+  r.culling = false;
   glDisable(GL_BLEND);
   glUseProgram(r.program);
 
@@ -321,7 +350,8 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   const auto& parent = scene.parent_index();
   r.visible.resize(order.size());
   for (std::size_t i = 0; i < order.size(); ++i)
-    r.visible[i] = order[i]->visible && (parent[i] < 0 || r.visible[static_cast<std::size_t>(parent[i])]);
+    r.visible[i] =
+        order[i]->visible && (parent[i] < 0 || r.visible[static_cast<std::size_t>(parent[i])]);
 
   const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
   const Eigen::Vector3f eye = view.cam_from_world.inverse().col(3).head<3>().cast<float>();
@@ -341,7 +371,8 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
       if (it == r.assets.end() || it->second.sha256 != n.asset.sha256) continue;  // check_assets()
       const GpuAsset& a = it->second;
       r.set_matrices(r.world[i]);
-      const GLuint override_texture = n.material.texture.empty() ? 0 : r.texture_for_path(n.material.texture);
+      const GLuint override_texture =
+          n.material.texture.empty() ? 0 : r.texture_for_path(n.material.texture);
       auto draw_one = [&](std::size_t m) {
         if (m >= a.meshes.size()) return;
         const GpuMesh& mesh = a.meshes[m];
@@ -349,10 +380,19 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
         Eigen::Vector3f emissive = Eigen::Vector3f::Zero();
         GLuint texture = override_texture;
         if (mesh.material >= 0) {
-          const scene_assets::MaterialData& md = a.materials[static_cast<std::size_t>(mesh.material)];
+          const scene_assets::MaterialData& md =
+              a.materials[static_cast<std::size_t>(mesh.material)];
           base = base.cwiseProduct(md.base_colour);
           emissive = md.emissive;
-          if (!texture && md.texture >= 0) texture = a.textures[static_cast<std::size_t>(md.texture)];
+          if (!texture && md.texture >= 0)
+            texture = a.textures[static_cast<std::size_t>(md.texture)];
+        }
+        bool cull = false;
+        if (mesh.material >= 0)
+          cull = !a.materials[static_cast<std::size_t>(mesh.material)].double_sided;
+        if (cull != r.culling) {
+          cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+          r.culling = cull;
         }
         glUniform4fv(r.u.base, 1, base.data());
         glUniform3fv(r.u.emissive, 1, emissive.data());
@@ -368,6 +408,8 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
     } else if (n.kind == scene::NodeKind::actor) {
       auto it = r.actors.find(n.actor_id);
       if (it == r.actors.end() || it->second.index_count == 0) continue;
+      if (r.culling) glDisable(GL_CULL_FACE);  // actor meshes are drawn two-sided
+      r.culling = false;
       r.set_matrices(r.world[i]);
       glUniform4fv(r.u.base, 1, n.material.colour.data());
       const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
@@ -378,6 +420,8 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
     }
   }
   glBindVertexArray(0);
+  glDisable(GL_CULL_FACE);
+  r.culling = false;
 }
 
 void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, float inflate_m,

@@ -1,8 +1,8 @@
 #include "scene/animation.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <Eigen/Geometry>
 
 namespace studio::scene {
 namespace {
@@ -107,18 +107,24 @@ Eigen::Vector4d sample_linear_scan(const Track& track, double t) {
 
 const char* to_string(TrackPath p) {
   switch (p) {
-    case TrackPath::translation: return "translation";
-    case TrackPath::rotation: return "rotation";
-    case TrackPath::scale: return "scale";
+    case TrackPath::translation:
+      return "translation";
+    case TrackPath::rotation:
+      return "rotation";
+    case TrackPath::scale:
+      return "scale";
   }
   return "?";
 }
 const char* to_string(Interpolation i) { return i == Interpolation::step ? "step" : "linear"; }
 const char* to_string(PlayMode m) {
   switch (m) {
-    case PlayMode::once: return "once";
-    case PlayMode::loop: return "loop";
-    case PlayMode::ping_pong: return "ping_pong";
+    case PlayMode::once:
+      return "once";
+    case PlayMode::loop:
+      return "loop";
+    case PlayMode::ping_pong:
+      return "ping_pong";
   }
   return "?";
 }

@@ -20,7 +20,8 @@ bool unit_colour(const auto& c) {
 
 Expected<void> Node::validate() const {
   if (id.empty()) return fail("node id is empty");
-  if (!printable(id) || id.size() > 256) return fail("node id '" + id + "' is not a printable name of <= 256 bytes");
+  if (!printable(id) || id.size() > 256)
+    return fail("node id '" + id + "' is not a printable name of <= 256 bytes");
   if (!printable(parent)) return fail("node '" + id + "': parent id has control characters");
   if (parent == id) return fail("node '" + id + "' is its own parent");
   if (auto ok = local.validate(); !ok) return fail("node '" + id + "': " + ok.error().message);
@@ -31,7 +32,8 @@ Expected<void> Node::validate() const {
       if (asset.path.empty()) return fail("node '" + id + "': a model needs an asset path");
       break;
     case NodeKind::light:
-      if (!unit_colour(light.colour)) return fail("node '" + id + "': light colour must be in [0, 1]");
+      if (!unit_colour(light.colour))
+        return fail("node '" + id + "': light colour must be in [0, 1]");
       if (!std::isfinite(light.intensity) || light.intensity < 0)
         return fail("node '" + id + "': light intensity must be finite and >= 0");
       if (!std::isfinite(light.range) || light.range < 0)
@@ -53,19 +55,26 @@ Expected<void> Node::validate() const {
 
 const char* to_string(NodeKind kind) {
   switch (kind) {
-    case NodeKind::group: return "group";
-    case NodeKind::model: return "model";
-    case NodeKind::light: return "light";
-    case NodeKind::actor: return "actor";
+    case NodeKind::group:
+      return "group";
+    case NodeKind::model:
+      return "model";
+    case NodeKind::light:
+      return "light";
+    case NodeKind::actor:
+      return "actor";
   }
   return "?";
 }
 
 const char* to_string(LightType type) {
   switch (type) {
-    case LightType::point: return "point";
-    case LightType::directional: return "directional";
-    case LightType::spot: return "spot";
+    case LightType::point:
+      return "point";
+    case LightType::directional:
+      return "directional";
+    case LightType::spot:
+      return "spot";
   }
   return "?";
 }

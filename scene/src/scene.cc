@@ -20,9 +20,10 @@ struct Overload : F... {
 
 const char* command_name(const CommandOp& op) {
   static constexpr const char* kNames[] = {
-      "add_node", "remove_node", "set_transform", "set_parent", "set_material",
-      "set_visible", "add_animation", "remove_animation", "play", "pause", "seek", "set_speed",
-      "tick", "batch"};
+      "add_node",     "remove_node", "set_transform", "set_parent",
+      "set_material", "set_visible", "add_animation", "remove_animation",
+      "play",         "pause",       "seek",          "set_speed",
+      "tick",         "batch"};
   return kNames[op.index()];
 }
 
@@ -35,9 +36,14 @@ Expected<void> SceneOptions::validate() const {
 Scene::Scene(SceneOptions options) : options_(options) {}
 
 Scene::Scene(const Scene& o)
-    : options_(o.options_), frame_(o.frame_), nodes_(o.nodes_), animations_(o.animations_),
-      updated_(o.updated_), removed_(o.removed_) {
+    : options_(o.options_),
+      frame_(o.frame_),
+      nodes_(o.nodes_),
+      animations_(o.animations_),
+      updated_(o.updated_),
+      removed_(o.removed_) {
   rebuild_order();
+  rebuild_targets();
 }
 
 Scene& Scene::operator=(const Scene& o) {
@@ -103,7 +109,8 @@ Expected<void> Scene::validate(const Command& c) const {
           },
           [&](const SetTransform& x) -> Expected<void> {
             if (auto n = need_node(x.id); !n) return std::unexpected(n.error());
-            if (auto ok = x.local.validate(); !ok) return err("'" + x.id + "': " + ok.error().message);
+            if (auto ok = x.local.validate(); !ok)
+              return err("'" + x.id + "': " + ok.error().message);
             return {};
           },
           [&](const SetParent& x) -> Expected<void> {
@@ -134,7 +141,8 @@ Expected<void> Scene::validate(const Command& c) const {
               return err("animation '" + x.animation.name + "' exists");
             for (const Track& t : x.animation.tracks)
               if (!nodes_.contains(t.node))
-                return err("animation '" + x.animation.name + "' drives unknown node '" + t.node + "'");
+                return err("animation '" + x.animation.name + "' drives unknown node '" + t.node +
+                           "'");
             return {};
           },
           [&](const RemoveAnimation& x) -> Expected<void> {
@@ -173,91 +181,95 @@ void Scene::mutate(const Command& c) {
     for (auto& [name, entry] : animations_)
       if (a.empty() || a == name) fn(entry);
   };
-  std::visit(
-      Overload{
-          [&](const AddNode& x) {
-            Node n = x.node;
-            n.local = n.local.normalized();
-            n.frame = f;
-            removed_.erase(n.id);
-            updated_.insert(n.id);
-            nodes_.emplace(n.id, std::move(n));
-            rebuild_order();
-          },
-          [&](const RemoveNode& x) {
-            std::vector<NodeId> doomed;
-            for (const auto& [id, n] : nodes_)
-              if (in_subtree(id, x.id)) doomed.push_back(id);
-            for (const NodeId& id : doomed) {
-              nodes_.erase(id);
-              updated_.erase(id);
-              removed_.insert(id);
-            }
-            rebuild_order();
-          },
-          [&](const SetTransform& x) {
-            Node& n = nodes_.at(x.id);
-            n.local = x.local.normalized();
-            touch(n, f);
-          },
-          [&](const SetParent& x) {
-            Node& n = nodes_.at(x.id);
-            n.parent = x.parent;
-            touch(n, f);
-            rebuild_order();
-          },
-          [&](const SetMaterial& x) {
-            Node& n = nodes_.at(x.id);
-            n.material = x.material;
-            touch(n, f);
-          },
-          [&](const SetVisible& x) {
-            Node& n = nodes_.at(x.id);
-            n.visible = x.visible;
-            touch(n, f);
-          },
-          [&](const AddAnimation& x) {
-            AnimationEntry e{x.animation, AnimationClock{}};
-            for (Track& t : e.animation.tracks)
-              if (t.path == TrackPath::rotation)
-                for (auto& v : t.values) v.normalize();
-            e.clock.anchor_frame = f;
-            animations_.emplace(x.animation.name, std::move(e));
-          },
-          [&](const RemoveAnimation& x) { animations_.erase(x.name); },
-          [&](const Play& x) {
-            for_clocks(x.animation, [&](AnimationEntry& e) {
-              e.clock.anchor_time = x.from_time ? *x.from_time
-                                                : e.clock.clock_time(f, options_.frame_period);
-              e.clock.anchor_frame = f;
-              e.clock.playing = true;
-              if (x.mode) e.animation.mode = *x.mode;
-            });
-          },
-          [&](const Pause& x) {
-            for_clocks(x.animation, [&](AnimationEntry& e) {
-              e.clock.anchor_time = e.clock.clock_time(f, options_.frame_period);
-              e.clock.anchor_frame = f;
-              e.clock.playing = false;
-            });
-          },
-          [&](const Seek& x) {
-            for_clocks(x.animation, [&](AnimationEntry& e) {
-              e.clock.anchor_time = x.time;
-              e.clock.anchor_frame = f;
-            });
-          },
-          [&](const SetSpeed& x) {
-            for_clocks(x.animation, [&](AnimationEntry& e) {
-              e.clock.anchor_time = e.clock.clock_time(f, options_.frame_period);
-              e.clock.anchor_frame = f;
-              e.clock.speed = x.speed;
-            });
-          },
-          [&](const Tick&) { evaluate(f); },
-          [&](const Batch&) {},
-      },
-      c.op);
+  std::visit(Overload{
+                 [&](const AddNode& x) {
+                   Node n = x.node;
+                   n.local = n.local.normalized();
+                   n.frame = f;
+                   removed_.erase(n.id);
+                   updated_.insert(n.id);
+                   nodes_.emplace(n.id, std::move(n));
+                   rebuild_order();
+                 },
+                 [&](const RemoveNode& x) {
+                   std::vector<NodeId> doomed;
+                   for (const auto& [id, n] : nodes_)
+                     if (in_subtree(id, x.id)) doomed.push_back(id);
+                   for (const NodeId& id : doomed) {
+                     nodes_.erase(id);
+                     updated_.erase(id);
+                     removed_.insert(id);
+                   }
+                   rebuild_order();
+                 },
+                 [&](const SetTransform& x) {
+                   Node& n = nodes_.at(x.id);
+                   n.local = x.local.normalized();
+                   touch(n, f);
+                 },
+                 [&](const SetParent& x) {
+                   Node& n = nodes_.at(x.id);
+                   n.parent = x.parent;
+                   touch(n, f);
+                   rebuild_order();
+                 },
+                 [&](const SetMaterial& x) {
+                   Node& n = nodes_.at(x.id);
+                   n.material = x.material;
+                   touch(n, f);
+                 },
+                 [&](const SetVisible& x) {
+                   Node& n = nodes_.at(x.id);
+                   n.visible = x.visible;
+                   touch(n, f);
+                 },
+                 [&](const AddAnimation& x) {
+                   AnimationEntry e{x.animation, AnimationClock{}};
+                   for (Track& t : e.animation.tracks)
+                     if (t.path == TrackPath::rotation)
+                       for (auto& v : t.values) v.normalize();
+                   e.clock.anchor_frame = f;
+                   std::vector<Node*>& targets = targets_[x.animation.name];
+                   for (const Track& t : e.animation.tracks) targets.push_back(&nodes_.at(t.node));
+                   animations_.emplace(x.animation.name, std::move(e));
+                 },
+                 [&](const RemoveAnimation& x) {
+                   animations_.erase(x.name);
+                   targets_.erase(x.name);
+                 },
+                 [&](const Play& x) {
+                   for_clocks(x.animation, [&](AnimationEntry& e) {
+                     e.clock.anchor_time =
+                         x.from_time ? *x.from_time : e.clock.clock_time(f, options_.frame_period);
+                     e.clock.anchor_frame = f;
+                     e.clock.playing = true;
+                     if (x.mode) e.animation.mode = *x.mode;
+                   });
+                 },
+                 [&](const Pause& x) {
+                   for_clocks(x.animation, [&](AnimationEntry& e) {
+                     e.clock.anchor_time = e.clock.clock_time(f, options_.frame_period);
+                     e.clock.anchor_frame = f;
+                     e.clock.playing = false;
+                   });
+                 },
+                 [&](const Seek& x) {
+                   for_clocks(x.animation, [&](AnimationEntry& e) {
+                     e.clock.anchor_time = x.time;
+                     e.clock.anchor_frame = f;
+                   });
+                 },
+                 [&](const SetSpeed& x) {
+                   for_clocks(x.animation, [&](AnimationEntry& e) {
+                     e.clock.anchor_time = e.clock.clock_time(f, options_.frame_period);
+                     e.clock.anchor_frame = f;
+                     e.clock.speed = x.speed;
+                   });
+                 },
+                 [&](const Tick&) { evaluate(f); },
+                 [&](const Batch&) {},
+             },
+             c.op);
 }
 
 Expected<void> Scene::apply(const Command& c) {
@@ -281,11 +293,14 @@ Expected<void> Scene::apply(const Command& c) {
 
 void Scene::evaluate(std::int64_t f) {
   frame_ = f;
+  auto targets = targets_.begin();
   for (auto& [name, entry] : animations_) {
     const double t = animation_time(entry.clock.clock_time(f, options_.frame_period),
                                     entry.animation.duration(), entry.animation.mode);
-    for (const Track& track : entry.animation.tracks) {
-      Node& n = nodes_.at(track.node);
+    const std::vector<Node*>& driven = (targets++)->second;
+    for (std::size_t k = 0; k < entry.animation.tracks.size(); ++k) {
+      const Track& track = entry.animation.tracks[k];
+      Node& n = *driven[k];
       const Eigen::Vector4d v = sample(track, t);
       bool changed = false;
       switch (track.path) {
@@ -304,7 +319,10 @@ void Scene::evaluate(std::int64_t f) {
           n.local.scale = v.head<3>();
           break;
       }
-      if (changed) touch(n, f);
+      if (changed) {
+        n.frame = f;
+        if (!updated_.contains(n.id)) updated_.emplace_hint(updated_.end(), n.id);
+      }
     }
   }
 }
@@ -332,6 +350,14 @@ void Scene::rebuild_order() {
   }
 }
 
+void Scene::rebuild_targets() {
+  targets_.clear();
+  for (const auto& [name, entry] : animations_) {
+    std::vector<Node*>& targets = targets_[name];
+    for (const Track& t : entry.animation.tracks) targets.push_back(&nodes_.at(t.node));
+  }
+}
+
 Expected<Eigen::Matrix4d> Scene::world_from_node(const NodeId& id) const {
   const Node* n = find(id);
   if (!n) return fail("unknown node '" + id + "'");
@@ -353,7 +379,8 @@ void Scene::world_from_nodes(std::vector<Eigen::Matrix4d>& out) const {
   out.resize(order_.size());
   for (std::size_t i = 0; i < order_.size(); ++i) {
     const int p = parent_index_[i];
-    out[i] = p < 0 ? order_[i]->local.matrix() : Eigen::Matrix4d(out[p] * order_[i]->local.matrix());
+    out[i] =
+        p < 0 ? order_[i]->local.matrix() : Eigen::Matrix4d(out[p] * order_[i]->local.matrix());
   }
 }
 
@@ -370,6 +397,8 @@ std::uint64_t Scene::state_hash() const {
   const std::vector<std::uint8_t> bytes = serialize(*this);
   return fnv1a64(bytes.data(), bytes.size());
 }
+
+std::uint64_t Scene::nodes_hash() const { return hash_nodes(nodes_); }
 
 Expected<void> Scene::check_invariants() const {
   if (auto ok = options_.validate(); !ok) return ok;

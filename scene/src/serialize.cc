@@ -172,6 +172,13 @@ std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
   return h;
 }
 
+std::uint64_t hash_nodes(const std::map<NodeId, Node>& nodes) {
+  Writer w;
+  w.u32(static_cast<std::uint32_t>(nodes.size()));
+  for (const auto& [id, n] : nodes) write_node(w, n);
+  return fnv1a64(w.bytes.data(), w.bytes.size());
+}
+
 std::vector<std::uint8_t> serialize(const Scene& scene) {
   Writer w;
   w.bytes.insert(w.bytes.end(), kMagic, kMagic + 8);
@@ -207,7 +214,8 @@ Expected<Scene> deserialize(const std::vector<std::uint8_t>& bytes) {
   if (!r.magic()) return fail("scene state: not a scene state (bad magic)");
   SceneOptions options;
   options.frame_period = r.f64();
-  if (auto ok = options.validate(); r.ok() && !ok) return fail("scene state: " + ok.error().message);
+  if (auto ok = options.validate(); r.ok() && !ok)
+    return fail("scene state: " + ok.error().message);
   Scene scene(options);
   scene.frame_ = r.i64();
   const std::size_t n_nodes = r.count(64);
@@ -246,9 +254,11 @@ Expected<Scene> deserialize(const std::vector<std::uint8_t>& bytes) {
       return fail("scene state: animation '" + name + "' appears twice");
   }
   if (!r.ok()) return fail("scene state: truncated or corrupt");
-  if (r.remaining() != 0) return fail("scene state: " + std::to_string(r.remaining()) + " trailing bytes");
+  if (r.remaining() != 0)
+    return fail("scene state: " + std::to_string(r.remaining()) + " trailing bytes");
   scene.rebuild_order();
   if (auto ok = scene.check_invariants(); !ok) return fail("scene state: " + ok.error().message);
+  scene.rebuild_targets();
   // A restored scene publishes every node once.
   for (const auto& [id, n] : scene.nodes_) scene.updated_.insert(id);
   return scene;

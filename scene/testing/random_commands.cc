@@ -7,7 +7,8 @@ namespace studio::scene::testing {
 
 NodeId RandomCommandSource::some_node(const Scene& scene, bool allow_unknown) {
   const auto& nodes = scene.nodes();
-  if (nodes.empty() || (allow_unknown && rng_() % 12 == 0)) return "ghost" + std::to_string(rng_() % 5);
+  if (nodes.empty() || (allow_unknown && rng_() % 12 == 0))
+    return "ghost" + std::to_string(rng_() % 5);
   auto it = nodes.begin();
   std::advance(it, static_cast<long>(rng_() % nodes.size()));
   return it->first;
@@ -16,7 +17,7 @@ NodeId RandomCommandSource::some_node(const Scene& scene, bool allow_unknown) {
 std::string RandomCommandSource::some_animation(const Scene& scene) {
   const auto& anims = scene.animations();
   const auto r = rng_() % 10;
-  if (r == 0) return "";                        // all
+  if (r == 0) return "";                         // all
   if (r == 1 || anims.empty()) return "nosuch";  // unknown
   auto it = anims.begin();
   std::advance(it, static_cast<long>(rng_() % anims.size()));
@@ -31,10 +32,18 @@ Transform RandomCommandSource::some_transform(bool allow_bad) {
   t.scale = Eigen::Vector3d::Constant(0.5 + std::abs(u(rng_)));
   if (allow_bad && rng_() % 10 == 0) {
     switch (rng_() % 4) {
-      case 0: t.translation.y() = NAN; break;
-      case 1: t.rotation.coeffs().setZero(); break;
-      case 2: t.scale.x() = 0; break;
-      default: t.translation.x() = INFINITY; break;
+      case 0:
+        t.translation.y() = NAN;
+        break;
+      case 1:
+        t.rotation.coeffs().setZero();
+        break;
+      case 2:
+        t.scale.x() = 0;
+        break;
+      default:
+        t.translation.x() = INFINITY;
+        break;
     }
   }
   return t;
@@ -47,7 +56,9 @@ Node RandomCommandSource::some_node_to_add(const Scene& scene) {
   n.parent = rng_() % 3 == 0 ? "" : some_node(scene);
   n.local = some_transform(true);
   switch (rng_() % 4) {
-    case 0: n.kind = NodeKind::group; break;
+    case 0:
+      n.kind = NodeKind::group;
+      break;
     case 1:
       n.kind = NodeKind::model;
       n.asset = {rng_() % 10 ? "set.glb" : "", "00ff", {static_cast<std::uint32_t>(rng_() % 4)}};

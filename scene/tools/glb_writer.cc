@@ -71,10 +71,9 @@ int GlbWriter::view(const void* data, std::size_t size, int target) {
 
 int GlbWriter::accessor(int view, int component_type, std::size_t count, const std::string& type,
                         const std::string& min_max) {
-  accessors_.push_back("{\"bufferView\":" + std::to_string(view) +
-                       ",\"componentType\":" + std::to_string(component_type) +
-                       ",\"count\":" + std::to_string(count) + ",\"type\":\"" + type + "\"" +
-                       min_max + "}");
+  accessors_.push_back("{\"bufferView\":" + std::to_string(view) + ",\"componentType\":" +
+                       std::to_string(component_type) + ",\"count\":" + std::to_string(count) +
+                       ",\"type\":\"" + type + "\"" + min_max + "}");
   return static_cast<int>(accessors_.size()) - 1;
 }
 
@@ -88,8 +87,9 @@ int GlbWriter::add_texture_png(const std::string& name, const std::vector<std::u
 
 int GlbWriter::add_material(const std::string& name, const Eigen::Vector4f& base, int texture,
                             const Eigen::Vector3f& emissive) {
-  std::string m = "{\"name\":" + quoted(name) + ",\"pbrMetallicRoughness\":{\"baseColorFactor\":" +
-                  vec(base) + ",\"metallicFactor\":0,\"roughnessFactor\":0.7";
+  std::string m = "{\"name\":" + quoted(name) +
+                  ",\"pbrMetallicRoughness\":{\"baseColorFactor\":" + vec(base) +
+                  ",\"metallicFactor\":0,\"roughnessFactor\":0.7";
   if (texture >= 0) m += ",\"baseColorTexture\":{\"index\":" + std::to_string(texture) + "}";
   m += "},\"emissiveFactor\":" + vec(emissive) + "}";
   materials_.push_back(m);
@@ -106,7 +106,8 @@ int GlbWriter::add_mesh(const std::string& name, const MeshBuild& mesh, int mate
   const int pos = accessor(view(mesh.positions.data(), n * 12, 34962), 5126, n, "VEC3",
                            ",\"min\":" + vec(lo) + ",\"max\":" + vec(hi));
   const int nrm = accessor(view(mesh.normals.data(), n * 12, 34962), 5126, n, "VEC3");
-  std::string attributes = "{\"POSITION\":" + std::to_string(pos) + ",\"NORMAL\":" + std::to_string(nrm);
+  std::string attributes =
+      "{\"POSITION\":" + std::to_string(pos) + ",\"NORMAL\":" + std::to_string(nrm);
   if (!mesh.uvs.empty()) {
     const int uv = accessor(view(mesh.uvs.data(), n * 8, 34962), 5126, n, "VEC2");
     attributes += ",\"TEXCOORD_0\":" + std::to_string(uv);
@@ -114,8 +115,8 @@ int GlbWriter::add_mesh(const std::string& name, const MeshBuild& mesh, int mate
   const int idx = accessor(view(mesh.indices.data(), mesh.indices.size() * 4, 34963), 5125,
                            mesh.indices.size(), "SCALAR");
   meshes_.push_back("{\"name\":" + quoted(name) + ",\"primitives\":[{\"attributes\":" + attributes +
-                    "},\"indices\":" + std::to_string(idx) + ",\"material\":" +
-                    std::to_string(material) + ",\"mode\":4}]}");
+                    "},\"indices\":" + std::to_string(idx) +
+                    ",\"material\":" + std::to_string(material) + ",\"mode\":4}]}");
   return static_cast<int>(meshes_.size()) - 1;
 }
 
@@ -126,8 +127,8 @@ int GlbWriter::add_node(const GltfNode& node) {
 
 int GlbWriter::add_light(const std::string& name, const std::string& type,
                          const Eigen::Vector3f& colour, float intensity) {
-  std::string l = "{\"name\":" + quoted(name) + ",\"type\":\"" + type + "\",\"color\":" +
-                  vec(colour) + ",\"intensity\":" + num(intensity);
+  std::string l = "{\"name\":" + quoted(name) + ",\"type\":\"" + type +
+                  "\",\"color\":" + vec(colour) + ",\"intensity\":" + num(intensity);
   if (type == "spot") l += ",\"spot\":{\"innerConeAngle\":0.3,\"outerConeAngle\":0.7}";
   lights_.push_back(l + "}");
   return static_cast<int>(lights_.size()) - 1;
@@ -137,15 +138,16 @@ void GlbWriter::add_animation(const std::string& name, int node, const std::vect
                               const std::vector<Eigen::Vector3f>& translations,
                               const std::vector<Eigen::Vector4f>& rotations) {
   const std::size_t n = times.size();
-  const int input = accessor(view(times.data(), n * 4, 0), 5126, n, "SCALAR",
-                             ",\"min\":[" + num(times.front()) + "],\"max\":[" + num(times.back()) + "]");
+  const int input =
+      accessor(view(times.data(), n * 4, 0), 5126, n, "SCALAR",
+               ",\"min\":[" + num(times.front()) + "],\"max\":[" + num(times.back()) + "]");
   const int t_out = accessor(view(translations.data(), n * 12, 0), 5126, n, "VEC3");
   const int r_out = accessor(view(rotations.data(), n * 16, 0), 5126, n, "VEC4");
   const std::string in = std::to_string(input);
   animations_.push_back(
-      "{\"name\":" + quoted(name) + ",\"samplers\":[" +
-      "{\"input\":" + in + ",\"output\":" + std::to_string(t_out) + ",\"interpolation\":\"LINEAR\"}," +
-      "{\"input\":" + in + ",\"output\":" + std::to_string(r_out) + ",\"interpolation\":\"LINEAR\"}]," +
+      "{\"name\":" + quoted(name) + ",\"samplers\":[" + "{\"input\":" + in + ",\"output\":" +
+      std::to_string(t_out) + ",\"interpolation\":\"LINEAR\"}," + "{\"input\":" + in +
+      ",\"output\":" + std::to_string(r_out) + ",\"interpolation\":\"LINEAR\"}]," +
       "\"channels\":[{\"sampler\":0,\"target\":{\"node\":" + std::to_string(node) +
       ",\"path\":\"translation\"}},{\"sampler\":1,\"target\":{\"node\":" + std::to_string(node) +
       ",\"path\":\"rotation\"}}]}");
@@ -176,14 +178,18 @@ std::vector<std::uint8_t> GlbWriter::bytes() const {
 
   std::string json = "{\"asset\":{\"version\":\"2.0\",\"generator\":\"studio-scene-museum\"}";
   if (!lights_.empty())
-    json += ",\"extensionsUsed\":[\"KHR_lights_punctual\"],\"extensions\":{\"KHR_lights_punctual\":{\"lights\":" +
-            join(lights_) + "}}";
+    json +=
+        ",\"extensionsUsed\":[\"KHR_lights_punctual\"],\"extensions\":{\"KHR_lights_punctual\":{"
+        "\"lights\":" +
+        join(lights_) + "}}";
   json += ",\"scene\":0,\"scenes\":[{\"name\":\"museum\",\"nodes\":" + join(roots) + "}]";
   json += ",\"nodes\":" + join(nodes) + ",\"meshes\":" + join(meshes_) +
           ",\"materials\":" + join(materials_);
   if (!textures_.empty())
-    json += ",\"samplers\":[{\"magFilter\":9729,\"minFilter\":9987,\"wrapS\":10497,\"wrapT\":10497}]"
-            ",\"images\":" + join(images_) + ",\"textures\":" + join(textures_);
+    json +=
+        ",\"samplers\":[{\"magFilter\":9729,\"minFilter\":9987,\"wrapS\":10497,\"wrapT\":10497}]"
+        ",\"images\":" +
+        join(images_) + ",\"textures\":" + join(textures_);
   if (!animations_.empty()) json += ",\"animations\":" + join(animations_);
   json += ",\"accessors\":" + join(accessors_) + ",\"bufferViews\":" + join(views_) +
           ",\"buffers\":[{\"byteLength\":" + std::to_string(bin_.size()) + "}]}";

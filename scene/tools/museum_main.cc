@@ -90,14 +90,17 @@ int main(int argc, char** argv) {
 
   // Hall: x in [-12, 12], z in [-18, 10], height 6.
   const float x0 = -12, x1 = 12, z0 = -18, z1 = 10, h = 6;
-  const Eigen::Vector3f X = Eigen::Vector3f::UnitX(), Y = Eigen::Vector3f::UnitY(), Z = Eigen::Vector3f::UnitZ();
+  const Eigen::Vector3f X = Eigen::Vector3f::UnitX(), Y = Eigen::Vector3f::UnitY(),
+                        Z = Eigen::Vector3f::UnitZ();
   std::size_t triangles = 0;
-  auto model = [&](const std::string& name, const MeshBuild& mesh, int material, Eigen::Vector3d at) {
+  auto model = [&](const std::string& name, const MeshBuild& mesh, int material,
+                   Eigen::Vector3d at) {
     triangles += mesh.triangles();
     return add_model(w, root, name, mesh, material, at);
   };
   model("floor", grid({x0, 0, z1}, (x1 - x0) * X, (z0 - z1) * Z, 48, 56, 4.0f), m_floor, {0, 0, 0});
-  model("ceiling", grid({x0, h, z0}, (x1 - x0) * X, (z1 - z0) * Z, 12, 14, 4.0f), m_ceiling, {0, 0, 0});
+  model("ceiling", grid({x0, h, z0}, (x1 - x0) * X, (z1 - z0) * Z, 12, 14, 4.0f), m_ceiling,
+        {0, 0, 0});
   MeshBuild walls;
   walls.append(grid({x0, 0, z0}, (x1 - x0) * X, h * Y, 24, 6, 3.0f));  // back, facing +z
   walls.append(grid({x1, 0, z1}, (x0 - x1) * X, h * Y, 24, 6, 3.0f));  // front, facing -z
@@ -115,18 +118,21 @@ int main(int argc, char** argv) {
       return m;
     };
     model("painting_left_" + std::to_string(k),
-          canvas(grid({0, -ph / 2, pw / 2}, -pw * Z, ph * Y, 1, 1, pw)), k % 2 ? m_abstract : m_landscape,
-          {x0 + 0.05, 3.0, z});
+          canvas(grid({0, -ph / 2, pw / 2}, -pw * Z, ph * Y, 1, 1, pw)),
+          k % 2 ? m_abstract : m_landscape, {x0 + 0.05, 3.0, z});
     model("painting_right_" + std::to_string(k),
-          canvas(grid({0, -ph / 2, -pw / 2}, pw * Z, ph * Y, 1, 1, pw)), k % 2 ? m_landscape : m_abstract,
-          {x1 - 0.05, 3.0, z});
+          canvas(grid({0, -ph / 2, -pw / 2}, pw * Z, ph * Y, 1, 1, pw)),
+          k % 2 ? m_landscape : m_abstract, {x1 - 0.05, 3.0, z});
   }
 
   // Columns.
-  const MeshBuild column = lathe([&](float s) { return Eigen::Vector2f(s < 0.04f || s > 0.96f ? 0.45f : 0.35f, s * h); }, 48, 24);
+  const MeshBuild column =
+      lathe([&](float s) { return Eigen::Vector2f(s < 0.04f || s > 0.96f ? 0.45f : 0.35f, s * h); },
+            48, 24);
   int c = 0;
   for (float x : {-9.0f, 9.0f})
-    for (float z : {-14.0f, -3.0f, 6.0f}) model("column_" + std::to_string(c++), column, m_stone, {x, 0, z});
+    for (float z : {-14.0f, -3.0f, 6.0f})
+      model("column_" + std::to_string(c++), column, m_stone, {x, 0, z});
 
   // Exhibits on pedestals along z = -8.
   struct Exhibit {
@@ -135,16 +141,27 @@ int main(int argc, char** argv) {
     MeshBuild mesh;
   };
   const Exhibit exhibits[] = {
-      {"exhibit_red_sphere", {0.90f, 0.08f, 0.08f, 1}, uv_sphere(0.5f, 160, 96)},
-      {"exhibit_green_torus", {0.08f, 0.80f, 0.15f, 1},
-       torus(0.38f, 0.14f, 160, 64).transformed(Eigen::AngleAxisf(kPi / 2, X).toRotationMatrix(), Eigen::Vector3f::Zero())},
-      {"exhibit_blue_vase", {0.10f, 0.25f, 0.95f, 1},
-       lathe([](float s) { return Eigen::Vector2f(0.18f + 0.22f * std::sin(kPi * s * 1.2f) + 0.05f * s, s * 1.0f - 0.5f); }, 128, 64)},
-      {"exhibit_yellow_knot", {0.95f, 0.80f, 0.05f, 1}, torus_knot(0.15f, 0.1f, 2, 3, 512, 24)},
-      {"exhibit_magenta_cone", {0.85f, 0.08f, 0.80f, 1},
+      {"exhibit_red_sphere", {0.90f, 0.08f, 0.08f, 1}, uv_sphere(0.5f, 128, 72)},
+      {"exhibit_green_torus",
+       {0.08f, 0.80f, 0.15f, 1},
+       torus(0.38f, 0.14f, 128, 48)
+           .transformed(Eigen::AngleAxisf(kPi / 2, X).toRotationMatrix(), Eigen::Vector3f::Zero())},
+      {"exhibit_blue_vase",
+       {0.10f, 0.25f, 0.95f, 1},
+       lathe(
+           [](float s) {
+             return Eigen::Vector2f(0.18f + 0.22f * std::sin(kPi * s * 1.2f) + 0.05f * s,
+                                    s * 1.0f - 0.5f);
+           },
+           96, 48)},
+      {"exhibit_yellow_knot", {0.95f, 0.80f, 0.05f, 1}, torus_knot(0.15f, 0.1f, 2, 3, 384, 16)},
+      {"exhibit_magenta_cone",
+       {0.85f, 0.08f, 0.80f, 1},
        lathe([](float s) { return Eigen::Vector2f(0.45f * (1 - s) + 0.001f, s - 0.5f); }, 128, 16)},
-      {"exhibit_cyan_cube", {0.05f, 0.80f, 0.85f, 1},
-       box({0.8f, 0.8f, 0.8f}).transformed(Eigen::AngleAxisf(kPi / 5, Y).toRotationMatrix(), Eigen::Vector3f::Zero())},
+      {"exhibit_cyan_cube",
+       {0.05f, 0.80f, 0.85f, 1},
+       box({0.8f, 0.8f, 0.8f})
+           .transformed(Eigen::AngleAxisf(kPi / 5, Y).toRotationMatrix(), Eigen::Vector3f::Zero())},
   };
   const MeshBuild pedestal = box({0.9f, 1.0f, 0.9f});
   for (int k = 0; k < 6; ++k) {
@@ -155,9 +172,13 @@ int main(int argc, char** argv) {
   }
 
   // The flyer: a bird-like body (nose along -z) with two wings; animated.
-  MeshBuild flyer_mesh = uv_sphere(0.5f, 48, 32).transformed(Eigen::Vector3f(0.25f, 0.18f, 0.55f).asDiagonal(), Eigen::Vector3f::Zero());
-  flyer_mesh.append(box({1.4f, 0.04f, 0.35f}).transformed(Eigen::Matrix3f::Identity(), {0, 0.02f, 0.05f}));
-  flyer_mesh.append(box({0.5f, 0.03f, 0.2f}).transformed(Eigen::Matrix3f::Identity(), {0, 0.05f, 0.45f}));
+  MeshBuild flyer_mesh =
+      uv_sphere(0.5f, 48, 32)
+          .transformed(Eigen::Vector3f(0.25f, 0.18f, 0.55f).asDiagonal(), Eigen::Vector3f::Zero());
+  flyer_mesh.append(
+      box({1.4f, 0.04f, 0.35f}).transformed(Eigen::Matrix3f::Identity(), {0, 0.02f, 0.05f}));
+  flyer_mesh.append(
+      box({0.5f, 0.03f, 0.2f}).transformed(Eigen::Matrix3f::Identity(), {0, 0.05f, 0.45f}));
   const int m_flyer = w.add_material("flyer", Eigen::Vector4f(1.0f, 0.55f, 0.05f, 1), -1,
                                      Eigen::Vector3f(0.3f, 0.15f, 0.0f));
   const int flyer = model("flyer", flyer_mesh, m_flyer, flight_position(0).cast<double>());
@@ -190,18 +211,23 @@ int main(int argc, char** argv) {
     n.light = w.add_light(name, type, colour, intensity);
     w.node(root).children.push_back(w.add_node(n));
   };
-  light("light_exhibits_left", "point", {1.0f, 0.97f, 0.92f}, 25, {-5, 4.3, -7}, Eigen::Quaterniond::Identity());
-  light("light_exhibits_right", "point", {1.0f, 0.97f, 0.92f}, 25, {5, 4.3, -7}, Eigen::Quaterniond::Identity());
-  light("light_stage", "point", {0.95f, 0.97f, 1.0f}, 20, {0, 4.3, 3}, Eigen::Quaterniond::Identity());
+  light("light_exhibits_left", "point", {1.0f, 0.97f, 0.92f}, 25, {-5, 4.3, -7},
+        Eigen::Quaterniond::Identity());
+  light("light_exhibits_right", "point", {1.0f, 0.97f, 0.92f}, 25, {5, 4.3, -7},
+        Eigen::Quaterniond::Identity());
+  light("light_stage", "point", {0.95f, 0.97f, 1.0f}, 20, {0, 4.3, 3},
+        Eigen::Quaterniond::Identity());
   light("light_sky", "directional", {1.0f, 1.0f, 1.0f}, 0.6f, {0, 5.9, 0},
         Eigen::Quaterniond(Eigen::AngleAxisd(-1.1, Eigen::Vector3d::UnitX())));
 
   const std::vector<std::uint8_t> bytes = w.bytes();
   std::ofstream file(out, std::ios::binary);
-  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  file.write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
   file.close();
   if (!file) {
-    std::fprintf(stderr, "studio-scene-museum: cannot write %s: %s\n", out.c_str(), std::strerror(errno));
+    std::fprintf(stderr, "studio-scene-museum: cannot write %s: %s\n", out.c_str(),
+                 std::strerror(errno));
     return 1;
   }
   std::printf("%s: %zu triangles, %zu bytes\n", out.c_str(), triangles, bytes.size());

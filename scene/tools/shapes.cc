@@ -55,22 +55,24 @@ MeshBuild box(const Eigen::Vector3f& size) {
   const Eigen::Vector3f h = size / 2;
   MeshBuild m;
   // Six faces: (origin corner, u, v) with u x v pointing out.
-  const Eigen::Vector3f X = Eigen::Vector3f::UnitX() * size.x(), Y = Eigen::Vector3f::UnitY() * size.y(),
+  const Eigen::Vector3f X = Eigen::Vector3f::UnitX() * size.x(),
+                        Y = Eigen::Vector3f::UnitY() * size.y(),
                         Z = Eigen::Vector3f::UnitZ() * size.z();
   const float uvm = std::max({size.x(), size.y(), size.z()});
-  m.append(grid(Eigen::Vector3f(-h.x(), -h.y(), h.z()), X, Y, 1, 1, uvm));             // +z
-  m.append(grid(Eigen::Vector3f(h.x(), -h.y(), -h.z()), -X, Y, 1, 1, uvm));            // -z
-  m.append(grid(Eigen::Vector3f(h.x(), -h.y(), h.z()), -Z, Y, 1, 1, uvm));             // +x
-  m.append(grid(Eigen::Vector3f(-h.x(), -h.y(), -h.z()), Z, Y, 1, 1, uvm));            // -x
-  m.append(grid(Eigen::Vector3f(-h.x(), h.y(), h.z()), X, -Z, 1, 1, uvm));             // +y
-  m.append(grid(Eigen::Vector3f(-h.x(), -h.y(), -h.z()), X, Z, 1, 1, uvm));            // -y
+  m.append(grid(Eigen::Vector3f(-h.x(), -h.y(), h.z()), X, Y, 1, 1, uvm));   // +z
+  m.append(grid(Eigen::Vector3f(h.x(), -h.y(), -h.z()), -X, Y, 1, 1, uvm));  // -z
+  m.append(grid(Eigen::Vector3f(h.x(), -h.y(), h.z()), -Z, Y, 1, 1, uvm));   // +x
+  m.append(grid(Eigen::Vector3f(-h.x(), -h.y(), -h.z()), Z, Y, 1, 1, uvm));  // -x
+  m.append(grid(Eigen::Vector3f(-h.x(), h.y(), h.z()), X, -Z, 1, 1, uvm));   // +y
+  m.append(grid(Eigen::Vector3f(-h.x(), -h.y(), -h.z()), X, Z, 1, 1, uvm));  // -y
   return m;
 }
 
 MeshBuild uv_sphere(float radius, int slices, int stacks) {
   return lattice(slices, stacks, [&](float s, float t, Eigen::Vector3f& p, Eigen::Vector3f& n) {
     const float phi = 2 * kPi * s, theta = kPi * t;
-    n = Eigen::Vector3f(std::sin(theta) * std::cos(phi), -std::cos(theta), std::sin(theta) * std::sin(phi));
+    n = Eigen::Vector3f(std::sin(theta) * std::cos(phi), -std::cos(theta),
+                        std::sin(theta) * std::sin(phi));
     p = radius * n;
     if (n.norm() < 1e-6f) n = Eigen::Vector3f(0, t < 0.5f ? -1.0f : 1.0f, 0);
   });

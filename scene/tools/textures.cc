@@ -40,11 +40,12 @@ std::vector<std::uint8_t> marble_png(int size) {
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) {
       const float t = static_cast<float>(x + y) / size;
-      const float vein = std::pow(std::abs(std::sin(3.14159f * (3 * t + 4 * n.at<float>(y, x)))), 0.35f);
+      const float vein =
+          std::pow(std::abs(std::sin(3.14159f * (3 * t + 4 * n.at<float>(y, x)))), 0.35f);
       const float base = 200 + 45 * vein;
-      img.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(base - 6),
-                                          cv::saturate_cast<uchar>(base - 3),
-                                          cv::saturate_cast<uchar>(base));
+      img.at<cv::Vec3b>(y, x) =
+          cv::Vec3b(cv::saturate_cast<uchar>(base - 6), cv::saturate_cast<uchar>(base - 3),
+                    cv::saturate_cast<uchar>(base));
     }
   // Tile joints every quarter.
   for (int k = 0; k <= 4; ++k) {
@@ -61,9 +62,9 @@ std::vector<std::uint8_t> wall_panel_png(int size) {
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) {
       const float v = 0.93f + 0.07f * n.at<float>(y, x);
-      img.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(150 * v),
-                                          cv::saturate_cast<uchar>(180 * v),
-                                          cv::saturate_cast<uchar>(200 * v));
+      img.at<cv::Vec3b>(y, x) =
+          cv::Vec3b(cv::saturate_cast<uchar>(150 * v), cv::saturate_cast<uchar>(180 * v),
+                    cv::saturate_cast<uchar>(200 * v));
     }
   const int m = size / 10;
   cv::rectangle(img, {m, m}, {size - m, size - m}, cv::Scalar(110, 135, 155), 6);
@@ -91,12 +92,20 @@ std::vector<std::uint8_t> landscape_png(int w, int h) {
     img.row(y).setTo(cv::Scalar(200 - 60 * t, 180 - 40 * t, 150 - 30 * t));
   }
   cv::circle(img, {w * 3 / 4, h / 4}, h / 10, cv::Scalar(150, 200, 230), cv::FILLED, cv::LINE_AA);
-  std::vector<cv::Point> far{{0, h * 6 / 10}, {w / 4, h * 45 / 100}, {w / 2, h * 55 / 100},
-                             {w * 3 / 4, h * 4 / 10}, {w, h * 55 / 100}, {w, h}, {0, h}};
-  cv::fillPoly(img, std::vector<std::vector<cv::Point>>{far}, cv::Scalar(120, 135, 125), cv::LINE_AA);
-  std::vector<cv::Point> near{{0, h * 8 / 10}, {w / 3, h * 7 / 10}, {w * 2 / 3, h * 78 / 100},
-                              {w, h * 7 / 10}, {w, h}, {0, h}};
-  cv::fillPoly(img, std::vector<std::vector<cv::Point>>{near}, cv::Scalar(80, 110, 105), cv::LINE_AA);
+  std::vector<cv::Point> far{{0, h * 6 / 10},
+                             {w / 4, h * 45 / 100},
+                             {w / 2, h * 55 / 100},
+                             {w * 3 / 4, h * 4 / 10},
+                             {w, h * 55 / 100},
+                             {w, h},
+                             {0, h}};
+  cv::fillPoly(img, std::vector<std::vector<cv::Point>>{far}, cv::Scalar(120, 135, 125),
+               cv::LINE_AA);
+  std::vector<cv::Point> near{
+      {0, h * 8 / 10}, {w / 3, h * 7 / 10}, {w * 2 / 3, h * 78 / 100}, {w, h * 7 / 10}, {w, h},
+      {0, h}};
+  cv::fillPoly(img, std::vector<std::vector<cv::Point>>{near}, cv::Scalar(80, 110, 105),
+               cv::LINE_AA);
   cv::rectangle(img, {0, 0}, {w - 1, h - 1}, cv::Scalar(40, 70, 110), h / 20);  // gilt frame
   return png(img);
 }

@@ -1,6 +1,6 @@
 #pragma once
 // Options of the keyer (keyer/keyer.h). Every field is a key of keyer.yaml (see
-// keyer/keyer.example.yaml, which documents them; keyer/cli/keyer_yaml.cc reads it).
+// keyer/keyer.example.yaml, which documents them; keyer/config/keyer_yaml.cc reads it).
 //
 // Colour-difference key (Vlahos style), for a blue (default) or green backing:
 //   excess  = K - max(O1, O2)           K = key channel (B or G), O1, O2 = the other two, in 0..255

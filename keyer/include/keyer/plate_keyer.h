@@ -20,6 +20,7 @@
 //     kKeyed          `mask` holds the frame's binary mask.
 
 #include <atomic>
+#include <string>
 
 #include "core/error.h"
 #include "core/image.h"
@@ -27,6 +28,13 @@
 #include "keyer/keyer.h"
 
 namespace studio::keyer {
+
+// KeyerPlate's value as a request (valid_plate_request), or the one-line reason it is refused:
+// "KeyerPlate 2.5: expected 0 (clear) or a frame count 1..1000".
+Expected<int> plate_request(double value);
+// What a request does, for the log: "clean plate cleared" or "capturing a clean plate from the
+// next N frame(s)".
+std::string plate_request_text(int frames);
 
 class PlateKeyer {
  public:

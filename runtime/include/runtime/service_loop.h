@@ -66,7 +66,8 @@
 // - stop(): idempotent; clears running(), triggers the stop guard (the WaitSet returns at once),
 //   interrupts and joins every thread, runs the at_stop() hooks (no other thread of the loop
 //   runs then; the outputs still write: a last state, finishing recordings), then releases the
-//   DDS entities. The destructor stops.
+//   DDS entities. start() after stop() runs the same declarations again on new entities. The
+//   destructor stops.
 
 #include <atomic>
 #include <chrono>
@@ -232,7 +233,8 @@ class OutputBase {
 };
 
 // A declared publication. write() and dispose() are thread-safe (DDS writers are); before
-// start() and after stop() they fail with a one-line error.
+// start() and after stop() they fail with a one-line error. Threads the loop does not own must
+// stop writing before stop() (the loop's own threads and at_stop() hooks may write throughout).
 template <wire::WireType T>
 class Output : public OutputBase {
  public:

@@ -82,9 +82,15 @@ scene::Transform to_transform(const aiMatrix4x4& m) {
 scene::Light to_light(const aiLight& l) {
   scene::Light out;
   switch (l.mType) {
-    case aiLightSource_DIRECTIONAL: out.type = scene::LightType::directional; break;
-    case aiLightSource_SPOT: out.type = scene::LightType::spot; break;
-    default: out.type = scene::LightType::point; break;
+    case aiLightSource_DIRECTIONAL:
+      out.type = scene::LightType::directional;
+      break;
+    case aiLightSource_SPOT:
+      out.type = scene::LightType::spot;
+      break;
+    default:
+      out.type = scene::LightType::point;
+      break;
   }
   // assimp folds the intensity into the colour.
   const Eigen::Vector3f c(l.mColorDiffuse.r, l.mColorDiffuse.g, l.mColorDiffuse.b);
@@ -92,10 +98,10 @@ scene::Light to_light(const aiLight& l) {
   out.intensity = peak;
   out.colour = peak > 0 ? Eigen::Vector3f(c / peak) : Eigen::Vector3f::Ones();
   const float half_pi = std::numbers::pi_v<float> / 2;
-  out.outer_cone = std::clamp(std::isfinite(l.mAngleOuterCone) ? l.mAngleOuterCone : half_pi, 0.0f,
-                              half_pi);
-  out.inner_cone = std::clamp(std::isfinite(l.mAngleInnerCone) ? l.mAngleInnerCone : 0.0f, 0.0f,
-                              out.outer_cone);
+  out.outer_cone =
+      std::clamp(std::isfinite(l.mAngleOuterCone) ? l.mAngleOuterCone : half_pi, 0.0f, half_pi);
+  out.inner_cone =
+      std::clamp(std::isfinite(l.mAngleInnerCone) ? l.mAngleInnerCone : 0.0f, 0.0f, out.outer_cone);
   return out;
 }
 
@@ -118,10 +124,11 @@ Expected<Asset> load_asset(const std::string& path) {
   if (!hash) return std::unexpected(hash.error());
   Assimp::Importer importer;
   // Points and lines are dropped: the renderer draws triangles.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* ai = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_SortByPType |
-                aiProcess_ValidateDataStructure);
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* ai =
+      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_GenSmoothNormals |
+                                  aiProcess_SortByPType | aiProcess_ValidateDataStructure);
   if (!ai || !ai->mRootNode) return fail(path + ": " + one_line(importer.GetErrorString()));
   if ((ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || ai->mNumMeshes == 0)
     return fail(path + ": no meshes");
@@ -137,11 +144,14 @@ Expected<Asset> load_asset(const std::string& path) {
     MaterialData md;
     md.name = m->GetName().C_Str();
     aiColor4D c;
-    if (m->Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS || m->Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS)
+    if (m->Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS ||
+        m->Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS)
       md.base_colour = Eigen::Vector4f(c.r, c.g, c.b, c.a).cwiseMax(0.0f).cwiseMin(1.0f);
     aiColor3D e;
     if (m->Get(AI_MATKEY_COLOR_EMISSIVE, e) == AI_SUCCESS)
       md.emissive = Eigen::Vector3f(e.r, e.g, e.b).cwiseMax(0.0f);
+    int two_sided = 0;
+    if (m->Get(AI_MATKEY_TWOSIDED, two_sided) == AI_SUCCESS) md.double_sided = two_sided != 0;
     aiString tex;
     if (m->GetTexture(aiTextureType_BASE_COLOR, 0, &tex) == AI_SUCCESS ||
         m->GetTexture(aiTextureType_DIFFUSE, 0, &tex) == AI_SUCCESS) {
@@ -181,7 +191,8 @@ Expected<Asset> load_asset(const std::string& path) {
       md.colours.resize(m->mNumVertices);
       for (unsigned v = 0; v < m->mNumVertices; ++v)
         md.colours[v] = Eigen::Vector3f(m->mColors[0][v].r, m->mColors[0][v].g, m->mColors[0][v].b)
-                            .cwiseMax(0.0f).cwiseMin(1.0f);
+                            .cwiseMax(0.0f)
+                            .cwiseMin(1.0f);
     }
     for (unsigned f = 0; f < m->mNumFaces; ++f) {
       const aiFace& face = m->mFaces[f];
@@ -243,7 +254,8 @@ Expected<Asset> load_asset(const std::string& path) {
       });
       add(scene::TrackPath::rotation, ch->mNumRotationKeys, [&](unsigned k) {
         const auto& key = ch->mRotationKeys[k];
-        return std::pair{key.mTime, Eigen::Vector4d(key.mValue.x, key.mValue.y, key.mValue.z, key.mValue.w)};
+        return std::pair{key.mTime,
+                         Eigen::Vector4d(key.mValue.x, key.mValue.y, key.mValue.z, key.mValue.w)};
       });
       add(scene::TrackPath::scale, ch->mNumScalingKeys, [&](unsigned k) {
         const auto& key = ch->mScalingKeys[k];

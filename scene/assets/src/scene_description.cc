@@ -40,19 +40,23 @@ Expected<scene::Scene> build_scene(const SceneDescription& d, AssetCache& cache,
     auto set = cache.load(d.set);
     if (!set) return fail(d.file + ": set: " + set.error().message);
     const Instance inst = instantiate(**set, d.set_id, "", frame);
-    if (auto ok = run({frame, scene::Batch{inst.commands}}, "set"); !ok) return std::unexpected(ok.error());
+    if (auto ok = run({frame, scene::Batch{inst.commands}}, "set"); !ok)
+      return std::unexpected(ok.error());
   }
   for (const NodeSpec& ns : d.nodes) {
     if (ns.translation.size() != 3 || ns.rotation.size() != 4 || ns.scale.size() != 3 ||
         ns.colour.size() != 4)
-      return fail(d.file + ": nodes: '" + ns.id + "': translation, rotation, scale, colour need 3, 4, 3, 4 numbers");
+      return fail(d.file + ": nodes: '" + ns.id +
+                  "': translation, rotation, scale, colour need 3, 4, 3, 4 numbers");
     scene::Node n;
     n.id = ns.id;
     n.parent = ns.parent;
     n.local.translation = Eigen::Vector3d(ns.translation[0], ns.translation[1], ns.translation[2]);
-    n.local.rotation = Eigen::Quaterniond(ns.rotation[3], ns.rotation[0], ns.rotation[1], ns.rotation[2]);
+    n.local.rotation =
+        Eigen::Quaterniond(ns.rotation[3], ns.rotation[0], ns.rotation[1], ns.rotation[2]);
     n.local.scale = Eigen::Vector3d(ns.scale[0], ns.scale[1], ns.scale[2]);
-    n.material.colour = Eigen::Vector4d(ns.colour[0], ns.colour[1], ns.colour[2], ns.colour[3]).cast<float>();
+    n.material.colour =
+        Eigen::Vector4d(ns.colour[0], ns.colour[1], ns.colour[2], ns.colour[3]).cast<float>();
     n.material.texture = ns.texture;
     n.material.high_contrast = ns.high_contrast;
     n.visible = ns.visible;
@@ -76,20 +80,23 @@ Expected<scene::Scene> build_scene(const SceneDescription& d, AssetCache& cache,
       if (!t) return fail(d.file + ": animations: '" + as.name + "': " + t.error().message);
       a.tracks.push_back(std::move(*t));
     }
-    if (auto ok = run({frame, scene::AddAnimation{a}}, "animations"); !ok) return std::unexpected(ok.error());
+    if (auto ok = run({frame, scene::AddAnimation{a}}, "animations"); !ok)
+      return std::unexpected(ok.error());
   }
   for (const std::string& id : d.high_contrast) {
     const scene::Node* n = s.find(id);
     if (!n) return fail(d.file + ": high_contrast: unknown node '" + id + "'");
     scene::Material m = n->material;
     m.high_contrast = true;
-    if (auto ok = run({frame, scene::SetMaterial{id, m}}, "high_contrast"); !ok) return std::unexpected(ok.error());
+    if (auto ok = run({frame, scene::SetMaterial{id, m}}, "high_contrast"); !ok)
+      return std::unexpected(ok.error());
   }
   for (const PlaySpec& p : d.play) {
     scene::Play play;
     play.animation = p.animation;
     play.mode = p.mode;
-    if (auto ok = run({p.at_frame, scene::SetSpeed{p.animation, p.speed}}, "play"); !ok) return std::unexpected(ok.error());
+    if (auto ok = run({p.at_frame, scene::SetSpeed{p.animation, p.speed}}, "play"); !ok)
+      return std::unexpected(ok.error());
     if (auto ok = run({p.at_frame, play}, "play"); !ok) return std::unexpected(ok.error());
   }
   if (auto ok = run({frame, scene::Tick{}}, "tick"); !ok) return std::unexpected(ok.error());

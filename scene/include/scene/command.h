@@ -99,9 +99,9 @@ struct Batch {
   bool operator==(const Batch&) const;
 };
 
-using CommandOp = std::variant<AddNode, RemoveNode, SetTransform, SetParent, SetMaterial,
-                               SetVisible, AddAnimation, RemoveAnimation, Play, Pause, Seek,
-                               SetSpeed, Tick, Batch>;
+using CommandOp =
+    std::variant<AddNode, RemoveNode, SetTransform, SetParent, SetMaterial, SetVisible,
+                 AddAnimation, RemoveAnimation, Play, Pause, Seek, SetSpeed, Tick, Batch>;
 
 struct Command {
   std::int64_t frame = 0;

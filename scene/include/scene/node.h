@@ -70,10 +70,10 @@ struct Node {
   NodeKind kind = NodeKind::group;
   Transform local;  // parent_from_node
   bool visible = true;
-  AssetRef asset;         // kind == model
-  Material material;      // model and actor
-  Light light;            // kind == light
-  std::string actor_id;   // kind == actor
+  AssetRef asset;        // kind == model
+  Material material;     // model and actor
+  Light light;           // kind == light
+  std::string actor_id;  // kind == actor
 
   // Studio frame at which `local` was last set (by a command or an animation evaluated at that
   // frame); renderers draw the latest. Part of the state.

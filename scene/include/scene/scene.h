@@ -83,6 +83,9 @@ class Scene {
   // A 64-bit hash of the whole state: options, frame, every node, every animation and its clock
   // (the bytes of serialize()). Equal states give equal hashes on every host.
   std::uint64_t state_hash() const;
+  // A hash of the nodes alone (serialize.h: hash_nodes), comparable with what a reader of the
+  // published nodes computes.
+  std::uint64_t nodes_hash() const;
 
   Expected<void> check_invariants() const;
 
@@ -93,6 +96,7 @@ class Scene {
   void mutate(const Command& c);
   void evaluate(std::int64_t frame);
   void rebuild_order();
+  void rebuild_targets();
   void touch(Node& node, std::int64_t frame);
   bool in_subtree(const NodeId& id, const NodeId& root) const;
 
@@ -102,6 +106,10 @@ class Scene {
   std::map<std::string, AnimationEntry> animations_;
   std::vector<const Node*> order_;
   std::vector<int> parent_index_;
+  // The node each track drives, per animation (same keys and order as animations_). std::map
+  // keeps node addresses across inserts, moves and the removal of other nodes, and a driven node
+  // cannot be removed, so these stay valid until the animation is removed.
+  std::map<std::string, std::vector<Node*>> targets_;
   std::set<NodeId> updated_, removed_;
 };
 

@@ -7,6 +7,7 @@
 // scene invariants, so corrupt or truncated bytes give an error, never a crash or a half scene.
 
 #include <cstdint>
+#include <map>
 #include <vector>
 
 #include "core/error.h"
@@ -16,6 +17,11 @@ namespace studio::scene {
 
 std::vector<std::uint8_t> serialize(const Scene& scene);
 Expected<Scene> deserialize(const std::vector<std::uint8_t>& bytes);
+
+// A hash of the nodes alone (every field of every node, by id), what a renderer that only
+// receives SceneNode samples can compute from them and compare with the server's
+// Scene::nodes_hash(). Animations and their clocks are not part of it (state_hash() has them).
+std::uint64_t hash_nodes(const std::map<NodeId, Node>& nodes);
 
 // 64-bit FNV-1a of bytes (the state hash's function).
 std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size);

@@ -28,8 +28,11 @@ struct Texture {
 struct MaterialData {
   std::string name;
   Eigen::Vector4f base_colour = Eigen::Vector4f::Ones();  // glTF baseColorFactor / diffuse
-  int texture = -1;                                        // index into Asset::textures, -1 none
+  int texture = -1;                                       // index into Asset::textures, -1 none
   Eigen::Vector3f emissive = Eigen::Vector3f::Zero();
+  // glTF doubleSided / assimp's two-sided flag: back faces are drawn only when true (glTF's
+  // default is false: closed meshes show their counter-clockwise front faces).
+  bool double_sided = false;
 };
 
 // Triangles only; normals always present (generated where the file has none); uvs empty or

@@ -18,8 +18,8 @@ namespace studio::scene_assets {
 struct NodeSpec {
   std::string id;
   std::string parent;
-  std::string asset;    // a model's file (path resolved by the reader)
-  std::string actor;    // an actor node's actor id
+  std::string asset;  // a model's file (path resolved by the reader)
+  std::string actor;  // an actor node's actor id
   std::vector<double> translation{0, 0, 0};
   std::vector<double> rotation{0, 0, 0, 1};  // quaternion x, y, z, w
   std::vector<double> scale{1, 1, 1};

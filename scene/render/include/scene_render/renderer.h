@@ -7,7 +7,8 @@
 // node's meshes with its asset material (base colour x texture x node colour), every actor node's
 // latest ActorMesh, lit by the scene's light nodes (up to 8; Blinn-Phong with inverse-square
 // fall-off for point and spot lights) plus an ambient term; high-contrast nodes (paper §V-F) and
-// emissive materials are drawn unlit at full intensity. Faces are two-sided.
+// emissive materials are drawn unlit at full intensity. Back faces of asset meshes are culled
+// unless their material is double-sided (glTF's rule); actor meshes are drawn two-sided.
 //
 // Assets are uploaded once (upload(), cached by path; re-uploaded when the content hash differs)
 // and actor meshes into buffers that only grow; a steady-state draw() allocates nothing.
@@ -73,7 +74,8 @@ class Renderer {
   // the output pixel at normalised coordinates p in [0,1]^2 samples the texture at
   // dehomogenised tex_from_screen * (p, 1) (identity: a plain copy; the projector passes its
   // homography). Depth test off.
-  void draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen = Eigen::Matrix3f::Identity());
+  void draw_texture(unsigned texture,
+                    const Eigen::Matrix3f& tex_from_screen = Eigen::Matrix3f::Identity());
 
   int draw_calls_last_frame() const;
 
