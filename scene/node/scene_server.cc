@@ -31,11 +31,11 @@ class SceneServer : public runtime::Node {
               std::optional<WriteAheadLog> wal, runtime::NodeContext& context)
       : options_(std::move(options)),
         wal_(std::move(wal)),
-        cache_(std::move(cache)),
         scene_(std::move(state.scene)),
+        cache_(std::move(cache)),
         published_(std::move(state.published)),
-        sequence_(state.sequence),
         instance_(context.instance.empty() ? "scene" : context.instance),
+        sequence_(state.sequence),
         loop_(context, kLog) {
     nodes_out_ = &loop_.output<studio_SceneNode>({.counter = "nodes_published"});
     state_out_ = &loop_.output<studio_SceneState>({.counter = "states_published", .rate = false});

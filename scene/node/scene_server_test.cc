@@ -401,8 +401,11 @@ TEST_F(SceneServerTest, Kill9AndRestartConvergesToThePersistedStateWithoutStaleN
       << "reader holds " << reader.nodes.size() << " nodes";
   EXPECT_FALSE(reader.nodes.contains("b"));
   EXPECT_FALSE(reader.nodes.contains("c"));
-  for (const auto& [id, n] : s.scene.nodes())
-    if (id != "spin") EXPECT_EQ(reader.nodes.at(id), n) << id;
+  for (const auto& [id, n] : s.scene.nodes()) {
+    if (id != "spin") {
+      EXPECT_EQ(reader.nodes.at(id), n) << id;
+    }
+  }
   // The animation resumed on the studio clock.
   ASSERT_TRUE(
       reader.until([&] { return reader.nodes.at("spin").frame > persisted_frame + 3; }, 5s));
