@@ -225,34 +225,7 @@ Verdict validate(const studio_HeadPose& s) {
   return std::nullopt;
 }
 
-Verdict validate(const studio_SceneNode& s) {
-  if (!id_ok(s.node_id)) return Reject::bad_id;
-  if (!text_ok(s.parent) || !text_ok(s.asset) || !text_ok(s.material)) return Reject::bad_id;
-  if (std::strcmp(s.parent, s.node_id) == 0) return Reject::out_of_range;
-  if (!finite(s.parent_from_node)) return Reject::non_finite;
-  const double* m = s.parent_from_node;
-  if (m[12] != 0 || m[13] != 0 || m[14] != 0 || m[15] != 1) return Reject::out_of_range;
-  return std::nullopt;
-}
-
-Verdict validate(const studio_SceneCommand& s) {
-  if (!text_ok(s.target) || !text_ok(s.path)) return Reject::bad_id;
-  if (!std::isfinite(s.value) || !finite(s.transform)) return Reject::non_finite;
-  switch (raw(s.verb)) {
-    case studio_SCENE_LOAD_SET:
-      return s.path[0] ? Verdict{} : Reject::bad_id;
-    case studio_SCENE_MOVE_NODE:
-    case studio_SCENE_REMOVE_NODE:
-      return s.target[0] ? Verdict{} : Reject::bad_id;
-    case studio_SCENE_SPEED:
-      return s.value >= 0 ? Verdict{} : Reject::out_of_range;
-    case studio_SCENE_PLAY:
-    case studio_SCENE_PAUSE:
-    case studio_SCENE_SEEK:
-      return std::nullopt;
-  }
-  return Reject::out_of_range;
-}
+// SceneNode, SceneCommand and SceneState: idl/src/scene_validate.cc.
 
 Verdict validate(const studio_ProjectorCalibration& s) {
   if (!id_ok(s.projector_id)) return Reject::bad_id;

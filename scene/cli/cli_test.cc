@@ -104,7 +104,7 @@ TEST(SceneCli, BadInputIsOneLineAndNonZero) {
   expect_one_line_error(run("render"), "--out");
   expect_one_line_error(run("render --mesh " + (d / "none.ply").string() + out), "--mesh");
   expect_one_line_error(run("serve"), "unknown command");
-  expect_one_line_error(run("--config scene.yaml"), "--config");
+  expect_one_line_error(run("--config /nonexistent/scene.yaml"), "scene.yaml");  // the server's
   expect_one_line_error(run(""), "command");
   EXPECT_FALSE(fs::exists(d / "x.png"));
 }

@@ -1,6 +1,6 @@
-// studio-scene: the virtual scene's command line (DESIGN §6). For now one subcommand, `render`,
-// which renders one frame of a scene headless (EGL surfaceless, llvmpipe) into a PNG. The scene
-// server (`studio-scene --config scene.yaml`) is a separate node built on the scene library.
+// studio-scene: the virtual scene's command line (DESIGN §6). `render` renders one frame of a
+// scene headless (EGL surfaceless, llvmpipe) into a PNG; `--config scene.yaml` runs the scene
+// server (scene/node/scene_server.h) through runtime::service_main.
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -13,12 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "runtime/service.h"
 #include "scene/view.h"
 #include "scene_assets/scene_description.h"
 #include "scene_config/scene_yaml.h"
 #include "scene_render/egl_context.h"
 #include "scene_render/render_target.h"
 #include "scene_render/renderer.h"
+#include "scene_server.h"
 
 using namespace studio;
 
@@ -257,12 +259,14 @@ int main(int argc, char** argv) {
     const std::string command = argv[1];
     if (command == "--help" || command == "-h") {
       std::fputs(kUsage, stdout);
-      return 0;
+      std::fputs("\n", stdout);
+      std::fflush(stdout);  // then the scene server's usage and config keys
+      return runtime::service_main(argc, argv, scene::node::service_definition());
     }
     if (command == "render") return render(argc, argv);
-    if (command == "--config")
-      die("--config: the scene server is not part of this build; only 'render' (see --help)");
-    die("unknown command '" + command + "'; only 'render' (see --help)");
+    // The scene server (scene/node/scene_server.h): studio-scene --config scene.yaml.
+    if (command == "--config") return runtime::service_main(argc, argv, scene::node::service_definition());
+    die("unknown command '" + command + "'; 'render' or --config FILE (see --help)");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "studio-scene: internal error: %s\n", e.what());
     return 1;

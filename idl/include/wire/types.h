@@ -28,8 +28,9 @@ enum class TopicId : uint8_t {
   scene_command,
   projector_calibration,
   service_status,
+  scene_state,
 };
-inline constexpr std::size_t kTopicCount = 13;
+inline constexpr std::size_t kTopicCount = 14;
 
 // Why a received sample was rejected (counted per reason by every Reader).
 enum class Reject : uint8_t {
@@ -75,6 +76,7 @@ Verdict validate(const studio_SceneNode& s);
 Verdict validate(const studio_SceneCommand& s);
 Verdict validate(const studio_ProjectorCalibration& s);
 Verdict validate(const studio_ServiceStatus& s);
+Verdict validate(const studio_SceneState& s);
 
 template <class T>
 struct TopicTraits;  // specialised below for every topic type only
@@ -100,6 +102,7 @@ STUDIO_WIRE_TOPIC(SceneNode, scene_node)
 STUDIO_WIRE_TOPIC(SceneCommand, scene_command)
 STUDIO_WIRE_TOPIC(ProjectorCalibration, projector_calibration)
 STUDIO_WIRE_TOPIC(ServiceStatus, service_status)
+STUDIO_WIRE_TOPIC(SceneState, scene_state)
 #undef STUDIO_WIRE_TOPIC
 
 template <class T>
