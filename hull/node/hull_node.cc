@@ -13,6 +13,7 @@
 #include "core/log.h"
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
+#include "hull/visibility.h"
 #include "segments_wire.h"
 #include "wire/convert.h"
 #include "wire/endpoint.h"
@@ -208,7 +209,7 @@ class HullNode : public runtime::Node {
     for (std::size_t i = 0; i < frame.items.size(); ++i)
       if (frame.items[i]) views.push_back(View{&camera_for(i, frame.frame), &*frame.items[i]});
     CutOptions cut;
-    cut.outside = options_.outside;
+    cut.min_views = options_.min_views;
     cut.threads = options_.threads;
     auto hull = visual_hull(options_.grid_spec(), views, cut);
     if (!hull) {
@@ -324,6 +325,12 @@ Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& o
   if (std::size_t(options.min_cameras) > cameras.size())
     return fail("min_cameras " + std::to_string(options.min_cameras) + " exceeds the rig's " +
                 std::to_string(cameras.size()) + " cameras");
+  GridSpec sampled = options.grid_spec();  // a fraction: 128 x 128 columns at most suffice
+  sampled.cells_u = sampled.cells_v = std::min(sampled.cells_u, 128);
+  if (auto c = coverage(sampled, cameras, options.min_views); c) {
+    STUDIO_LOG(info, kLog) << "box coverage: " << 100 * c->unseen << " % seen by no camera, "
+                           << 100 * c->below_min_views << " % by fewer than " << c->min_views;
+  }
   return std::unique_ptr<runtime::Node>(new HullNode(options, std::move(cameras), context));
 }
 
@@ -340,7 +347,8 @@ runtime::ServiceDefinition hull_service_definition() {
       "    axis: y                 continuous axis of the segments: x|y|z\n"
       "    deadline_ms: 40         wait for a frame's missing masks at most this long\n"
       "    min_cameras: 2          drop a frame with fewer masks at its deadline\n"
-      "    outside: keep           column parts outside an image: keep|cut\n"
+      "    min_views: 2            actor = inside every silhouette that sees it AND seen by\n"
+      "                            >= min_views cameras (0..64; see studio-hull offline --help)\n"
       "    threads: 2              cut threads\n"
       "    mesh: true              publish studio/actor/mesh\n"
       "    refine: true            exact crossings on the mesh (else half-cell vertices)\n"
@@ -358,8 +366,7 @@ runtime::ServiceDefinition hull_service_definition() {
                          {{"x", Axis::x}, {"y", Axis::y}, {"z", Axis::z}}),
         yaml::field("deadline_ms", &HullNodeOptions::deadline_ms).range(1, 1000),
         yaml::field("min_cameras", &HullNodeOptions::min_cameras).range(1, 64),
-        yaml::enum_field("outside", &HullNodeOptions::outside,
-                         {{"keep", Outside::keep}, {"cut", Outside::cut}}),
+        yaml::field("min_views", &HullNodeOptions::min_views).range(0, 64),
         yaml::field("threads", &HullNodeOptions::threads).range(1, 64),
         yaml::field("mesh", &HullNodeOptions::mesh),
         yaml::field("refine", &HullNodeOptions::refine),
