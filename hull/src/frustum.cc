@@ -42,19 +42,38 @@ void at_least(std::span<const Range> ranges, int need, double lo, double hi,
     out->push_back({lo, hi});
     return;
   }
-  events->clear();
+  // Starts in events[0, n), ends in events[n, 2n), each sorted by insertion (a few dozen views),
+  // then merged with ends before starts at equal t (touching ranges do not overlap).
+  events->resize(2 * ranges.size());
+  std::pair<double, int>* e = events->data();
+  std::size_t n = 0;
   for (const Range& r : ranges) {
     const double a = std::max(lo, r.lo), b = std::min(hi, r.hi);
-    if (a < b) events->push_back({a, +1}), events->push_back({b, -1});
+    if (!(a < b)) continue;
+    std::size_t k = n;
+    for (; k > 0 && e[k - 1].first > a; --k) e[k] = e[k - 1];
+    e[k].first = a;
+    ++n;
   }
-  if (events->size() < 2 * std::size_t(need)) return;
-  // Ends before starts at equal t: touching ranges do not overlap (half-open pieces).
-  std::sort(events->begin(), events->end());
+  if (n < std::size_t(need)) return;
+  std::pair<double, int>* f = e + n;
+  std::size_t m = 0;
+  for (const Range& r : ranges) {
+    const double a = std::max(lo, r.lo), b = std::min(hi, r.hi);
+    if (!(a < b)) continue;
+    std::size_t k = m;
+    for (; k > 0 && f[k - 1].first > b; --k) f[k] = f[k - 1];
+    f[k].first = b;
+    ++m;
+  }
   int count = 0;
   double open = 0;
-  for (const auto& [t, step] : *events) {
+  std::size_t i = 0, j = 0;
+  while (j < m) {
+    const bool start = i < n && e[i].first < f[j].first;
+    const double t = start ? e[i++].first : f[j++].first;
     const bool was = count >= need;
-    count += step;
+    count += start ? 1 : -1;
     const bool is = count >= need;
     if (!was && is) {
       open = t;

@@ -39,45 +39,39 @@ struct Work {
 
 }  // namespace
 
-void ColumnImage::block_bounds(double i0, double i1, double j0, double j1, double lo, double hi,
-                               Range* inner, Range* outer) const {
-  double in_lo = lo, in_hi = hi;
+Range ColumnImage::block_inner(double i0, double i1, double j0, double j1, double lo,
+                               double hi) const {
   for (const double i : {i0, i1})
     for (const double j : {j0, j1}) {
       const Range r = seen(i, j, lo, hi);
-      in_lo = std::max(in_lo, r.lo), in_hi = std::min(in_hi, r.hi);
+      lo = std::max(lo, r.lo), hi = std::min(hi, r.hi);
     }
-  // Outer: per half-space alpha(i, j) + t beta >= 0 (alpha affine), the loosest corner bound.
+  return {lo, hi};
+}
+
+Range ColumnImage::block_outer(double i0, double i1, double j0, double j1, double lo,
+                               double hi) const {
+  // Per half-space alpha(i, j) + t beta >= 0 (alpha affine), the loosest corner bound.
   const Vec3 c[4] = {A(i0, j0), A(i1, j0), A(i0, j1), A(i1, j1)};
   double o_lo = lo, o_hi = hi;
-  const auto half = [&](auto alpha, double beta) {
-    double lo_bound = 1e300, hi_bound = -1e300;
-    bool any = false;
-    for (const Vec3& a : c) {
-      const double al = alpha(a);
-      if (beta == 0) {
-        any = any || al >= 0;
-        continue;
-      }
-      const double t = -al / beta;
-      lo_bound = std::min(lo_bound, t), hi_bound = std::max(hi_bound, t);
-    }
+  const auto half = [&](const Vec3& w, double beta) {  // alpha = w . A
+    double a_max = -1e300;  // the loosest bound comes from the largest alpha either way
+    for (const Vec3& a : c) a_max = std::max(a_max, w.dot(a));
     if (beta > 0) {
-      o_lo = std::max(o_lo, lo_bound);
+      o_lo = std::max(o_lo, -a_max / beta);
     } else if (beta < 0) {
-      o_hi = std::min(o_hi, hi_bound);
-    } else if (!any) {
+      o_hi = std::min(o_hi, -a_max / beta);
+    } else if (a_max < 0) {
       o_lo = 1, o_hi = 0;
     }
   };
   const detail::Rect& r = rect;
-  half([&](const Vec3& a) { return a[2] - 1e-12; }, b[2]);
-  half([&](const Vec3& a) { return a[0] - r.u0 * a[2]; }, b[0] - r.u0 * b[2]);
-  half([&](const Vec3& a) { return r.u1 * a[2] - a[0]; }, r.u1 * b[2] - b[0]);
-  half([&](const Vec3& a) { return a[1] - r.v0 * a[2]; }, b[1] - r.v0 * b[2]);
-  half([&](const Vec3& a) { return r.v1 * a[2] - a[1]; }, r.v1 * b[2] - b[1]);
-  *inner = {in_lo, in_hi};
-  *outer = {o_lo, o_hi};
+  half(Vec3(0, 0, 1), b[2]);  // w > 0 (the 1e-12 of in_rect only makes the outer bound looser)
+  half(Vec3(1, 0, -r.u0), b[0] - r.u0 * b[2]);
+  half(Vec3(-1, 0, r.u1), r.u1 * b[2] - b[0]);
+  half(Vec3(0, 1, -r.v0), b[1] - r.v0 * b[2]);
+  half(Vec3(0, -1, r.v1), r.v1 * b[2] - b[1]);
+  return {o_lo, o_hi};
 }
 
 ColumnImage column_image(const Camera& camera, const GridSpec& g) {
@@ -149,32 +143,37 @@ void cut_blocks(const GridSpec& g, const SegmentSet* src, const BlockCutViews& v
       }
     }
     if (dead) continue;
-    for (std::size_t k = 0; k < P; ++k)
-      views.partial[k]->image.block_bounds(i0, i1, bj0, bj1, t0, t1, &inner[k], &outer[k]);
-    for (std::size_t k = 0; k < G; ++k)
-      views.general_image[k].block_bounds(i0, i1, bj0, bj1, t0, t1, &inner[P + k], &outer[P + k]);
-    if (need > 0) {
-      w.cover.clear();
-      detail::at_least(outer, need, t0, t1, &w.events, &w.cover);
-      intersect_ranges(&set, w.cover, &w.tmp);
-    }
     // A partial view keeps, of what it sees from every column of the block (the inner seen
     // range), only the t where some column of the block can image into its silhouette's rows.
-    for (std::size_t k = 0; k < P && !set.empty(); ++k) {
-      const auto* f = views.partial[k];
+    std::size_t done = 0;
+    for (; done < P && !set.empty(); ++done) {
+      const auto* f = views.partial[done];
+      inner[done] = f->image.block_inner(i0, i1, bj0, bj1, t0, t1);
       int k0 = 0, k1 = 0;
-      if (!(inner[k].lo < inner[k].hi) || !f->block_bins(i0, i1, bj0, bj1, &k0, &k1)) continue;
+      if (!(inner[done].lo < inner[done].hi) || !f->block_bins(i0, i1, bj0, bj1, &k0, &k1))
+        continue;
       double y0 = 0, y1 = 0;
       f->rows(k0, k1, &y0, &y1);
       w.keep.clear();
-      w.keep.push_back({t0 - 1, inner[k].lo});
+      w.keep.push_back({t0 - 1, inner[done].lo});
       if (y0 <= y1) {
         const Range sil = f->block_t(i0, i1, bj0, bj1, y0, y1);
-        const double a = std::max(sil.lo, inner[k].lo), b = std::min(sil.hi, inner[k].hi);
+        const double a = std::max(sil.lo, inner[done].lo), b = std::min(sil.hi, inner[done].hi);
         if (a < b) w.keep.push_back({a, b});
       }
-      w.keep.push_back({inner[k].hi, t1 + 1});
+      w.keep.push_back({inner[done].hi, t1 + 1});
       intersect_ranges(&set, w.keep, &w.tmp);
+    }
+    if (set.empty()) continue;
+    // Coverage: t seen by fewer than `need` views even by the outer ranges.
+    if (need > 0) {
+      for (std::size_t k = 0; k < P; ++k)
+        outer[k] = views.partial[k]->image.block_outer(i0, i1, bj0, bj1, t0, t1);
+      for (std::size_t k = 0; k < G; ++k)
+        outer[P + k] = views.general_image[k].block_outer(i0, i1, bj0, bj1, t0, t1);
+      w.cover.clear();
+      detail::at_least(outer, need, t0, t1, &w.events, &w.cover);
+      intersect_ranges(&set, w.cover, &w.tmp);
     }
     if (set.empty()) continue;
     const int su = blk.tu1 - blk.tu0, sv = blk.tv1 - blk.tv0;
@@ -183,6 +182,8 @@ void cut_blocks(const GridSpec& g, const SegmentSet* src, const BlockCutViews& v
       tile.alive = true;
       tile.sees.resize(P);
       for (std::size_t k = 0; k < P; ++k) tile.sees[k] = within(set, inner[k]);
+      for (std::size_t k = 0; k < G; ++k)
+        inner[P + k] = views.general_image[k].block_inner(i0, i1, bj0, bj1, t0, t1);
       inner_cover.clear();
       detail::at_least(inner, need, t0, t1, &w.events, &inner_cover);
       tile.covered = need <= 0 || within(set, inner_cover);

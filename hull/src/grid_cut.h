@@ -40,12 +40,12 @@ struct ColumnImage {
     return detail::in_rect(A(i, j), b, rect, lo, hi);
   }
   // For the block of columns [i0, i1] x [j0, j1] (corner columns included):
-  // inner: t-range seen from EVERY column of the block (the corners' common range: the block's
-  //        cross-section at such t is the convex hull of four seen points);
+  // inner: the t-range seen from EVERY column of the block (the corners' common range: the
+  //        block's cross-section at such t is the convex hull of four seen points);
   // outer: a t-range holding everything any column of the block sees (per half-space, the
   //        loosest corner bound; their intersection).
-  void block_bounds(double i0, double i1, double j0, double j1, double lo, double hi,
-                    detail::Range* inner, detail::Range* outer) const;
+  detail::Range block_inner(double i0, double i1, double j0, double j1, double lo, double hi) const;
+  detail::Range block_outer(double i0, double i1, double j0, double j1, double lo, double hi) const;
 };
 
 struct GridCutAccess {

@@ -502,9 +502,13 @@ bool GridCutAccess::make(const PreparedView& view, const GridSpec& g, Fast* f) {
     f->group_lo[k / Fast::kGroup] = std::min(f->group_lo[k / Fast::kGroup], f->row_lo[k]);
     f->group_hi[k / Fast::kGroup] = std::max(f->group_hi[k / Fast::kGroup], f->row_hi[k]);
   }
+  // Run ends are pixel-row edges y - 0.5 (build_pencil): one division per row edge, not per end.
+  const int H = m.mask->height();
+  std::vector<double> inv(std::size_t(H) + 1);
+  for (int y = 0; y <= H; ++y) inv[std::size_t(y)] = 1 / (V[1] - (y - 0.5) * V[2]);
   f->ends.resize(m.bin_v.size());
   for (std::size_t r = 0; r < m.bin_v.size(); ++r) {
-    const double y = m.bin_v[r], a = 1 / (V[1] - y * V[2]);
+    const double y = m.bin_v[r], a = inv[std::size_t(std::lround(y + 0.5))];
     f->ends[r] = {y * a, a};
   }
   return true;
