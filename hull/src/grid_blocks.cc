@@ -199,6 +199,7 @@ void cut_blocks(const GridSpec& g, const SegmentSet* src, const BlockCutViews& v
   // Exact cut of the columns of the surviving tiles, in column order.
   const Interval full_column{float(t0), float(t1)};
   std::vector<Range> seen(P);
+  std::vector<int> bins(P);
   Vec3 d = Vec3::Zero();
   d[g.a()] = 1;
   for (int j = j0; j < j1; ++j) {
@@ -226,14 +227,16 @@ void cut_blocks(const GridSpec& g, const SegmentSet* src, const BlockCutViews& v
           std::swap(w.a, w.b);
           dead = w.a.empty();
         }
+        // First the cheapest test that can kill the column: a view that sees all of it and
+        // whose bin holds no silhouette.
+        for (std::size_t p = 0; p < P && !dead; ++p) {
+          bins[p] = views.partial[p]->bin(i, j);
+          dead = tile.sees[p] && bins[p] < 0;
+        }
         for (std::size_t p = 0; p < P && !dead; ++p) {
           const auto* f = views.partial[p];
-          const int k = f->bin(i, j);
+          const int k = bins[p];
           if (tile.sees[p]) {  // the column's set lies in what this view sees: bins decide
-            if (k < 0) {
-              dead = true;
-              break;
-            }
             w.b.clear();
             f->cut(i, j, k, w.a, &w.pieces, &w.b);
             std::swap(w.a, w.b);
