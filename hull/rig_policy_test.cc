@@ -234,6 +234,9 @@ TEST(RigPolicy, TiltedRigHullIsAccurate) {
   const testing::VoxelCarve carve(s.frame.cameras, s.frame.truth, kDefaultMinViews);
   const double voxel = (box.box_max - box.box_min).prod() / (256.0 * 256.0 * 256.0);
   const double reference = double(carve.carve(box, 256)) * voxel;
+  const Eigen::Vector3d size = box.box_max - box.box_min;
+  std::printf("loose box %.2f x %.2f x %.2f m (actor %.2f x %.2f x %.2f)\n", size.x(), size.y(),
+              size.z(), s.hi.x() - s.lo.x(), s.hi.y() - s.lo.y(), s.hi.z() - s.lo.z());
   for (const int n : {128, 256}) {
     GridSpec g = box;
     g.cells_u = g.cells_v = n;
