@@ -12,6 +12,7 @@
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
+#include "hull/viewpoint_cut.h"
 #include "hull/visibility.h"
 #include "testing/raster.h"
 #include "testing/sim_rig.h"
@@ -223,6 +224,34 @@ TEST(RigPolicy, CoverageReportMatchesSampledPoints) {
   EXPECT_GT(cov->below_min_views, 0.05);  // the loose box is looser than the rig
   EXPECT_EQ(cov->min_views, 2);
   EXPECT_FALSE(coverage(loose, s.frame.cameras, 65));
+}
+
+// The projector mask (viewpoint_cut) under the same policy: from a projector above the rig, the
+// loose box gives the tight box's mask; min_views 0 covers the unseen slabs too (control).
+TEST(RigPolicy, ProjectorMaskOfTheLooseBoxIsTheTightBoxMask) {
+  const RigScene& s = RigScene::get();
+  const auto views = s.frame.views();
+  const Eigen::Vector3d mid = 0.5 * (s.lo + s.hi);
+  const Camera projector = testing::look_at("projector", mid + Eigen::Vector3d(0.5, 3.5, 3.0), mid,
+                                            Eigen::Vector3d::UnitY(), 512, 384, 420);
+  const auto box_of = [](const GridSpec& g) { return Eigen::AlignedBox3d(g.box_min, g.box_max); };
+  const auto pixels = [&](const GridSpec& g, int min_views) {
+    ViewpointOptions o;
+    o.step = 2;
+    o.cut.min_views = min_views;
+    o.cut.threads = 2;
+    auto cut = viewpoint_cut(projector, box_of(g), views, o);
+    EXPECT_TRUE(cut) << cut.error().message;
+    return cut ? std::size_t(cut->coverage.area()) : std::size_t(0);
+  };
+  const std::size_t tight = pixels(testing::tight_box(s.lo, s.hi, 0.1, 1), kDefaultMinViews);
+  const std::size_t loose = pixels(testing::loose_box(s.lo, s.hi, 3, 1), kDefaultMinViews);
+  const std::size_t keep = pixels(testing::loose_box(s.lo, s.hi, 3, 1), 0);
+  std::printf("projector mask pixels: tight %zu, loose %zu, loose with min_views 0 %zu\n", tight,
+              loose, keep);
+  ASSERT_GT(tight, 500u);
+  EXPECT_NEAR(double(loose) / double(tight), 1.0, 0.03);
+  EXPECT_GT(double(keep), 2.0 * double(tight));
 }
 
 // The accuracy targets on the 20-camera rig, loose box: watertight meshes, every view's
