@@ -130,9 +130,12 @@ TEST(SilhouetteCut, RandomScenesContainTheObjectAndViewsOnlyShrink) {
     std::vector<View> views;
     double previous = SegmentSet::full(g).volume();
     SegmentSet hull = SegmentSet::full(g);
+    CutOptions one_at_a_time;  // one view per call: what it does not see stays for the next
+    one_at_a_time.min_views = 0;
     for (std::size_t k = 0; k < cams.size(); ++k) {
-      ASSERT_TRUE(
-          cut(hull, std::span<const View>(&views.emplace_back(View{&cams[k], &masks[k]}), 1)));
+      ASSERT_TRUE(cut(hull,
+                      std::span<const View>(&views.emplace_back(View{&cams[k], &masks[k]}), 1),
+                      one_at_a_time));
       EXPECT_LE(hull.volume(), previous + 1e-12) << "view " << k;
       previous = hull.volume();
     }
@@ -220,6 +223,8 @@ TEST(SilhouetteCut, GridFastPathMatchesPerLineCut) {
   EXPECT_LE(differ, nonempty / 100) << differ << " of " << nonempty << " columns differ";
 }
 
+// The visibility policy's two extremes with one camera: min_views 0 keeps what it does not see,
+// min_views all (= 1 here) cuts it.
 TEST(SilhouetteCut, OutsideImageKeptOrCut) {
   Scene s;
   s.ellipsoids.push_back({Eigen::Vector3d(0, 1, 0), Eigen::Vector3d::Constant(0.3)});
@@ -233,7 +238,8 @@ TEST(SilhouetteCut, OutsideImageKeptOrCut) {
   g.box_max = {0.5, 3, 0.5};
   g.cells_u = g.cells_v = 40;
   CutOptions keep, drop;
-  drop.outside = Outside::cut;
+  keep.min_views = 0;
+  drop.min_views = kAllViews;
   auto a = visual_hull(g, std::span<const View>(&v, 1), keep);
   auto b = visual_hull(g, std::span<const View>(&v, 1), drop);
   ASSERT_TRUE(a && b);

@@ -10,6 +10,7 @@
 
 #include "core/rig.h"
 #include "support/cameras.h"
+#include "testing/mesh_read.h"
 #include "testing/synthetic.h"
 #include "yaml_io/rig_yaml.h"
 
@@ -110,7 +111,64 @@ TEST_F(HullCli, RejectsEmptyBox) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
+// The visibility policy through the process (issue 18): a box much looser than the 4-camera rig.
+// --min-views 0 (the former --outside keep) keeps what no camera sees; the default (2) cuts it
+// but, with only 4 cameras 90 degrees apart, keeps where exactly two opposite cameras' cones
+// cross beyond the other two's images; --min-views 3 gives the tight box's hull. --timing
+// reports the box coverage.
+TEST_F(HullCli, DefaultPolicyIgnoresWhatTheCamerasDoNotSee) {
+  const auto hull_volume = [&](const std::string& box, const std::string& extra, Result* r) {
+    *r = run(base_ + "--masks " + (dir_ / "masks").string() + " --box " + box + " --out " +
+                 (dir_ / "v.ply").string() + " --timing " + extra,
+             dir_);
+    EXPECT_EQ(r->code, 0) << r->err;
+    auto mesh = testing::read_ply((dir_ / "v.ply").string());
+    EXPECT_TRUE(mesh) << (mesh ? "" : mesh.error().message);
+    return mesh ? mesh->volume() : 0.0;
+  };
+  const auto number = [](const std::string& json, const std::string& key) {
+    const auto at = json.find("\"" + key + "\": ");
+    EXPECT_NE(at, std::string::npos) << key << " in " << json;
+    return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 4));
+  };
+  Result tight, loose, keep;
+  const double v_tight = hull_volume("-1,0,-1,1,2,1", "", &tight);
+  const double v_loose = hull_volume("-4,-1,-4,4,5,4", "--grid 256", &loose);
+  const double v_keep = hull_volume("-4,-1,-4,4,5,4", "--grid 256 --min-views 0", &keep);
+  Result three;
+  const double v_three = hull_volume("-4,-1,-4,4,5,4", "--grid 256 --min-views 3", &three);
+  std::printf("tight %.4f, loose: default %.4f, min-views 0 %.4f, min-views 3 %.4f m^3\n", v_tight,
+              v_loose, v_keep, v_three);
+  EXPECT_GT(v_tight, 0.01);
+  // 64 columns over 2 m and 256 over 8 m: the same cells.
+  EXPECT_GT(v_keep, 20 * v_tight);
+  EXPECT_LT(v_loose, 0.2 * v_keep);
+  EXPECT_GT(v_loose, 0.97 * v_tight);
+  EXPECT_NEAR(v_three / v_tight, 1.0, 0.05);
+  EXPECT_EQ(number(tight.out, "min_views"), 2);
+  EXPECT_NEAR(number(tight.out, "unseen_fraction"), 0.0, 1e-9);
+  EXPECT_GT(number(loose.out, "unseen_fraction"), 0.2);
+  EXPECT_GE(number(loose.out, "below_min_views_fraction"), number(loose.out, "unseen_fraction"));
+  EXPECT_EQ(number(keep.out, "below_min_views_fraction"), 0);
+  // --progress: the coverage line on stderr.
+  Result r;
+  hull_volume("-4,-1,-4,4,5,4", "--progress", &r);
+  EXPECT_NE(r.err.find("box coverage:"), std::string::npos) << r.err;
+}
+
 TEST_F(HullCli, HelpAndBadArguments) {
+  const Result help = run("offline --help", dir_);
+  EXPECT_EQ(help.code, 0);
+  EXPECT_NE(help.out.find("--min-views N     visibility policy (default 2)"), std::string::npos);
+  for (const char* bad : {"--min-views x", "--min-views 65", "--outside keep"}) {
+    const Result b = run(base_ + "--masks " + (dir_ / "masks").string() +
+                             " --box -1,0,-1,1,2,1 --out " + (dir_ / "a.ply").string() + " " + bad,
+                         dir_);
+    EXPECT_EQ(b.code, 2) << bad;
+    EXPECT_EQ(std::count(b.err.begin(), b.err.end(), '\n'), 1) << b.err;
+    EXPECT_NE(b.err.find(std::string(bad).substr(0, std::string(bad).find(' '))), std::string::npos)
+        << b.err;
+  }
   EXPECT_EQ(run("--help", dir_).code, 0);
   const Result r = run("offline --grid x", dir_);
   EXPECT_EQ(r.code, 2);

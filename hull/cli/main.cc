@@ -23,6 +23,7 @@
 #include "hull/mesh_io.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
+#include "hull/visibility.h"
 #include "hull_node.h"
 #include "keyer/config/keyer_yaml.h"
 #include "yaml_io/rig_yaml.h"
@@ -39,7 +40,7 @@ constexpr const char* kUsage =
                            --box X0,Y0,Z0,X1,Y1,Z1
                            --grid N [--axis x|y|z] [--frames A:B] --out FILE|DIR
                            [--format ply|obj|glb] [--keyer keyer.yaml | --key blue|green]
-                           [--outside keep|cut] [--no-refine] [--threads N] [--timing]
+                           [--min-views N|all] [--no-refine] [--threads N] [--timing]
                            [--progress | --quiet]
 
 Offline visual hull (line-segment representation, segment marching cubes) from silhouettes.
@@ -60,15 +61,26 @@ Offline visual hull (line-segment representation, segment marching cubes) from s
                     between PCs)
   --out PATH        mesh file for one frame (.ply/.obj/.glb), else a folder (<frame>.<format>)
   --format F        mesh format in a folder (default ply)
-  --outside M       keep (default) or cut the parts of a column that leave a camera's image
+  --min-views N     visibility policy (default 2): a point is actor only if it is inside the
+                    silhouette of every camera that sees it (in front, inside its image) AND
+                    at least N cameras see it. 2 is the fewest views that bound a point in depth:
+                    parts of a loose box seen by no camera or by one (slabs, single silhouette
+                    cones) are cut, while every point of a studio's acting area is seen by at
+                    least 2 cameras, so the hull stays a superset of the actor there. 0 keeps
+                    what no camera sees (the former --outside keep); all: every camera must see
+                    the point (the former --outside cut: cuts an actor who leaves one image)
   --no-refine       skip the exact crossings (vertices between an inside and an outside column
                     stay at half a cell, which re-projects about half a cell too wide)
   --threads N       worker threads (default: all cores; frames run in parallel, a single frame
                     cuts its columns in parallel)
   --timing          print JSON on stdout: milliseconds per frame of each stage (load, key, cut,
-                    mesh, refine, write) and the wall time
+                    mesh, refine, write), the wall time and the box coverage (below)
   --progress        progress bar on stderr even when it is not a terminal (default: only on a
                     terminal, for more than one frame); --quiet: never
+Box coverage: the fraction of the box no camera sees and the fraction seen by fewer than
+--min-views cameras (cut whatever the silhouettes; large means the box is looser than the rig)
+are in the --timing JSON (unseen_fraction, below_min_views_fraction) and, on a terminal or with
+--progress, on one stderr line after the last frame.
 Exit status: 0 done; 2 bad arguments or input found before any frame (missing camera, empty
 box, ...); 1 a frame failed (unreadable or wrong-size mask or take frame, CRC, disk); frames
 finished before it stay written. Errors are one line on stderr.
@@ -82,7 +94,7 @@ struct Args {
   int grid = 0;
   Axis axis = Axis::y;
   std::optional<cli::FrameRange> frames;
-  Outside outside = Outside::keep;
+  int min_views = kDefaultMinViews;
   int threads = int(std::max(1u, std::thread::hardware_concurrency()));
   bool timing = false, refine = true;
   std::optional<bool> progress;
@@ -167,13 +179,20 @@ Expected<Args> parse(int argc, char** argv) {
         return fail("--frames: '" + *v + "': expected A:B with 0 <= A <= B");
       }
       a.frames = cli::FrameRange{lo, hi};
+    } else if (opt == "--min-views") {
+      if (*v == "all") {
+        a.min_views = kAllViews;
+      } else {
+        try {
+          std::size_t used = 0;
+          a.min_views = std::stoi(*v, &used);
+          if (used != v->size() || a.min_views < 0 || a.min_views > 64) throw 0;
+        } catch (...) {
+          return fail("--min-views: '" + *v + "': expected 0..64 or all");
+        }
+      }
     } else if (opt == "--outside") {
-      if (*v == "keep")
-        a.outside = Outside::keep;
-      else if (*v == "cut")
-        a.outside = Outside::cut;
-      else
-        return fail("--outside: '" + *v + "': expected keep or cut");
+      return fail("--outside was replaced by --min-views N|all (keep = 0, cut = all; see --help)");
     } else {
       return fail("unknown option " + opt + " (see --help)");
     }
@@ -286,9 +305,17 @@ int run_offline(int argc, char** argv) {
 
   const int workers = std::min<int>(args->threads, int(frames.size()));
   CutOptions cut_options;
-  cut_options.outside = args->outside;
+  cut_options.min_views = args->min_views;
   cut_options.threads = frames.size() == 1 ? args->threads : 1;
   const bool progress = frames.size() > 1 && args->progress.value_or(::isatty(2) != 0);
+  // How much of the box the rig covers (a fraction: at most 128 x 128 columns suffice).
+  GridSpec coarse = grid;
+  coarse.cells_u = coarse.cells_v = std::min(grid.cells_u, 128);
+  auto covered = coverage(coarse, cameras, args->min_views);
+  if (!covered) {
+    std::cerr << "studio-hull: " << covered.error().message << "\n";
+    return 2;
+  }
   std::atomic<std::size_t> next{0}, done{0};
   std::atomic<bool> failed{false};
   std::mutex lock;
@@ -352,16 +379,24 @@ int run_offline(int argc, char** argv) {
     std::cerr << "studio-hull: " << error << "\n";
     return 1;
   }
+  if (args->progress.value_or(::isatty(2) != 0)) {
+    std::fprintf(stderr,
+                 "studio-hull: box coverage: %.1f %% seen by no camera, %.1f %% by fewer than %d "
+                 "(cut by --min-views)\n",
+                 100 * covered->unseen, 100 * covered->below_min_views, covered->min_views);
+  }
   if (args->timing) {
     const double n = double(frames.size());
     std::printf(
         "{\"input\": \"%s\", \"frames\": %zu, \"grid\": %d, \"cameras\": %zu, \"threads\": %d, "
         "\"frames_in_parallel\": %d, "
         "\"exact_crossings\": %s, \"load\": %.3f, \"key\": %.3f, \"cut\": %.3f, \"mesh\": %.3f, "
-        "\"refine\": %.3f, \"write\": %.3f, \"unit\": \"ms per frame\", \"wall_ms\": %.3f}\n",
+        "\"refine\": %.3f, \"write\": %.3f, \"unit\": \"ms per frame\", \"wall_ms\": %.3f, "
+        "\"min_views\": %d, \"unseen_fraction\": %.5f, \"below_min_views_fraction\": %.5f}\n",
         in.keyed() ? "take" : "masks", frames.size(), args->grid, cameras.size(), args->threads,
         workers, args->refine ? "true" : "false", t_load.read / n, t_load.key / n, t_cut / n,
-        t_mesh / n, t_refine / n, t_write / n, ms_since(wall0));
+        t_mesh / n, t_refine / n, t_write / n, ms_since(wall0), covered->min_views, covered->unseen,
+        covered->below_min_views);
   }
   return 0;
 }

@@ -39,7 +39,8 @@ runtime::ServiceDefinition hull_service_definition() {
       "    axis: y                 continuous axis of the segments: x|y|z\n"
       "    deadline_ms: 40         wait for a frame's missing masks at most this long\n"
       "    min_cameras: 2          drop a frame with fewer masks at its deadline\n"
-      "    outside: keep           column parts outside an image: keep|cut\n"
+      "    min_views: 2            actor = inside every silhouette that sees it AND seen by\n"
+      "                            >= min_views cameras (0..64; see studio-hull offline --help)\n"
       "    threads: 2              cut threads\n"
       "    mesh: true              publish studio/actor/mesh\n"
       "    refine: true            exact crossings on the mesh (else half-cell vertices)\n"
@@ -57,8 +58,7 @@ runtime::ServiceDefinition hull_service_definition() {
                          {{"x", Axis::x}, {"y", Axis::y}, {"z", Axis::z}}),
         yaml::field("deadline_ms", &HullNodeOptions::deadline_ms).range(1, 1000),
         yaml::field("min_cameras", &HullNodeOptions::min_cameras).range(1, 64),
-        yaml::enum_field("outside", &HullNodeOptions::outside,
-                         {{"keep", Outside::keep}, {"cut", Outside::cut}}),
+        yaml::field("min_views", &HullNodeOptions::min_views).range(0, 64),
         yaml::field("threads", &HullNodeOptions::threads).range(1, 64),
         yaml::field("mesh", &HullNodeOptions::mesh),
         yaml::field("refine", &HullNodeOptions::refine),

@@ -9,6 +9,7 @@
 #include "hull/camera_poses.h"
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
+#include "hull/visibility.h"
 #include "runtime/service_loop.h"
 #include "wire/actor_convert.h"
 #include "wire/convert.h"
@@ -132,7 +133,7 @@ class HullNode : public runtime::Node {
       views.push_back(View{pose.camera, &*frame.items[i]});
     }
     CutOptions cut;
-    cut.outside = options_.outside;
+    cut.min_views = options_.min_views;
     cut.threads = options_.threads;
     auto hull = visual_hull(options_.grid_spec(), views, cut);
     if (!hull) {
@@ -205,6 +206,12 @@ Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& o
   if (std::size_t(options.min_cameras) > cameras.size())
     return fail("min_cameras " + std::to_string(options.min_cameras) + " exceeds the rig's " +
                 std::to_string(cameras.size()) + " cameras");
+  GridSpec sampled = options.grid_spec();  // a fraction: 128 x 128 columns at most suffice
+  sampled.cells_u = sampled.cells_v = std::min(sampled.cells_u, 128);
+  if (auto c = coverage(sampled, cameras, options.min_views); c) {
+    STUDIO_LOG(info, kLog) << "box coverage: " << 100 * c->unseen << " % seen by no camera, "
+                           << 100 * c->below_min_views << " % by fewer than " << c->min_views;
+  }
   return std::unique_ptr<runtime::Node>(new HullNode(options, std::move(cameras), context));
 }
 

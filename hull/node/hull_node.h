@@ -13,7 +13,9 @@
 //   axis: y                   continuous axis of the segments (x|y|z)
 //   deadline_ms: 40           wait for a frame's missing masks at most this long
 //   min_cameras: 2            fewer masks than this at the deadline: the frame is dropped
-//   outside: keep             a column part outside an image is kept or cut (keep|cut)
+//   min_views: 2              visibility policy (hull/silhouette_cut.h): a point is actor iff
+//                             inside every silhouette that sees it and seen by >= min_views
+//                             cameras (0..64; the offline CLI's default, kDefaultMinViews)
 //   threads: 2                cut threads (columns are independent)
 //   mesh: true                publish studio/actor/mesh (segment marching cubes)
 //   refine: true              exact crossings on the mesh (hull/crossing_refine.h): vertices
@@ -39,7 +41,7 @@ struct HullNodeOptions {
   Axis axis = Axis::y;
   double deadline_ms = 40;
   int min_cameras = 2;
-  Outside outside = Outside::keep;
+  int min_views = kDefaultMinViews;
   int threads = 2;
   bool mesh = true;
   bool refine = true;

@@ -38,13 +38,27 @@ Expected<void> cut_grid(const GridSpec& g, const SegmentSet* src, std::span<cons
   // touching float pieces merge; it is fixed, so the result does not depend on the threads.
   std::vector<GridCutAccess::Fast> fast;
   std::vector<const PreparedView*> general;
-  for (const PreparedView& p : prepared) {
+  std::vector<const Camera*> general_camera;
+  for (std::size_t k = 0; k < prepared.size(); ++k) {
     GridCutAccess::Fast f;
-    if (GridCutAccess::make(p, g, &f)) {
+    if (GridCutAccess::make(prepared[k], g, &f)) {
       fast.push_back(std::move(f));
     } else {
-      general.push_back(&p);
+      general.push_back(&prepared[k]);
+      general_camera.push_back(views[k].camera);
     }
+  }
+  const int need = options.required_views(views.size());
+  // The studio case: every view sees the whole domain with pencil bins (the policy holds for
+  // every point once enough of them do). Otherwise the coarse-to-fine cut of grid_blocks.cc.
+  const bool studio = general.empty() && need <= int(fast.size()) &&
+                      std::all_of(fast.begin(), fast.end(), [](const auto& f) { return f.whole; });
+  BlockCutViews block_views;
+  if (!studio) {
+    for (const auto& f : fast) (f.whole ? block_views.full : block_views.partial).push_back(&f);
+    block_views.general = general;
+    for (const Camera* c : general_camera) block_views.general_image.push_back(column_image(*c, g));
+    block_views.need = need;
   }
   Vec3 d = Vec3::Zero();
   d[g.a()] = 1;
@@ -58,6 +72,7 @@ Expected<void> cut_grid(const GridSpec& g, const SegmentSet* src, std::span<cons
   const auto work = [&](int chunk) {
     const int j0 = int(int64_t(nv) * chunk / T), j1 = int(int64_t(nv) * (chunk + 1) / T);
     std::vector<Interval>& out = chunk_iv[chunk];
+    if (!studio) return cut_blocks(g, src, block_views, j0, j1, &out, &start);
     std::vector<Interval> a, b;
     std::vector<Range> pieces;
     std::vector<GridCutAccess::Span> alive, spans, next;

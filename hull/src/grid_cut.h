@@ -21,10 +21,32 @@
 #include <utility>
 #include <vector>
 
+#include "frustum.h"
 #include "hull/segment_set.h"
 #include "hull/silhouette_cut.h"
 
 namespace studio::hull {
+
+// The homogeneous image of the grid's columns in one camera: column (i, j) at parameter t images
+// to A(i, j) + t B with A affine in (i, j) and B = P (e_axis, 0) constant. Every "seen" test
+// (detail::in_rect) is then a half-space in (i, j, t), so the seen set is convex in (i, j, t):
+// bounds over a block of columns follow from its four corner columns.
+struct ColumnImage {
+  Eigen::Vector3d a0, ai, aj, b;
+  detail::Rect rect;
+
+  Eigen::Vector3d A(double i, double j) const { return a0 + i * ai + j * aj; }
+  detail::Range seen(double i, double j, double lo, double hi) const {
+    return detail::in_rect(A(i, j), b, rect, lo, hi);
+  }
+  // For the block of columns [i0, i1] x [j0, j1] (corner columns included):
+  // inner: the t-range seen from EVERY column of the block (the corners' common range: the
+  //        block's cross-section at such t is the convex hull of four seen points);
+  // outer: a t-range holding everything any column of the block sees (per half-space, the
+  //        loosest corner bound; their intersection).
+  detail::Range block_inner(double i0, double i1, double j0, double j1, double lo, double hi) const;
+  detail::Range block_outer(double i0, double i1, double j0, double j1, double lo, double hi) const;
+};
 
 struct GridCutAccess {
   struct End {
@@ -32,6 +54,9 @@ struct GridCutAccess {
   };
   using Span = std::pair<int, int>;
   struct Fast {
+    bool whole = true;  // the domain projects inside the image (else `image` clips each column)
+    ColumnImage image;
+    std::vector<uint32_t> occupied_before;  // occupied_before[k]: bins < k holding silhouette
     double n0, ni, nj, d0, di, dj;  // bin coordinate = (n0 + j nj + i ni) / (d0 + j dj + i di)
     double a10, a1i, a1j, a20, a2i, a2j;  // A1, A2 of column (i, j)
     int nbins = 0;
@@ -45,6 +70,62 @@ struct GridCutAccess {
       if (!(x >= 0 && x < nbins)) return -1;
       const int k = int(x);
       return bin_start[k] == bin_start[k + 1] ? -1 : k;
+    }
+    // Bins [*k0, *k1) holding every column of the block [i0, i1] x [j0, j1] (corners included):
+    // the bin coordinate is a ratio of affine functions, monotone along each axis where its
+    // denominator keeps its sign, so its extremes are at the corners (one bin of margin for
+    // rounding). False when the denominator changes sign over the block (no bound).
+    bool block_bins(int i0, int i1, int j0, int j1, int* k0, int* k1) const {
+      double lo = 1e300, hi = -1e300;
+      int sign = 0;
+      for (const int i : {i0, i1})
+        for (const int j : {j0, j1}) {
+          const double D = d0 + j * dj + i * di;
+          const int s = D > 0 ? 1 : D < 0 ? -1 : 0;
+          if (s == 0 || (sign != 0 && s != sign)) return false;
+          sign = s;
+          const double x = (n0 + j * nj + i * ni) / D;
+          lo = std::min(lo, x), hi = std::max(hi, x);
+        }
+      if (!(std::isfinite(lo) && std::isfinite(hi))) return false;
+      *k0 = std::clamp(int(std::floor(std::max(lo, -2.0))) - 1, 0, nbins);
+      *k1 = std::clamp(int(std::floor(std::min(hi, nbins + 2.0))) + 2, 0, nbins);
+      return true;
+    }
+    // Whether no column of the block can have a bin holding silhouette.
+    bool block_empty(int i0, int i1, int j0, int j1) const {
+      int k0 = 0, k1 = 0;
+      return block_bins(i0, i1, j0, j1, &k0, &k1) && occupied_before[k1] == occupied_before[k0];
+    }
+    // The image rows [*lo, *hi] spanned by the runs of bins [k0, k1) (*lo > *hi: none).
+    static constexpr int kGroup = 32;
+    std::vector<float> row_lo, row_hi;      // per bin
+    std::vector<float> group_lo, group_hi;  // per kGroup bins
+    void rows(int k0, int k1, double* lo, double* hi) const {
+      float a = 1e30f, b = -1e30f;
+      int k = k0;
+      for (; k < k1 && k % kGroup != 0; ++k) a = std::min(a, row_lo[k]), b = std::max(b, row_hi[k]);
+      for (; k + kGroup <= k1; k += kGroup)
+        a = std::min(a, group_lo[k / kGroup]), b = std::max(b, group_hi[k / kGroup]);
+      for (; k < k1; ++k) a = std::min(a, row_lo[k]), b = std::max(b, row_hi[k]);
+      *lo = a, *hi = b;
+    }
+    double v1 = 0, v2 = 0;  // V[1], V[2]: column (i, j) meets image row y at
+                            // t = (y A2 - A1) / (v1 - y v2), affine in (i, j) for a fixed y
+    // A t-range holding every t where a column of the block [i0, i1] x [j0, j1] images into the
+    // rows [y0, y1]: t(y) is monotone in y along a column and affine in (i, j) for a fixed y.
+    CutScratch::Piece block_t(int i0, int i1, int j0, int j1, double y0, double y1) const {
+      double lo = 1e300, hi = -1e300;
+      for (const double y : {y0, y1}) {
+        const double a = 1 / (v1 - y * v2);
+        for (const int i : {i0, i1})
+          for (const int j : {j0, j1}) {
+            const double A1 = a10 + j * a1j + i * a1i, A2 = a20 + j * a2j + i * a2i;
+            const double t = (y * A2 - A1) * a;
+            lo = std::min(lo, t), hi = std::max(hi, t);
+          }
+      }
+      return {lo, hi};
     }
     // Sorted, disjoint i-ranges of row j holding every column whose bin holds silhouette (a
     // superset: one column of margin for rounding; bin() decides exactly).
@@ -74,6 +155,23 @@ struct GridCutAccess {
           }
         }
         r->resize(w + 1);
+      }
+    }
+    // The t-ranges of bin k's runs on column (i, j), ascending.
+    void pieces(int i, int j, int k, std::vector<CutScratch::Piece>* pieces) const {
+      const double A1 = a10 + j * a1j + i * a1i, A2 = a20 + j * a2j + i * a2i;
+      const uint32_t r0 = bin_start[k], r1 = bin_start[k + 1];
+      const End* e = ends.data() + 2 * r0;
+      const std::size_t n = r1 - r0;
+      pieces->resize(n);
+      CutScratch::Piece* pc = pieces->data();
+      if ((d0 + j * dj + i * di) > 0) {
+        for (std::size_t r = 0; r < n; ++r)
+          pc[n - 1 - r] = {e[2 * r + 1].p * A2 - e[2 * r + 1].q * A1,
+                           e[2 * r].p * A2 - e[2 * r].q * A1};
+      } else {
+        for (std::size_t r = 0; r < n; ++r)
+          pc[r] = {e[2 * r].p * A2 - e[2 * r].q * A1, e[2 * r + 1].p * A2 - e[2 * r + 1].q * A1};
       }
     }
     // out = in ∩ (the t-ranges of bin k's runs), float end points, touching pieces merged.
@@ -112,10 +210,33 @@ struct GridCutAccess {
   };
 
   // A fast cutter for `view` over grid g, or false when the view has no pencil bins or the
-  // domain does not project inside its image.
-  // A fast cutter for `view` over grid g, or false when the view has no pencil bins or the
-  // domain does not project inside its image (defined in silhouette_cut.cc, beside the bins).
+  // domain is not wholly in front of the camera (defined in silhouette_cut.cc, beside the
+  // bins). f->whole tells whether the domain also projects inside the image.
   static bool make(const PreparedView& view, const GridSpec& g, Fast* f);
 };
+
+// The column image of a camera over grid g (first column centre at i = j = 0).
+ColumnImage column_image(const Camera& camera, const GridSpec& g);
+
+// The cut on a general rig (grid_blocks.cc): some views see only part of the domain, or have no
+// pencil bins, or the policy needs coverage. Coarse-to-fine over blocks of columns: a block
+// carries a conservative t-set (a superset of every one of its columns' hull) shrunk by
+//  - a fully-seeing fast view whose bins over the block hold no silhouette (the block dies),
+//  - a partially-seeing fast view whose bins hold no silhouette: the block keeps only what that
+//    view does not see from every column (the complement of the inner seen range),
+//  - coverage: t seen by fewer than `need` views even by the outer seen ranges is cut;
+// blocks whose set empties are skipped whole, the rest split in four down to small leaves whose
+// columns are cut exactly (the same arithmetic as PreparedView::cut_line: exact crossings kept
+// for every interval that survives). Writes the columns' intervals into out/counts like
+// cut_grid's workers (counts[c + 1] = intervals of column c).
+struct BlockCutViews {
+  std::vector<const GridCutAccess::Fast*> full;     // see the whole domain
+  std::vector<const GridCutAccess::Fast*> partial;  // pencil bins, see part of the domain
+  std::vector<const PreparedView*> general;         // cut line by line
+  std::vector<ColumnImage> general_image;           // their column images (coverage)
+  int need = 0;                                     // views that must see a point
+};
+void cut_blocks(const GridSpec& g, const SegmentSet* src, const BlockCutViews& views, int j0,
+                int j1, std::vector<Interval>* out, std::vector<uint32_t>* counts);
 
 }  // namespace studio::hull

@@ -5,6 +5,7 @@
 #include <string>
 #include <thread>
 
+#include "frustum.h"
 #include "grid_cut.h"
 
 namespace studio::hull {
@@ -12,33 +13,10 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-using Range = CutScratch::Piece;
-
-// Restricts [lo, hi] to the t where alpha + t beta >= 0.
-inline void clip_halfline(double alpha, double beta, double& lo, double& hi) {
-  if (beta > 0) {
-    lo = std::max(lo, -alpha / beta);
-  } else if (beta < 0) {
-    hi = std::min(hi, -alpha / beta);
-  } else if (alpha < 0) {
-    lo = 1, hi = 0;
-  }
-}
-
-struct Rect {
-  double u0, u1, v0, v1;
-};
-
-// The t-range of [lo, hi] where the homogeneous image point A + t B is in front of the camera
-// (w > 0) and inside the rectangle. Empty when lo >= hi.
-inline Range in_rect(const Vec3& A, const Vec3& B, const Rect& r, double lo, double hi) {
-  clip_halfline(A[2] - 1e-12, B[2], lo, hi);
-  clip_halfline(A[0] - r.u0 * A[2], B[0] - r.u0 * B[2], lo, hi);
-  clip_halfline(r.u1 * A[2] - A[0], r.u1 * B[2] - B[0], lo, hi);
-  clip_halfline(A[1] - r.v0 * A[2], B[1] - r.v0 * B[2], lo, hi);
-  clip_halfline(r.v1 * A[2] - A[1], r.v1 * B[2] - B[1], lo, hi);
-  return {lo, hi};
-}
+using detail::clip_halfline;
+using detail::in_rect;
+using detail::Range;
+using detail::Rect;
 
 // Pieces of [ta, tb] where the straight image piece A + t B (homogeneous, w > 0, inside the
 // image) lies on a foreground pixel square. Walks the rows it crosses; appends to *out. Every
@@ -130,19 +108,13 @@ Eigen::Vector2d ideal_to_observed(const Camera& c, const Eigen::Vector2d& ideal)
   return {k.fx * d.x() + k.skew * d.y() + k.cx, k.fy * d.y() + k.cy};
 }
 
-Eigen::Vector2d observed_to_ideal(const Camera& c, const Eigen::Vector2d& obs) {
-  const Intrinsics& k = c.intrinsics;
-  const double yn = (obs.y() - k.cy) / k.fy;
-  const double xn = (obs.x() - k.cx - k.skew * yn) / k.fx;
-  const Eigen::Vector2d d = undistort(c.distortion, {xn, yn});
-  return {k.fx * d.x() + k.skew * d.y() + k.cx, k.fy * d.y() + k.cy};
-}
-
 }  // namespace
 
 Expected<void> CutOptions::validate() const {
   if (threads < 1 || threads > 64)
     return fail("threads: " + std::to_string(threads) + " (need 1..64)");
+  if (min_views != kAllViews && (min_views < 0 || min_views > 64))
+    return fail("min_views: " + std::to_string(min_views) + " (need 0..64 or all)");
   return {};
 }
 
@@ -150,10 +122,11 @@ struct PreparedView::Impl {
   Camera camera;
   const RunMask* mask = nullptr;
   Eigen::Matrix<double, 3, 4> P;
-  bool keep_outside = true;
+  static constexpr bool keep_outside = true;  // the policy's min_views is applied by callers
   bool distorted = false;
   Rect image{};        // observed image rectangle (pixel-square edges)
   Rect ideal_image{};  // where the distortion model is trusted (ideal pixels)
+  Rect seen_rect{};    // the policy's seeing rectangle (detail::Frustum)
   // Pencil bins.
   bool pencil = false;
   bool all_inside = false;  // the whole domain projects in front of the camera, inside the image
@@ -385,25 +358,17 @@ Expected<PreparedView> PreparedView::create(const Camera& camera, const RunMask&
   m.camera = camera;
   m.mask = &mask;
   m.P = camera.projection_matrix();
-  m.keep_outside = options.outside == Outside::keep;
   m.distorted = !camera.distortion.is_identity();
   const int W = camera.width, H = camera.height;
   m.image = {-0.5, W - 0.5, -0.5, H - 0.5};
+  m.seen_rect = m.image;
   if (m.distorted) {
     // Ideal bounding box of the observed image border, padded: beyond it the distortion
     // polynomial is not trusted and the line counts as outside the image.
-    double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
-    for (int k = 0; k <= 64; ++k) {
-      const double fu = -0.5 + W * k / 64.0, fv = -0.5 + H * k / 64.0;
-      for (const Eigen::Vector2d& p : {Eigen::Vector2d(fu, -0.5), Eigen::Vector2d(fu, H - 0.5),
-                                       Eigen::Vector2d(-0.5, fv), Eigen::Vector2d(W - 0.5, fv)}) {
-        const Eigen::Vector2d q = observed_to_ideal(camera, p);
-        u0 = std::min(u0, q.x()), u1 = std::max(u1, q.x());
-        v0 = std::min(v0, q.y()), v1 = std::max(v1, q.y());
-      }
-    }
+    const Rect box = detail::ideal_border_box(camera);
     const double pad = 0.02 * std::max(W, H);
-    m.ideal_image = {u0 - pad, u1 + pad, v0 - pad, v1 + pad};
+    m.seen_rect = box;
+    m.ideal_image = {box.u0 - pad, box.u1 + pad, box.v0 - pad, box.v1 + pad};
   } else if (options.allow_pencil) {
     m.build_pencil(pencil_point);
   }
@@ -444,6 +409,14 @@ bool PreparedView::misses(const Eigen::Vector3d& o, const Eigen::Vector3d& d, do
 }
 
 bool PreparedView::uses_pencil() const { return impl_->pencil; }
+
+std::pair<double, double> PreparedView::seen(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                                             double lo, double hi) const {
+  const Impl& m = *impl_;
+  const Vec3 A = m.P.leftCols<3>() * o + m.P.col(3), B = m.P.leftCols<3>() * d;
+  const Range r = in_rect(A, B, m.seen_rect, lo, hi);
+  return {r.lo, r.hi};
+}
 bool PreparedView::domain_inside_image() const { return impl_->all_inside; }
 
 void PreparedView::cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
@@ -483,8 +456,14 @@ void PreparedView::cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
 }
 
 bool GridCutAccess::make(const PreparedView& view, const GridSpec& g, Fast* f) {
+  using Fast = GridCutAccess::Fast;
   const PreparedView::Impl& m = *view.impl_;
-  if (!m.pencil || !m.all_inside) return false;
+  // Any view with pencil bins: on the part of a column in front of the camera the image row is a
+  // monotone function of t whose range holds every image row (the pencil condition puts the
+  // vanishing point's row outside the image), so a run end row maps to one front t; the seen
+  // range (in front, in the image) clips the rest.
+  if (!m.pencil) return false;
+  f->whole = m.all_inside;
   const Vec3& V = m.V;
   Vec3 o = Vec3::Zero();
   o[g.u()] = g.box_min[g.u()] + 0.5 * g.du();
@@ -500,12 +479,36 @@ bool GridCutAccess::make(const PreparedView& view, const GridSpec& g, Fast* f) {
   f->d0 = cd.dot(A0), f->di = cd.dot(Ai), f->dj = cd.dot(Aj);
   f->a10 = A0[1], f->a1i = Ai[1], f->a1j = Aj[1];
   f->a20 = A0[2], f->a2i = Ai[2], f->a2j = Aj[2];
+  f->image = {A0, Ai, Aj, V, {m.image.u0, m.image.u1, m.image.v0, m.image.v1}};
   f->nbins = m.nbins;
   f->bin_start = m.bin_start.data();
   f->occupied = &m.occupied;
+  f->occupied_before.resize(std::size_t(m.nbins) + 1);
+  f->occupied_before[0] = 0;
+  for (int k = 0; k < m.nbins; ++k)
+    f->occupied_before[k + 1] = f->occupied_before[k] + (m.bin_start[k + 1] > m.bin_start[k]);
+  f->v1 = V[1], f->v2 = V[2];
+  f->row_lo.assign(std::size_t(m.nbins), 1e30f);
+  f->row_hi.assign(std::size_t(m.nbins), -1e30f);
+  for (int k = 0; k < m.nbins; ++k)
+    for (uint32_t r = m.bin_start[k]; r < m.bin_start[k + 1]; ++r) {
+      f->row_lo[k] = std::min(f->row_lo[k], m.bin_v[2 * r]);
+      f->row_hi[k] = std::max(f->row_hi[k], m.bin_v[2 * r + 1]);
+    }
+  const int groups = (m.nbins + Fast::kGroup - 1) / Fast::kGroup;
+  f->group_lo.assign(std::size_t(groups), 1e30f);
+  f->group_hi.assign(std::size_t(groups), -1e30f);
+  for (int k = 0; k < m.nbins; ++k) {
+    f->group_lo[k / Fast::kGroup] = std::min(f->group_lo[k / Fast::kGroup], f->row_lo[k]);
+    f->group_hi[k / Fast::kGroup] = std::max(f->group_hi[k / Fast::kGroup], f->row_hi[k]);
+  }
+  // Run ends are pixel-row edges y - 0.5 (build_pencil): one division per row edge, not per end.
+  const int H = m.mask->height();
+  std::vector<double> inv(std::size_t(H) + 1);
+  for (int y = 0; y <= H; ++y) inv[std::size_t(y)] = 1 / (V[1] - (y - 0.5) * V[2]);
   f->ends.resize(m.bin_v.size());
   for (std::size_t r = 0; r < m.bin_v.size(); ++r) {
-    const double y = m.bin_v[r], a = 1 / (V[1] - y * V[2]);
+    const double y = m.bin_v[r], a = inv[std::size_t(std::lround(y + 0.5))];
     f->ends[r] = {y * a, a};
   }
   return true;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <thread>
 
+#include "frustum.h"
+
 namespace studio::hull {
 
 Expected<void> ViewpointOptions::validate() const {
@@ -29,6 +31,7 @@ Expected<ViewpointCut> viewpoint_cut(const Camera& viewpoint, const Eigen::Align
   out.step = options.step;
   out.width = (viewpoint.width + options.step - 1) / options.step;
   out.height = (viewpoint.height + options.step - 1) / options.step;
+  const int need = options.cut.required_views(views.size());
   const int T = std::clamp(options.cut.threads, 1, std::max(1, out.height / 8));
   std::vector<std::vector<Interval>> chunk_iv(T);
   std::vector<std::vector<uint32_t>> chunk_count(T);
@@ -36,6 +39,8 @@ Expected<ViewpointCut> viewpoint_cut(const Camera& viewpoint, const Eigen::Align
     const int y0 = out.height * chunk / T, y1 = out.height * (chunk + 1) / T;
     CutScratch scratch;
     std::vector<Interval> a, b;
+    std::vector<detail::Range> seen(prepared.size()), cover;
+    std::vector<std::pair<double, int>> events;
     for (int y = y0; y < y1; ++y) {
       for (int x = 0; x < out.width; ++x) {
         const Eigen::Vector2d pixel(x * options.step, y * options.step);
@@ -53,7 +58,16 @@ Expected<ViewpointCut> viewpoint_cut(const Camera& viewpoint, const Eigen::Align
         }
         const std::size_t before = chunk_iv[chunk].size();
         if (float(t0) < float(t1)) {
-          a.assign(1, Interval{float(t0), float(t1)});
+          // The visibility policy: only the parts seen by at least `need` views.
+          const Interval whole{float(t0), float(t1)};
+          for (std::size_t k = 0; k < prepared.size(); ++k) {
+            const auto [lo, hi] = prepared[k].seen(C, d, whole.lo, whole.hi);
+            seen[k] = {lo, hi};
+          }
+          cover.clear();
+          detail::at_least(seen, need, whole.lo, whole.hi, &events, &cover);
+          a.clear();
+          detail::intersect(std::span<const Interval>(&whole, 1), cover, &a);
           for (const PreparedView& view : prepared) {
             b.clear();
             view.cut_line(C, d, a, &b, &scratch);

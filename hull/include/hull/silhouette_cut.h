@@ -19,12 +19,14 @@
 // - Row walker (exact for pixel squares, general): walks the rows crossed by each surviving
 //   interval and intersects with that row's runs (binary search). Lens distortion: the line's
 //   observed image curve is cut into chords of <= 8 px, each walked as a straight piece.
-// Parts of a line outside an image (or behind the camera) are kept or cut by Options::outside.
+// Parts of a line a camera does not see (outside its image or behind it) are not judged by that
+// camera's silhouette; the visibility policy below decides them.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/camera.h"
@@ -34,13 +36,34 @@
 
 namespace studio::hull {
 
-enum class Outside { keep, cut };
+// The visibility policy (issue 18; docs/hull.md "Visibility policy"). A camera SEES a point when
+// the point is in front of it and projects into its image (hull/src/frustum.h). A point is actor
+// iff
+//   (a) it lies inside the silhouette of EVERY camera that sees it, and
+//   (b) at least `min_views` cameras see it.
+// (a) alone (min_views 0, the former `outside: keep`) keeps every part of the box no camera sees,
+// and a part seen by one camera is only bounded by that camera's silhouette cone: on a real rig
+// with a loose box these come out as slabs and cones many times the actor's volume. Requiring
+// every camera (min_views = kAllViews, the former `outside: cut`) cuts the actor wherever one
+// camera's image ends before the actor does (feet at the edge of the acting area). Two views
+// are the fewest that bound a point in depth (two cones from different centres cross in a
+// bounded region around the actor), and the studio sees every point of its acting area with at
+// least 2 cameras by design, so kDefaultMinViews = 2: the hull stays a superset of the actor
+// wherever the actor stands in the acting area (the projector mask is drawn from it) and the
+// unseen slabs are gone. The offline CLI and the node both default to it; a consumer that needs
+// another policy sets its own min_views.
+inline constexpr int kDefaultMinViews = 2;
+inline constexpr int kAllViews = -1;  // min_views: every view given must see the point
 
 struct CutOptions {
-  Outside outside = Outside::keep;  // a line part that leaves an image: keep it or cut it
-  int threads = 1;                  // columns are independent; 1..64
-  bool allow_pencil = true;         // false forces the exact row walker (tests compare both)
+  int min_views = kDefaultMinViews;  // 0..64 or kAllViews
+  int threads = 1;                   // columns are independent; 1..64
+  bool allow_pencil = true;          // false forces the exact row walker (tests compare both)
   Expected<void> validate() const;
+  // min_views for a cut with `views` views (kAllViews -> views).
+  int required_views(std::size_t views) const {
+    return min_views == kAllViews ? int(views) : min_views;
+  }
 };
 
 // Reusable working memory for PreparedView::cut_line (one per thread).
@@ -69,8 +92,13 @@ class PreparedView {
 
   bool uses_pencil() const;
   bool domain_inside_image() const;
-  // Cuts the sorted intervals `in` of the line o + t d; appends the surviving intervals (sorted,
-  // disjoint) to *out. `scratch` is reused between calls (one per thread).
+  // The part [lo', hi'] of [lo, hi] of the line o + t d that this camera sees (lo' >= hi': none).
+  std::pair<double, double> seen(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double lo,
+                                 double hi) const;
+  // Cuts the sorted intervals `in` of the line o + t d by this camera alone: appends the parts
+  // inside its silhouette and the parts it does not see (sorted, disjoint) to *out. The policy's
+  // min_views is applied by the callers (cut(), viewpoint_cut()). `scratch` is reused between
+  // calls (one per thread).
   void cut_line(const Eigen::Vector3d& o, const Eigen::Vector3d& d, std::span<const Interval> in,
                 std::vector<Interval>* out, CutScratch* scratch) const;
   // Cheap early out, exact with respect to cut_line: true when cutting intervals spanning
@@ -90,8 +118,9 @@ struct View {
   const RunMask* mask;
 };
 
-// Cuts the segment set by every view's silhouette (the visual hull is the intersection).
-// Fails, leaving `set` untouched, on a mask whose size differs from its camera.
+// Cuts the segment set by every view's silhouette under the visibility policy (options.min_views
+// counts the views of this call). Fails, leaving `set` untouched, on a mask whose size differs
+// from its camera.
 Expected<void> cut(SegmentSet& set, std::span<const View> views, const CutOptions& options = {});
 
 // The hull from scratch: SegmentSet::full(grid) cut by every view.

@@ -2,7 +2,8 @@
 // The viewpoint cut (TCSVT 2004 §IV-B, eq. 7-8): the line-segment hull with its lines laid along
 // the lines of sight of a viewpoint (a camera or a projector, which is an inverse camera) instead
 // of a regular grid. Each sampled pixel's ray from the viewpoint centre, clipped to the box, is
-// cut by every silhouette exactly like a grid column; the result is, per pixel, whether the
+// cut by every silhouette exactly like a grid column, under the same visibility policy
+// (options.cut.min_views, hull/silhouette_cut.h); the result is, per pixel, whether the
 // actor covers it and the depth intervals along the ray — a mask for that viewpoint (the
 // projector mask) without building a mesh. All rays pass through the viewpoint centre, so their
 // images form a pencil through its epipole and the fast pencil path applies.
