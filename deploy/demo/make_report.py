@@ -209,14 +209,15 @@ def write_markdown(r, path):
              f"{(r.get('head_error_detail') or {}).get('updates')} updates. Masks lost: "
              f"{r.get('masks_lost')} of {(r.get('masks_detail') or {}).get('expected')}.\n")
     L.append("## Services\n")
-    L.append("| service | pid | state | rate Hz | CPU % | RSS MB | exit |\n|---|---|---|---|---|---|---|")
+    L.append("| service | pid | state | rate Hz (status) | delivered Hz (probe) | CPU % | RSS MB | exit |\n"
+             "|---|---|---|---|---|---|---|---|")
     exits = r.get("services_exit_status") or {}
     for s in r.get("per_service") or []:
         name = s["instance"] if s["service"] == "capture" else s["service"]
         if s["service"] == "keyer":
             name = s["instance"]
         L.append(f"| {s['service']}:{s['instance']} | {s['pid']} | {s['state']} | "
-                 f"{fmt(s.get('rate_hz'))} | {fmt(s.get('cpu_percent'))} | {fmt(s.get('rss_mb'))} | "
+                 f"{fmt(s.get('rate_hz'))} | {fmt(s.get('delivered_hz'))} | {fmt(s.get('cpu_percent'))} | {fmt(s.get('rss_mb'))} | "
                  f"{exits.get(name, '?')} |")
     p = r.get("probe") or {}
     L.append(f"\nThe probe itself: {fmt(p.get('cpu_percent'))} % CPU, {fmt(p.get('rss_mb'))} MB.\n")

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 #include "json_writer.h"
 
@@ -105,6 +106,8 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   Stats cap_mask, mask_seg, seg_mesh, seg_head, cap_mesh, cap_head, cap_both;
   uint64_t expected = 0, received = 0, complete = 0, meshes = 0, heads = 0, any_mask = 0;
   std::vector<uint64_t> per_camera(ncams, 0);
+  std::optional<uint64_t> worst;  // the frame with the longest capture -> delivered
+  int64_t worst_ns = 0;
   for (uint64_t f = f_lo; f < f_hi; ++f) {
     expected += uint64_t(ncams);
     auto it = c.frames.find(f);
@@ -123,6 +126,11 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     add(cap_mesh, t.capture_ns, t.mesh_ns);
     add(cap_head, t.capture_ns, t.head_ns);
     if (t.mesh_ns && t.head_ns) add(cap_both, t.capture_ns, std::max(t.mesh_ns, t.head_ns));
+    const int64_t done = std::max(t.mesh_ns, t.head_ns);
+    if (t.mesh_ns && (!worst || done - t.capture_ns > worst_ns)) {
+      worst = f;
+      worst_ns = done - t.capture_ns;
+    }
   }
   for (Stats* s : {&cap_mask, &mask_seg, &seg_mesh, &seg_head, &cap_mesh, &cap_head, &cap_both})
     std::sort(s->v.begin(), s->v.end());
@@ -163,6 +171,19 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     j.key("capture_to_mesh"); cap_mesh.write(j);
     j.key("capture_to_head"); cap_head.write(j);
     j.key("capture_to_mesh_and_head"); cap_both.write(j);
+    j.end_object();
+    // Where the slowest frame spent its time (a stall shows up in one stage).
+    j.key("slowest_frame").begin_object();
+    if (worst) {
+      const FrameTimes& t = c.frames.at(*worst);
+      auto ms = [](int64_t a, int64_t b) { return a && b ? double(b - a) * 1e-6 : kNaN; };
+      j.field("frame", *worst).field("total", double(worst_ns) * 1e-6);
+      j.field("masks", t.masks);
+      j.field("capture_to_mask", t.masks == ncams ? ms(t.capture_ns, t.last_mask_ns) : kNaN);
+      j.field("mask_to_segments", t.masks == ncams ? ms(t.last_mask_ns, t.segments_ns) : kNaN);
+      j.field("segments_to_mesh", ms(t.segments_ns, t.mesh_ns));
+      j.field("segments_to_head", ms(t.segments_ns, t.head_ns));
+    }
     j.end_object();
     j.end_object();
   }
@@ -237,6 +258,18 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     j.field("rate_hz", s.statuses_in_window ? s.output_hz_sum / s.statuses_in_window : s.output_hz);
     j.field("input_hz", s.statuses_in_window ? s.input_hz_sum / s.statuses_in_window : s.input_hz);
     j.field("latency_ms", s.latency_ms);
+    // What reached the probe from this service, per second (its status may not report a rate).
+    double delivered = kNaN;
+    if (s.service == "capture") {
+      for (int i = 0; i < ncams; ++i)
+        if (o.studio.camera_ids[i] == s.instance && window_s > 0)
+          delivered = double(per_camera[i]) / window_s;
+    } else if (s.service == "hull") {
+      delivered = fps;
+    } else if (s.service == "tracker" && window_s > 0) {
+      delivered = double(heads) / window_s;
+    }
+    j.field("delivered_hz", delivered);
     double cpu = kNaN;
     if (s.proc_start && s.proc_end) cpu = cpu_percent(*s.proc_start, *s.proc_end);
     j.field("cpu_percent", cpu).field("rss_mb", s.proc_end ? s.proc_end->rss_mb : kNaN);
