@@ -180,8 +180,10 @@ def write_markdown(r, path):
     L = []
     c = r["configuration"]
     L.append("# Studio demo report\n")
+    la = r["machine"].get("load_average") or {}
+    la_text = " → ".join("/".join(f"{x:.1f}" for x in la[k]) for k in ("start", "end") if k in la)
     L.append(f"{r['generated_utc']} — {r['machine']['cpu']}, {r['machine']['cores']} cores, "
-             f"load average at start/end: {r['machine'].get('load_average')}\n")
+             f"load average (1/5/15 min) at start → end: {la_text or 'n/a'}\n")
     L.append(f"{c['cameras']} simulated cameras at {c['size']}, {fmt(c['camera_fps'], 0)} fps, "
              f"keyed {c['keying']}; scheduling {c['scheduling']}; measured for {fmt(c['window_s'], 0)} s on loopback "
              f"(DDS domain {c['dds']['domain']}). Configs: `{c['configs']}`.\n")

@@ -335,6 +335,11 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     if (worst >= 0) {
       std::snprintf(buf, sizeof buf, "%s (p99 %.1f ms)", latency_limit.c_str(), worst);
       latency_limit = buf;
+      // The simulated cameras render their image after the frame's instant (capture_ns), all at
+      // once: that CPU is in this stage, where a real camera hands over a finished image.
+      if (latency_limit.starts_with("capture_to_mask"))
+        latency_limit += ": for the simulated cameras this includes rendering each image after "
+                         "the frame instant (all cameras at once on the shared cores), then keying";
     }
   }
   j.key("held_back_by").begin_object();
