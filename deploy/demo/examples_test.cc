@@ -28,11 +28,13 @@ class ExampleStudio : public testing::ProcessTest {
  protected:
   // Starts tracker, hull, the keyers (if any) and the six cameras; all must report ready.
   void start_studio(const std::string& capture_dir, const std::vector<std::string>& keyers) {
-    auto& tracker = spawn("tracker", "tracker/studio-tracker", {"--config", kExamples + "/tracker.yaml"});
+    auto& tracker =
+        spawn("tracker", "tracker/studio-tracker", {"--config", kExamples + "/tracker.yaml"});
     auto& hull = spawn("hull", "hull/studio-hull", {"--config", kExamples + "/hull.yaml"});
     std::vector<testing::Process*> all = {&tracker, &hull};
     for (const auto& k : keyers)
-      all.push_back(&spawn(k, "keyer/studio-keyer", {"--config", capture_dir + "/keyer-" + k + ".yaml"}));
+      all.push_back(
+          &spawn(k, "keyer/studio-keyer", {"--config", capture_dir + "/keyer-" + k + ".yaml"}));
     for (int i = 0; i < 6; ++i) {
       const std::string cam = "cam" + std::to_string(i);
       all.push_back(&spawn(cam, "capture/studio-capture",
@@ -56,7 +58,8 @@ class ExampleStudio : public testing::ProcessTest {
     const auto until = Clock::now() + 30s;
     while (Clock::now() < until && !(published.size() == 6 && mesh && head)) {
       cals->visit([&](const studio_CameraCalibration& s, const wire::SampleMeta& m) {
-        if (auto c = wire::to_core(s); m.valid_data && c) published.insert_or_assign(s.camera_id, *c);
+        if (auto c = wire::to_core(s); m.valid_data && c)
+          published.insert_or_assign(s.camera_id, *c);
       });
       meshes->visit([&](const studio_ActorMesh& s, const wire::SampleMeta& m) {
         if (m.valid_data && std::string(s.actor_id) == "actor0" && s.triangles._length > 300)
@@ -83,7 +86,8 @@ class ExampleStudio : public testing::ProcessTest {
       EXPECT_NEAR(c.intrinsics.fy, r.intrinsics.fy, 1e-9);
       EXPECT_NEAR(c.intrinsics.cx, r.intrinsics.cx, 1e-9);
       EXPECT_NEAR(c.intrinsics.cy, r.intrinsics.cy, 1e-9);
-      EXPECT_LT((c.cam_from_world.matrix() - r.cam_from_world.matrix()).cwiseAbs().maxCoeff(), 1e-9);
+      EXPECT_LT((c.cam_from_world.matrix() - r.cam_from_world.matrix()).cwiseAbs().maxCoeff(),
+                1e-9);
     }
     EXPECT_TRUE(mesh) << "no actor0 mesh from the hull within 30 s";
     EXPECT_TRUE(head) << "no head update of `actor` from the tracker within 30 s";

@@ -58,7 +58,8 @@ hull::Mesh mesh_from_wire(const studio_ActorMesh& s) {
   for (uint32_t i = 0; i + 2 < s.vertices._length; i += 3)
     m.vertices.emplace_back(v[i], v[i + 1], v[i + 2]);
   const uint32_t* t = s.triangles._buffer;
-  for (uint32_t i = 0; i + 2 < s.triangles._length; i += 3) m.triangles.push_back({t[i], t[i + 1], t[i + 2]});
+  for (uint32_t i = 0; i + 2 < s.triangles._length; i += 3)
+    m.triangles.push_back({t[i], t[i + 1], t[i + 2]});
   return m;
 }
 
@@ -67,7 +68,8 @@ hull::Mesh mesh_from_wire(const studio_ActorMesh& s) {
 class Recorder {
  public:
   explicit Recorder(const ProbeOptions& o) : o_(o), host_(this_host()) {
-    for (std::size_t i = 0; i < o.studio.camera_ids.size(); ++i) index_[o.studio.camera_ids[i]] = int(i);
+    for (std::size_t i = 0; i < o.studio.camera_ids.size(); ++i)
+      index_[o.studio.camera_ids[i]] = int(i);
   }
 
   Expected<void> start(const wire::Participant& p) {
@@ -290,8 +292,7 @@ class Recorder {
       if (collecting_) {
         collecting_->meshes.push_back(mesh_from_wire(s));
       } else if (truth_ && in_window(s.capture_ns) && jobs_.empty() && !scoring_ &&
-                 o_.score_rate_hz > 0 &&
-                 now - last_pick_ns_ >= int64_t(1e9 / o_.score_rate_hz)) {
+                 o_.score_rate_hz > 0 && now - last_pick_ns_ >= int64_t(1e9 / o_.score_rate_hz)) {
         last_pick_ns_ = now;
         collecting_ = Job{false, s.frame, {mesh_from_wire(s)}, Eigen::Vector3d::Zero(), 0};
       }
@@ -309,8 +310,8 @@ class Recorder {
       if (t.head_ns) return;
       t.head_ns = now;
       if (in_window(s.capture_ns)) {
-        jobs_.push_back(Job{true, s.frame, {},
-                            {s.position[0], s.position[1], s.position[2]}, s.confidence});
+        jobs_.push_back(
+            Job{true, s.frame, {}, {s.position[0], s.position[1], s.position[2]}, s.confidence});
         wake_.notify_all();
       }
     });
@@ -395,12 +396,10 @@ class Recorder {
         worst = std::max(worst, 1e9);
         continue;
       }
-      const double d = std::max({(r->cam_from_world.matrix() - p.cam_from_world.matrix())
-                                     .cwiseAbs()
-                                     .maxCoeff(),
-                                 std::abs(r->intrinsics.fx - p.intrinsics.fx),
-                                 std::abs(r->intrinsics.cx - p.intrinsics.cx),
-                                 std::abs(double(r->width - p.width))});
+      const double d = std::max(
+          {(r->cam_from_world.matrix() - p.cam_from_world.matrix()).cwiseAbs().maxCoeff(),
+           std::abs(r->intrinsics.fx - p.intrinsics.fx),
+           std::abs(r->intrinsics.cx - p.intrinsics.cx), std::abs(double(r->width - p.width))});
       worst = std::max(worst, d);
     }
     c_.rig_max_diff = worst;
@@ -434,7 +433,9 @@ Expected<std::string> run_probe(const ProbeOptions& o) {
   if (auto r = rec.start(*participant); !r) return std::unexpected(r.error());
 
   const auto t0 = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
   auto say = [&](const std::string& line) {
     if (o.progress) std::fprintf(stderr, "%s\n", line.c_str());
   };
@@ -460,7 +461,8 @@ Expected<std::string> run_probe(const ProbeOptions& o) {
     const auto w0 = std::chrono::steady_clock::now();
     const double total = o.warmup_s + o.seconds + 0.5;  // + the pipeline's tail for late frames
     for (int s = 1; s <= int(std::ceil(total)); ++s) {
-      std::this_thread::sleep_until(w0 + std::chrono::milliseconds(int64_t(std::min(double(s), total) * 1000)));
+      std::this_thread::sleep_until(
+          w0 + std::chrono::milliseconds(int64_t(std::min(double(s), total) * 1000)));
       const double t = std::min(double(s), total);
       say(rec.progress_line(realtime_ns(), t < o.warmup_s ? t : t - o.warmup_s,
                             t < o.warmup_s ? "warmup" : "measure"));

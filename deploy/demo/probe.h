@@ -37,9 +37,9 @@ struct ProbeOptions {
   double ready_timeout_s = 60;  // for every calibration and a first mesh
   double warmup_s = 3;
   double seconds = 10;
-  double score_rate_hz = 2;     // live meshes scored against the truth per second
+  double score_rate_hz = 2;  // live meshes scored against the truth per second
   std::string head_id = "actor";
-  std::string histogram_png;    // latency histogram (OpenCV), optional
+  std::string histogram_png;  // latency histogram (OpenCV), optional
   bool progress = true;
 
   Expected<void> validate() const;

@@ -2,12 +2,12 @@
 //   studio-demo-probe watch --capture FILE... [--rig FILE] [--seconds S] [--warmup S]
 //                           [--ready-timeout S] [--score-rate HZ] [--histogram PNG] [--out FILE]
 //   studio-demo-probe take  --capture FILE... [--name TAKE] [--frames N] [--lead S] [--timeout S]
-//   studio-demo-probe rig   (--from RIG | --published --capture FILE...) [--cameras ID,...] --out FILE
-//   studio-demo-probe score --rig RIG --meshes DIR [--out FILE]
+//   studio-demo-probe rig   (--from RIG | --published --capture FILE...) [--cameras ID,...] --out
+//   FILE studio-demo-probe score --rig RIG --meshes DIR [--out FILE]
 // DDS domain and profile as every service: $STUDIO_DDS_DOMAIN, $CYCLONEDDS_URI.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -19,10 +19,10 @@
 #include <vector>
 
 #include "core/clock.h"
-#include "testing/mesh_read.h"
 #include "json_writer.h"
 #include "probe.h"
 #include "take.h"
+#include "testing/mesh_read.h"
 #include "truth.h"
 #include "wire/convert.h"
 #include "wire/endpoint.h"
@@ -87,7 +87,8 @@ Expected<Args> parse(int argc, char** argv) {
   for (int i = 2; i < argc; ++i) {
     const std::string o = argv[i];
     if (o == "--capture") {
-      while (i + 1 < argc && std::strncmp(argv[i + 1], "--", 2) != 0) a.capture.push_back(argv[++i]);
+      while (i + 1 < argc && std::strncmp(argv[i + 1], "--", 2) != 0)
+        a.capture.push_back(argv[++i]);
       if (a.capture.empty()) return fail("--capture needs at least one file");
     } else if (o == "--quiet") {
       a.quiet = true;
@@ -235,7 +236,8 @@ int rig(const Args& a) {
 
 int score(const Args& a) {
   const std::string rig_path = opt(a, "rig"), dir = opt(a, "meshes");
-  if (rig_path.empty() || dir.empty()) return usage_error("score: --rig RIG and --meshes DIR are required");
+  if (rig_path.empty() || dir.empty())
+    return usage_error("score: --rig RIG and --meshes DIR are required");
   auto rig = yaml::read_rig(rig_path);
   if (!rig) return usage_error(rig.error().message);
   auto truth = demo::TruthScorer::create(rig->cameras);
@@ -297,5 +299,6 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return usage_error(e.what());
   }
-  return usage_error("unknown command '" + args->verb + "' (watch, take, rig or score; see --help)");
+  return usage_error("unknown command '" + args->verb +
+                     "' (watch, take, rig or score; see --help)");
 }

@@ -11,9 +11,9 @@
 namespace studio::demo {
 
 struct ProcSample {
-  double cpu_s = 0;       // user + system CPU seconds since the process started
-  double rss_mb = 0;      // VmRSS, MiB
-  int64_t taken_ns = 0;   // CLOCK_MONOTONIC when read
+  double cpu_s = 0;      // user + system CPU seconds since the process started
+  double rss_mb = 0;     // VmRSS, MiB
+  int64_t taken_ns = 0;  // CLOCK_MONOTONIC when read
 };
 
 // nullopt when the process does not exist (or /proc is unreadable).

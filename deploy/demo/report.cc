@@ -1,14 +1,13 @@
 #include "report.h"
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <numeric>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 
 #include "json_writer.h"
@@ -53,8 +52,9 @@ void draw_histogram(const Stats& s, const std::string& title, const std::string&
   const double px = double(W - L - R) / bins;
   for (int i = 0; i < bins; ++i) {
     const int h = int(double(count[i]) / top * (H - T - B));
-    cv::rectangle(img, cv::Point(L + int(i * px), H - B - h), cv::Point(L + int((i + 1) * px) - 1, H - B),
-                  cv::Scalar(180, 120, 40), cv::FILLED);
+    cv::rectangle(img, cv::Point(L + int(i * px), H - B - h),
+                  cv::Point(L + int((i + 1) * px) - 1, H - B), cv::Scalar(180, 120, 40),
+                  cv::FILLED);
   }
   cv::line(img, {L, H - B}, {W - R, H - B}, cv::Scalar(0, 0, 0));
   cv::line(img, {L, T}, {L, H - B}, cv::Scalar(0, 0, 0));
@@ -69,9 +69,8 @@ void draw_histogram(const Stats& s, const std::string& title, const std::string&
   cv::putText(img, "frames", {8, T - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0));
   cv::putText(img, "max " + std::to_string(top), {8, T + 12}, cv::FONT_HERSHEY_SIMPLEX, 0.4,
               cv::Scalar(0, 0, 0));
-  const std::pair<double, cv::Scalar> marks[] = {{50, cv::Scalar(0, 160, 0)},
-                                                 {95, cv::Scalar(0, 140, 255)},
-                                                 {99, cv::Scalar(0, 0, 220)}};
+  const std::pair<double, cv::Scalar> marks[] = {
+      {50, cv::Scalar(0, 160, 0)}, {95, cv::Scalar(0, 140, 255)}, {99, cv::Scalar(0, 0, 220)}};
   int row = 0;
   for (const auto& [p, colour] : marks) {
     const double x = s.pct(p);
@@ -147,30 +146,41 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   if (!c.ready) j.field("not_ready", c.not_ready_reason);
   j.field("cameras", ncams).field("camera_fps", rate).field("window_s", window_s);
   j.key("frames").begin_object();
-  j.field("expected", f_hi - f_lo).field("with_any_mask", any_mask).field("with_all_masks", complete);
+  j.field("expected", f_hi - f_lo)
+      .field("with_any_mask", any_mask)
+      .field("with_all_masks", complete);
   j.field("with_mesh", meshes).field("with_head", heads);
   j.end_object();
   const double fps = window_s > 0 ? double(meshes) / window_s : 0;
   j.field("fps", fps);
-  j.field("fps_stage", "studio/actor/mesh delivered (hull output; the scene server and projector "
-                       "that will consume it are not built)");
+  j.field("fps_stage",
+          "studio/actor/mesh delivered (hull output; the scene server and projector "
+          "that will consume it are not built)");
   j.field("heads_per_s", window_s > 0 ? double(heads) / window_s : 0);
   j.key("latency_ms");
   {
     j.begin_object();
     j.field("stage", headline_stage);
     j.field("p50", headline.pct(50)).field("p95", headline.pct(95)).field("p99", headline.pct(99));
-    j.field("max", headline.v.empty() ? kNaN : headline.v.back()).field("n", uint64_t(headline.v.size()));
+    j.field("max", headline.v.empty() ? kNaN : headline.v.back())
+        .field("n", uint64_t(headline.v.size()));
     j.key("stages").begin_object();
-    j.key("capture_to_mask"); cap_mask.write(j);
-    j.key("mask_to_segments"); mask_seg.write(j);
-    j.key("segments_to_mesh"); seg_mesh.write(j);
-    j.key("segments_to_head"); seg_head.write(j);
+    j.key("capture_to_mask");
+    cap_mask.write(j);
+    j.key("mask_to_segments");
+    mask_seg.write(j);
+    j.key("segments_to_mesh");
+    seg_mesh.write(j);
+    j.key("segments_to_head");
+    seg_head.write(j);
     j.end_object();
     j.key("end_to_end").begin_object();
-    j.key("capture_to_mesh"); cap_mesh.write(j);
-    j.key("capture_to_head"); cap_head.write(j);
-    j.key("capture_to_mesh_and_head"); cap_both.write(j);
+    j.key("capture_to_mesh");
+    cap_mesh.write(j);
+    j.key("capture_to_head");
+    cap_head.write(j);
+    j.key("capture_to_mesh_and_head");
+    cap_both.write(j);
     j.end_object();
     // Where the slowest frame spent its time (a stall shows up in one stage).
     j.key("slowest_frame").begin_object();
@@ -207,8 +217,9 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
       }
     j.field("frames_scored", uint64_t(c.mesh_scores.size()));
     j.field("worst_camera_iou", c.mesh_scores.empty() ? kNaN : worst).field("worst_at", where);
-    j.field("truth", "simulator's geometric silhouette (true mask) of the same frame number, "
-                     "mesh rasterised at pixel centres, every camera");
+    j.field("truth",
+            "simulator's geometric silhouette (true mask) of the same frame number, "
+            "mesh rasterised at pixel centres, every camera");
   }
   j.end_object();
   // Head error.
@@ -288,19 +299,33 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   }
   j.end_array();
   j.key("probe").begin_object();
-  j.field("cpu_percent", c.probe_start && c.probe_end ? cpu_percent(*c.probe_start, *c.probe_end) : kNaN);
+  j.field("cpu_percent",
+          c.probe_start && c.probe_end ? cpu_percent(*c.probe_start, *c.probe_end) : kNaN);
   j.field("rss_mb", c.probe_end ? c.probe_end->rss_mb : kNaN);
   j.field("note", "the probe's own cost (truth rendering for scoring), on the same cores");
   j.end_object();
   j.key("load_average").begin_object();
-  j.key("start").begin_array().value(c.load_start[0]).value(c.load_start[1]).value(c.load_start[2]).end_array();
-  j.key("end").begin_array().value(c.load_end[0]).value(c.load_end[1]).value(c.load_end[2]).end_array();
+  j.key("start")
+      .begin_array()
+      .value(c.load_start[0])
+      .value(c.load_start[1])
+      .value(c.load_start[2])
+      .end_array();
+  j.key("end")
+      .begin_array()
+      .value(c.load_end[0])
+      .value(c.load_end[1])
+      .value(c.load_end[2])
+      .end_array();
   j.end_object();
 
   // What holds the figures back.
   std::string rate_limit, latency_limit;
   if (c.ready && window_s > 0) {
-    const double min_cam = per_camera.empty() ? 0 : double(*std::min_element(per_camera.begin(), per_camera.end())) / window_s;
+    const double min_cam =
+        per_camera.empty()
+            ? 0
+            : double(*std::min_element(per_camera.begin(), per_camera.end())) / window_s;
     const double all_masks = double(complete) / window_s;
     const double any = double(any_mask) / window_s;
     char buf[400];
@@ -312,7 +337,8 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     } else if (all_masks < 0.95 * rate) {
       std::snprintf(buf, sizeof buf,
                     "transport: frames with every camera's mask %.1f/s of %.0f (masks lost on "
-                    "the way)", all_masks, rate);
+                    "the way)",
+                    all_masks, rate);
     } else if (fps < 0.95 * any) {
       std::snprintf(buf, sizeof buf, "hull: %.1f meshes/s from %.1f frames/s of masks", fps, any);
     } else if (have_heads && double(heads) / window_s < 0.95 * fps) {
@@ -338,8 +364,9 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
       // The simulated cameras render their image after the frame's instant (capture_ns), all at
       // once: that CPU is in this stage, where a real camera hands over a finished image.
       if (latency_limit.starts_with("capture_to_mask"))
-        latency_limit += ": for the simulated cameras this includes rendering each image after "
-                         "the frame instant (all cameras at once on the shared cores), then keying";
+        latency_limit +=
+            ": for the simulated cameras this includes rendering each image after "
+            "the frame instant (all cameras at once on the shared cores), then keying";
     }
   }
   j.key("held_back_by").begin_object();

@@ -48,8 +48,9 @@ Expected<StudioConfig> read_studio_config(const std::vector<std::string>& captur
       if (!clock) return std::unexpected(clock.error());
       if (have_clock &&
           (clock->period_ns != out.clock.period_ns || clock->epoch_ns != out.clock.epoch_ns))
-        return fail(file + ": clock differs from the other capture configs (DESIGN §5: one "
-                           "studio clock)");
+        return fail(file +
+                    ": clock differs from the other capture configs (DESIGN §5: one "
+                    "studio clock)");
       out.clock = *clock;
       have_clock = true;
       const YAML::Node cams = root["cameras"];

@@ -58,13 +58,14 @@ Expected<std::string> run_take(const TakeOptions& o) {
   }
   if (!all_cams([](const CamState&) { return true; }))
     return fail("take: not every camera's state arrived (are the capture servers running?)");
-  if (!(*commands)->wait_for_readers(1, std::chrono::duration_cast<std::chrono::milliseconds>(
-                                            deadline - Clock::now())))
+  if (!(*commands)->wait_for_readers(
+          1, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now())))
     return fail("take: no capture server reads studio/capture/command");
   std::this_thread::sleep_for(200ms);  // let every server's command reader match
 
   const auto& clock = o.studio.clock;
-  const uint64_t start = clock.frame_at(realtime_ns()) + uint64_t(o.lead_s * 1e9 / double(clock.period_ns)) + 1;
+  const uint64_t start =
+      clock.frame_at(realtime_ns()) + uint64_t(o.lead_s * 1e9 / double(clock.period_ns)) + 1;
   const uint64_t stop = start + uint64_t(o.frames);
   auto send = [&](studio_CaptureAction action, uint64_t at) -> Expected<void> {
     wire::Owned<studio_CaptureCommand> c;

@@ -23,7 +23,7 @@ struct TakeOptions {
   StudioConfig studio;
   std::string name = "demo";
   double lead_s = 1.0;
-  int frames = 50;          // 2 s at 25 fps
+  int frames = 50;  // 2 s at 25 fps
   double timeout_s = 30;
 };
 

@@ -4,8 +4,8 @@
 #include <limits>
 
 #include "capture/sim_source.h"
-#include "testing/raster.h"
 #include "sim/studio.h"
+#include "testing/raster.h"
 
 namespace studio::demo {
 
