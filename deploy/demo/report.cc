@@ -1,0 +1,387 @@
+#include "report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+
+#include "json_writer.h"
+
+namespace studio::demo {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct Stats {
+  std::vector<double> v;  // sorted, ms
+  double pct(double p) const {
+    if (v.empty()) return kNaN;
+    const std::size_t k = std::size_t(std::ceil(p / 100.0 * double(v.size())));  // nearest rank
+    return v[std::clamp<std::size_t>(k, 1, v.size()) - 1];
+  }
+  double mean() const {
+    return v.empty() ? kNaN : std::accumulate(v.begin(), v.end(), 0.0) / double(v.size());
+  }
+  void write(JsonWriter& j) const {
+    j.begin_object();
+    j.field("p50", pct(50)).field("p95", pct(95)).field("p99", pct(99));
+    j.field("max", v.empty() ? kNaN : v.back()).field("mean", mean());
+    j.field("n", uint64_t(v.size()));
+    j.end_object();
+  }
+};
+
+void add(Stats& s, int64_t from_ns, int64_t to_ns) {
+  if (from_ns && to_ns) s.v.push_back(double(to_ns - from_ns) * 1e-6);
+}
+
+void draw_histogram(const Stats& s, const std::string& title, const std::string& path) {
+  const int W = 900, H = 460, L = 70, R = 30, T = 60, B = 60;
+  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  const double hi = std::max(80.0, s.v.empty() ? 80.0 : std::ceil(s.pct(99) * 1.3 / 10) * 10);
+  const int bins = 80;
+  const double bw = hi / bins;
+  std::vector<int> count(bins, 0);
+  for (double x : s.v) count[std::clamp(int(x / bw), 0, bins - 1)]++;
+  const int top = std::max(1, *std::max_element(count.begin(), count.end()));
+  const double px = double(W - L - R) / bins;
+  for (int i = 0; i < bins; ++i) {
+    const int h = int(double(count[i]) / top * (H - T - B));
+    cv::rectangle(img, cv::Point(L + int(i * px), H - B - h),
+                  cv::Point(L + int((i + 1) * px) - 1, H - B), cv::Scalar(180, 120, 40),
+                  cv::FILLED);
+  }
+  cv::line(img, {L, H - B}, {W - R, H - B}, cv::Scalar(0, 0, 0));
+  cv::line(img, {L, T}, {L, H - B}, cv::Scalar(0, 0, 0));
+  for (double x = 0; x <= hi + 1e-9; x += hi / 8) {
+    const int u = L + int(x / hi * (W - L - R));
+    cv::line(img, {u, H - B}, {u, H - B + 5}, cv::Scalar(0, 0, 0));
+    cv::putText(img, std::to_string(int(x)), {u - 10, H - B + 22}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                cv::Scalar(0, 0, 0));
+  }
+  cv::putText(img, "ms (capture_ns -> delivered)", {W / 2 - 120, H - 12}, cv::FONT_HERSHEY_SIMPLEX,
+              0.5, cv::Scalar(0, 0, 0));
+  cv::putText(img, "frames", {8, T - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0));
+  cv::putText(img, "max " + std::to_string(top), {8, T + 12}, cv::FONT_HERSHEY_SIMPLEX, 0.4,
+              cv::Scalar(0, 0, 0));
+  const std::pair<double, cv::Scalar> marks[] = {
+      {50, cv::Scalar(0, 160, 0)}, {95, cv::Scalar(0, 140, 255)}, {99, cv::Scalar(0, 0, 220)}};
+  int row = 0;
+  for (const auto& [p, colour] : marks) {
+    const double x = s.pct(p);
+    if (!std::isfinite(x)) continue;
+    const int u = L + int(std::min(x, hi) / hi * (W - L - R));
+    cv::line(img, {u, T}, {u, H - B}, colour, 2);
+    char label[64];
+    std::snprintf(label, sizeof label, "p%d %.1f ms", int(p), x);
+    cv::putText(img, label, {W - R - 170, T + 18 + 20 * row++}, cv::FONT_HERSHEY_SIMPLEX, 0.5,
+                colour, 1);
+  }
+  cv::putText(img, title, {L, 30}, cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1);
+  cv::imwrite(path, img);
+}
+
+}  // namespace
+
+std::string make_report(const ProbeOptions& o, const Collected& c) {
+  const auto& clock = o.studio.clock;
+  const int64_t half = clock.period_ns / 2;
+  const double rate = 1e9 / double(clock.period_ns);
+  const int ncams = int(o.studio.camera_ids.size());
+  const double window_s = double(c.window_end_ns - c.window_start_ns) * 1e-9;
+
+  // Frames whose capture instant lies in the window.
+  uint64_t f_lo = clock.frame_at(c.window_start_ns - half);
+  while (clock.time_of(f_lo) + half < c.window_start_ns) ++f_lo;
+  uint64_t f_hi = clock.frame_at(c.window_end_ns - half);
+  while (clock.time_of(f_hi) + half < c.window_end_ns) ++f_hi;
+  if (!c.ready) f_hi = f_lo;
+
+  Stats cap_mask, mask_seg, seg_mesh, seg_head, cap_mesh, cap_head, cap_both;
+  uint64_t expected = 0, received = 0, complete = 0, meshes = 0, heads = 0, any_mask = 0;
+  std::vector<uint64_t> per_camera(ncams, 0);
+  std::optional<uint64_t> worst;  // the frame with the longest capture -> delivered
+  int64_t worst_ns = 0;
+  for (uint64_t f = f_lo; f < f_hi; ++f) {
+    expected += uint64_t(ncams);
+    auto it = c.frames.find(f);
+    if (it == c.frames.end()) continue;
+    const FrameTimes& t = it->second;
+    received += uint64_t(t.masks);
+    for (int i = 0; i < ncams; ++i) per_camera[i] += (t.mask_bits >> i) & 1u;
+    if (t.masks > 0) ++any_mask;
+    if (t.masks == ncams) ++complete;
+    if (t.mesh_ns) ++meshes;
+    if (t.head_ns) ++heads;
+    if (t.masks == ncams) add(cap_mask, t.capture_ns, t.last_mask_ns);
+    if (t.masks == ncams) add(mask_seg, t.last_mask_ns, t.segments_ns);
+    add(seg_mesh, t.segments_ns, t.mesh_ns);
+    add(seg_head, t.segments_ns, t.head_ns);
+    add(cap_mesh, t.capture_ns, t.mesh_ns);
+    add(cap_head, t.capture_ns, t.head_ns);
+    if (t.mesh_ns && t.head_ns) add(cap_both, t.capture_ns, std::max(t.mesh_ns, t.head_ns));
+    const int64_t done = std::max(t.mesh_ns, t.head_ns);
+    if (t.mesh_ns && (!worst || done - t.capture_ns > worst_ns)) {
+      worst = f;
+      worst_ns = done - t.capture_ns;
+    }
+  }
+  for (Stats* s : {&cap_mask, &mask_seg, &seg_mesh, &seg_head, &cap_mesh, &cap_head, &cap_both})
+    std::sort(s->v.begin(), s->v.end());
+  const bool have_heads = !cap_both.v.empty();
+  const Stats& headline = have_heads ? cap_both : cap_mesh;
+  const char* headline_stage =
+      have_heads ? "capture -> actor mesh and head both delivered to a subscriber (where the "
+                   "projector will read them)"
+                 : "capture -> actor mesh delivered to a subscriber (no head updates arrived)";
+
+  JsonWriter j;
+  j.begin_object();
+  j.field("complete", c.ready);
+  if (!c.ready) j.field("not_ready", c.not_ready_reason);
+  j.field("cameras", ncams).field("camera_fps", rate).field("window_s", window_s);
+  j.key("frames").begin_object();
+  j.field("expected", f_hi - f_lo)
+      .field("with_any_mask", any_mask)
+      .field("with_all_masks", complete);
+  j.field("with_mesh", meshes).field("with_head", heads);
+  j.end_object();
+  const double fps = window_s > 0 ? double(meshes) / window_s : 0;
+  j.field("fps", fps);
+  j.field("fps_stage",
+          "studio/actor/mesh delivered (hull output; the scene server and projector "
+          "that will consume it are not built)");
+  j.field("heads_per_s", window_s > 0 ? double(heads) / window_s : 0);
+  j.key("latency_ms");
+  {
+    j.begin_object();
+    j.field("stage", headline_stage);
+    j.field("p50", headline.pct(50)).field("p95", headline.pct(95)).field("p99", headline.pct(99));
+    j.field("max", headline.v.empty() ? kNaN : headline.v.back())
+        .field("n", uint64_t(headline.v.size()));
+    j.key("stages").begin_object();
+    j.key("capture_to_mask");
+    cap_mask.write(j);
+    j.key("mask_to_segments");
+    mask_seg.write(j);
+    j.key("segments_to_mesh");
+    seg_mesh.write(j);
+    j.key("segments_to_head");
+    seg_head.write(j);
+    j.end_object();
+    j.key("end_to_end").begin_object();
+    j.key("capture_to_mesh");
+    cap_mesh.write(j);
+    j.key("capture_to_head");
+    cap_head.write(j);
+    j.key("capture_to_mesh_and_head");
+    cap_both.write(j);
+    j.end_object();
+    // Where the slowest frame spent its time (a stall shows up in one stage).
+    j.key("slowest_frame").begin_object();
+    if (worst) {
+      const FrameTimes& t = c.frames.at(*worst);
+      auto ms = [](int64_t a, int64_t b) { return a && b ? double(b - a) * 1e-6 : kNaN; };
+      j.field("frame", *worst).field("total", double(worst_ns) * 1e-6);
+      j.field("masks", t.masks);
+      j.field("capture_to_mask", t.masks == ncams ? ms(t.capture_ns, t.last_mask_ns) : kNaN);
+      j.field("mask_to_segments", t.masks == ncams ? ms(t.last_mask_ns, t.segments_ns) : kNaN);
+      j.field("segments_to_mesh", ms(t.segments_ns, t.mesh_ns));
+      j.field("segments_to_head", ms(t.segments_ns, t.head_ns));
+    }
+    j.end_object();
+    j.end_object();
+  }
+  // Hull IoU.
+  j.key("hull_iou");
+  if (c.mesh_scores.empty()) {
+    j.null();
+  } else {
+    double sum = 0;
+    for (const auto& m : c.mesh_scores) sum += m.mean_iou;
+    j.value(sum / double(c.mesh_scores.size()));
+  }
+  j.key("hull_iou_detail").begin_object();
+  {
+    double worst = 1;
+    std::string where;
+    for (const auto& m : c.mesh_scores)
+      if (m.min_iou < worst) {
+        worst = m.min_iou;
+        where = m.worst_camera + " frame " + std::to_string(m.frame);
+      }
+    j.field("frames_scored", uint64_t(c.mesh_scores.size()));
+    j.field("worst_camera_iou", c.mesh_scores.empty() ? kNaN : worst).field("worst_at", where);
+    j.field("truth",
+            "simulator's geometric silhouette (true mask) of the same frame number, "
+            "mesh rasterised at pixel centres, every camera");
+  }
+  j.end_object();
+  // Head error.
+  j.key("head_error_m");
+  double rms = kNaN, worst_head = kNaN;
+  if (!c.heads.empty()) {
+    double ss = 0;
+    worst_head = 0;
+    for (const auto& h : c.heads) {
+      ss += h.error_m * h.error_m;
+      worst_head = std::max(worst_head, h.error_m);
+    }
+    rms = std::sqrt(ss / double(c.heads.size()));
+  }
+  j.value(rms);
+  j.key("head_error_detail").begin_object();
+  j.field("updates", uint64_t(c.heads.size())).field("max_m", worst_head);
+  j.field("truth", "the simulated actor's head centre at the same frame number");
+  j.end_object();
+  // Masks lost.
+  j.field("masks_lost", expected - received);
+  j.key("masks_detail").begin_object();
+  j.field("expected", expected).field("received", received);
+  j.field("rejected_by_validator", c.masks_rejected);
+  j.key("per_camera_per_s").begin_object();
+  for (int i = 0; i < ncams; ++i)
+    j.field(o.studio.camera_ids[i], window_s > 0 ? double(per_camera[i]) / window_s : 0.0);
+  j.end_object();
+  j.end_object();
+  // Rig check.
+  if (!o.rig.empty()) {
+    j.key("rig_check").begin_object();
+    j.field("rig", o.rig);
+    if (c.rig_max_diff) j.field("max_abs_diff", *c.rig_max_diff);
+    j.field("matches", c.rig_max_diff.has_value() && *c.rig_max_diff < 1e-9);
+    j.field("detail", c.rig_detail);
+    j.end_object();
+  }
+  // Services.
+  j.key("per_service").begin_array();
+  std::string busiest;
+  double busiest_cpu = -1;
+  for (const ServiceSeen& s : c.services) {
+    j.begin_object();
+    j.field("service", s.service).field("instance", s.instance).field("pid", s.pid);
+    j.field("host", s.host).field("state", s.state);
+    j.field("rate_hz", s.statuses_in_window ? s.output_hz_sum / s.statuses_in_window : s.output_hz);
+    j.field("input_hz", s.statuses_in_window ? s.input_hz_sum / s.statuses_in_window : s.input_hz);
+    j.field("latency_ms", s.latency_ms);
+    // What reached the probe from this service, per second (its status may not report a rate).
+    double delivered = kNaN;
+    if (s.service == "capture") {
+      for (int i = 0; i < ncams; ++i)
+        if (o.studio.camera_ids[i] == s.instance && window_s > 0)
+          delivered = double(per_camera[i]) / window_s;
+    } else if (s.service == "hull") {
+      delivered = fps;
+    } else if (s.service == "tracker" && window_s > 0) {
+      delivered = double(heads) / window_s;
+    }
+    j.field("delivered_hz", delivered);
+    double cpu = kNaN;
+    if (s.proc_start && s.proc_end) cpu = cpu_percent(*s.proc_start, *s.proc_end);
+    j.field("cpu_percent", cpu).field("rss_mb", s.proc_end ? s.proc_end->rss_mb : kNaN);
+    if (std::isfinite(cpu) && cpu > busiest_cpu) {
+      busiest_cpu = cpu;
+      busiest = s.service + ":" + s.instance;
+    }
+    j.key("counters_in_window").begin_object();
+    for (const auto& [name, v] : s.counters) {
+      if (name.ends_with("_hz")) continue;  // the status's per-second rates, not counts
+      auto at = s.counters_at_start.find(name);
+      j.field(name, at == s.counters_at_start.end() ? v : v - at->second);
+    }
+    j.end_object();
+    j.end_object();
+  }
+  j.end_array();
+  j.key("probe").begin_object();
+  j.field("cpu_percent",
+          c.probe_start && c.probe_end ? cpu_percent(*c.probe_start, *c.probe_end) : kNaN);
+  j.field("rss_mb", c.probe_end ? c.probe_end->rss_mb : kNaN);
+  j.field("note", "the probe's own cost (truth rendering for scoring), on the same cores");
+  j.end_object();
+  j.key("load_average").begin_object();
+  j.key("start")
+      .begin_array()
+      .value(c.load_start[0])
+      .value(c.load_start[1])
+      .value(c.load_start[2])
+      .end_array();
+  j.key("end")
+      .begin_array()
+      .value(c.load_end[0])
+      .value(c.load_end[1])
+      .value(c.load_end[2])
+      .end_array();
+  j.end_object();
+
+  // What holds the figures back.
+  std::string rate_limit, latency_limit;
+  if (c.ready && window_s > 0) {
+    const double min_cam =
+        per_camera.empty()
+            ? 0
+            : double(*std::min_element(per_camera.begin(), per_camera.end())) / window_s;
+    const double all_masks = double(complete) / window_s;
+    const double any = double(any_mask) / window_s;
+    char buf[400];
+    if (min_cam < 0.95 * rate) {
+      std::snprintf(buf, sizeof buf,
+                    "capture: the slowest camera delivered %.1f masks/s of %.0f (simulated "
+                    "rendering + in-process keying per frame; busiest process %s at %.0f %% CPU)",
+                    min_cam, rate, busiest.c_str(), busiest_cpu);
+    } else if (all_masks < 0.95 * rate) {
+      std::snprintf(buf, sizeof buf,
+                    "transport: frames with every camera's mask %.1f/s of %.0f (masks lost on "
+                    "the way)",
+                    all_masks, rate);
+    } else if (fps < 0.95 * any) {
+      std::snprintf(buf, sizeof buf, "hull: %.1f meshes/s from %.1f frames/s of masks", fps, any);
+    } else if (have_heads && double(heads) / window_s < 0.95 * fps) {
+      std::snprintf(buf, sizeof buf, "tracker: %.1f head updates/s from %.1f meshes/s",
+                    double(heads) / window_s, fps);
+    } else {
+      std::snprintf(buf, sizeof buf, "none: every stage keeps the camera rate (%.1f fps)", fps);
+    }
+    rate_limit = buf;
+    const std::pair<const char*, const Stats*> stages[] = {{"capture_to_mask", &cap_mask},
+                                                           {"mask_to_segments", &mask_seg},
+                                                           {"segments_to_mesh", &seg_mesh},
+                                                           {"segments_to_head", &seg_head}};
+    double worst = -1;
+    for (const auto& [name, s] : stages)
+      if (std::isfinite(s->pct(99)) && s->pct(99) > worst) {
+        worst = s->pct(99);
+        latency_limit = name;
+      }
+    if (worst >= 0) {
+      std::snprintf(buf, sizeof buf, "%s (p99 %.1f ms)", latency_limit.c_str(), worst);
+      latency_limit = buf;
+      // The simulated cameras render their image after the frame's instant (capture_ns), all at
+      // once: that CPU is in this stage, where a real camera hands over a finished image.
+      if (latency_limit.starts_with("capture_to_mask"))
+        latency_limit +=
+            ": for the simulated cameras this includes rendering each image after "
+            "the frame instant (all cameras at once on the shared cores), then keying";
+    }
+  }
+  j.key("held_back_by").begin_object();
+  j.field("rate", rate_limit).field("latency", latency_limit);
+  j.end_object();
+  j.end_object();
+
+  if (!o.histogram_png.empty()) {
+    char title[200];
+    std::snprintf(title, sizeof title, "%s, %zu frames, %d cameras",
+                  have_heads ? "capture -> mesh + head delivered" : "capture -> mesh delivered",
+                  headline.v.size(), ncams);
+    draw_histogram(headline, title, o.histogram_png);
+  }
+  return j.str();
+}
+
+}  // namespace studio::demo

@@ -1,0 +1,65 @@
+#include "truth.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "capture/sim_source.h"
+#include "sim/studio.h"
+#include "testing/raster.h"
+
+namespace studio::demo {
+
+struct TruthScorer::Impl {
+  sim::SimulatedStudio studio;
+};
+
+TruthScorer::TruthScorer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+TruthScorer::TruthScorer(TruthScorer&&) noexcept = default;
+TruthScorer& TruthScorer::operator=(TruthScorer&&) noexcept = default;
+TruthScorer::~TruthScorer() = default;
+
+Expected<TruthScorer> TruthScorer::create(std::vector<Camera> cameras) {
+  // The scene every `source: {type: sim}` camera renders (capture_config.cc sets no studio
+  // options, so SimSourceOptions's defaults are the scene).
+  const sim::StudioOptions scene = capture::SimSourceOptions{}.studio;
+  auto studio = sim::SimulatedStudio::create(std::move(cameras), scene);
+  if (!studio) return std::unexpected(studio.error());
+  return TruthScorer(std::make_unique<Impl>(Impl{std::move(*studio)}));
+}
+
+MeshScore TruthScorer::score_meshes(uint64_t frame, const std::vector<hull::Mesh>& meshes) const {
+  MeshScore score;
+  score.frame = frame;
+  score.min_iou = std::numeric_limits<double>::infinity();
+  const auto& cams = impl_->studio.cameras();
+  Mask truth;
+  double sum = 0;
+  for (int i = 0; i < int(cams.size()); ++i) {
+    impl_->studio.render(i, int64_t(frame), nullptr, &truth);
+    Mask drawn(cams[i].width, cams[i].height, 0);
+    for (const hull::Mesh& m : meshes) {
+      const Mask one = hull::testing::rasterise(m, cams[i]);
+      auto& d = drawn.pixels();
+      const auto& o = one.pixels();
+      for (std::size_t k = 0; k < d.size(); ++k) d[k] |= o[k];
+    }
+    const double iou = hull::testing::iou(drawn, truth);
+    sum += iou;
+    if (iou < score.min_iou) {
+      score.min_iou = iou;
+      score.worst_camera = cams[i].id;
+    }
+  }
+  score.mean_iou = cams.empty() ? 0 : sum / double(cams.size());
+  return score;
+}
+
+Eigen::Vector3d TruthScorer::true_head(uint64_t frame) const {
+  return impl_->studio.truth(int64_t(frame)).head_centre();
+}
+
+double TruthScorer::head_error(uint64_t frame, const Eigen::Vector3d& position) const {
+  return (position - true_head(frame)).norm();
+}
+
+}  // namespace studio::demo
