@@ -20,6 +20,7 @@
 #include <random>
 
 #include "hull/silhouette_cut.h"
+#include "support/cameras.h"
 #include "testing/synthetic.h"
 
 namespace studio::hull {
@@ -68,7 +69,7 @@ RandomRig random_rig(std::mt19937& rng, int trial) {
     const Eigen::Vector3d up = Eigen::AngleAxisd(roll, axis) * Eigen::Vector3d::UnitY();
     const Distortion dist_model = k % 7 == 6 ? Distortion::radial(-0.05, 0.01) : Distortion::none();
     r.cameras.push_back(
-        testing::look_at("c" + std::to_string(k), c, c + axis, up, 320, 240, focal, dist_model));
+        support::look_at_camera("c" + std::to_string(k), c, c + axis, up, 320, 240, focal, dist_model));
     focal_min = std::min(focal_min, focal);
     for (int q = 0; q < 8; ++q) {
       const Eigen::AlignedBox3d box(r.grid.box_min, r.grid.box_max);

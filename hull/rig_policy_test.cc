@@ -14,6 +14,8 @@
 #include "hull/silhouette_cut.h"
 #include "hull/viewpoint_cut.h"
 #include "hull/visibility.h"
+#include "support/cameras.h"
+#include "support/masks.h"
 #include "testing/raster.h"
 #include "testing/sim_rig.h"
 #include "testing/synthetic.h"
@@ -97,7 +99,7 @@ TEST(RigPolicy, CameraSeeingHalfTheBoxCutsNothingItDoesNotSee) {
   const Eigen::Vector3d mid = 0.5 * (s.lo + s.hi);
   const Eigen::Vector3d upper(mid.x(), s.lo.y() + 0.75 * (s.hi.y() - s.lo.y()), mid.z());
   std::vector<Camera> cams = s.frame.cameras;
-  cams.push_back(testing::look_at("close", upper + Eigen::Vector3d(0, 0.2, 1.6), upper,
+  cams.push_back(support::look_at_camera("close", upper + Eigen::Vector3d(0, 0.2, 1.6), upper,
                                   Eigen::Vector3d::UnitY(), 1024, 768, 800));
   const testing::SimFrame f = testing::render_sim(walker(), kFrame, cams);
   // It really sees only part of the box: the bottom corners are outside its image.
@@ -232,7 +234,7 @@ TEST(RigPolicy, ProjectorMaskOfTheLooseBoxIsTheTightBoxMask) {
   const RigScene& s = RigScene::get();
   const auto views = s.frame.views();
   const Eigen::Vector3d mid = 0.5 * (s.lo + s.hi);
-  const Camera projector = testing::look_at("projector", mid + Eigen::Vector3d(0.5, 3.5, 3.0), mid,
+  const Camera projector = support::look_at_camera("projector", mid + Eigen::Vector3d(0.5, 3.5, 3.0), mid,
                                             Eigen::Vector3d::UnitY(), 512, 384, 420);
   const auto box_of = [](const GridSpec& g) { return Eigen::AlignedBox3d(g.box_min, g.box_max); };
   const auto pixels = [&](const GridSpec& g, int min_views) {
@@ -281,7 +283,7 @@ TEST(RigPolicy, TiltedRigHullIsAccurate) {
     double worst = 1;
     std::printf("%dx%d IoU:", n, n);
     for (std::size_t c = 0; c < views.size(); ++c) {
-      const double q = testing::iou(testing::rasterise(mesh, s.frame.cameras[c]), s.frame.truth[c]);
+      const double q = support::iou(testing::rasterise(mesh, s.frame.cameras[c]), s.frame.truth[c]);
       std::printf(" %.3f", q);
       worst = std::min(worst, q);
     }

@@ -5,6 +5,7 @@
 
 #include "capture/sim_source.h"
 #include "sim/studio.h"
+#include "support/masks.h"
 #include "testing/raster.h"
 
 namespace studio::demo {
@@ -43,7 +44,7 @@ MeshScore TruthScorer::score_meshes(uint64_t frame, const std::vector<hull::Mesh
       const auto& o = one.pixels();
       for (std::size_t k = 0; k < d.size(); ++k) d[k] |= o[k];
     }
-    const double iou = hull::testing::iou(drawn, truth);
+    const double iou = support::iou(drawn, truth);
     sum += iou;
     if (iou < score.min_iou) {
       score.min_iou = iou;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "support/cameras.h"
 #include "testing/synthetic.h"
 
 namespace studio::hull::testing {
@@ -25,7 +26,7 @@ std::vector<Camera> tilted_rig(const Eigen::Vector3d& centre, const TiltedRigOpt
         std::cos(tilt) * horizontal - std::sin(tilt) * Eigen::Vector3d::UnitY();
     const Eigen::Vector3d up = Eigen::AngleAxisd(roll, axis) * Eigen::Vector3d::UnitY();
     out.push_back(
-        look_at("cam" + std::to_string(k), c, c + axis, up, o.width, o.height, o.focal_px));
+        support::look_at_camera("cam" + std::to_string(k), c, c + axis, up, o.width, o.height, o.focal_px));
   }
   return out;
 }
