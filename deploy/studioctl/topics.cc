@@ -76,6 +76,11 @@ int list(const Args& a) {
     for (const auto& row : wire::topic_table())
       if (!topics.contains(row.name)) topics[row.name].type = row.descriptor->m_typename;
 
+  if (topics.empty() && !a.common.json)
+    std::fprintf(
+        stderr,
+        "studioctl topic list: no topic seen within %.1f s (--all lists the studio table)\n",
+        *wait);
   if (!a.common.json)
     std::printf("%-32s %-28s %3s %3s  %-16s %s\n", "TOPIC", "TYPE", "W", "R", "HOSTS",
                 "QOS (studio table)");
