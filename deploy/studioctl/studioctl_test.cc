@@ -98,8 +98,10 @@ class StudioctlTest : public studio::testing::ProcessTest {
 
   // Runs studioctl in this test's DDS domain (the fixture exported it into this process's
   // environment) and collects stdout and stderr.
-  Run studioctl(const std::vector<std::string>& args) {
-    std::string cmd = studio::testing::built_binary("deploy/studioctl/studioctl").string();
+  // prefix: prepended to the command line (environment overrides, a wrapper such as unshare).
+  Run studioctl(const std::vector<std::string>& args, const std::string& prefix = "") {
+    std::string cmd =
+        prefix + " " + studio::testing::built_binary("deploy/studioctl/studioctl").string();
     for (const auto& a : args) cmd += " '" + a + "'";
     const fs::path err = dir_ / ("studioctl." + std::to_string(runs_++) + ".err");
     cmd += " 2>'" + err.string() + "'";
@@ -155,7 +157,8 @@ TEST_F(StudioctlTest, HelpEverywhereAndBadUsageIsOneLine) {
                                         {"capture", "--help"},
                                         {"capture", "start", "--help"},
                                         {"camera", "--help"},
-                                        {"camera", "set", "--help"}}) {
+                                        {"camera", "set", "--help"},
+                                        {"doctor", "--help"}}) {
     auto r = studioctl(args);
     EXPECT_EQ(r.code, 0) << args[0] << r.err;
     EXPECT_NE(r.out.find("usage: studioctl"), std::string::npos) << r.out;
@@ -453,6 +456,81 @@ TEST_F(StudioctlTest, CommandsWithoutAServiceFailClearly) {
   auto e = studioctl({"topic", "echo", "studio/actor/head", "--count", "1", "--timeout", "1"});
   EXPECT_EQ(e.code, 1);
   EXPECT_NE(e.err.find("timed out after 0 of 1 samples"), std::string::npos) << e.err;
+}
+
+// doctor: every check passes on the test profile (the clock may only warn); each injected fault
+// (a profile naming a missing interface, a buffer minimum above net.core.rmem_max, an unreadable
+// profile, a host without a multicast route) fails its check with the fix, and exits 1.
+TEST_F(StudioctlTest, DoctorPassesOnTheTestProfileAndNamesEachInjectedFault) {
+  auto checks_of = [&](const Run& r) {
+    std::map<std::string, Json> out;
+    for (auto& j : json_lines(r)) out[j.find("check")->string] = j;
+    return out;
+  };
+  auto ok = studioctl({"doctor", "--json"});
+  EXPECT_EQ(ok.code, 0) << ok.out << ok.err;
+  auto c = checks_of(ok);
+  for (const char* name :
+       {"profile", "interfaces", "socket_buffers", "multicast_route", "participant"})
+    EXPECT_EQ(c[name].find("status")->string, "ok") << name << ": " << ok.out;
+  EXPECT_NE(c["clock"].find("status")->string, "fail");
+  auto text = studioctl({"doctor"});
+  EXPECT_NE(text.out.find("ok   interfaces: interfaces: lo"), std::string::npos) << text.out;
+
+  const std::string loopback = slurp(fs::path(STUDIO_SOURCE_DIR) / "deploy/dds/loopback.xml");
+  auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
+    std::string x = loopback;
+    const auto at = x.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) x.replace(at, from.size(), to);
+    return write_file(name, x);
+  };
+  auto no_if = studioctl(
+      {"doctor", "--json", "--dds-config", variant("noif.xml", "name=\"lo\"", "name=\"studio9\"")});
+  EXPECT_EQ(no_if.code, 1);
+  c = checks_of(no_if);
+  EXPECT_EQ(c["interfaces"].find("status")->string, "fail");
+  EXPECT_NE(c["interfaces"].find("message")->string.find("studio9 does not exist"),
+            std::string::npos)
+      << no_if.out;
+  EXPECT_NE(c["interfaces"].find("fix")->string.find("ip link set"), std::string::npos);
+
+  auto big = studioctl({"doctor", "--json", "--dds-config",
+                        variant("big.xml", "SocketReceiveBufferSize min=\"1MB\"",
+                                "SocketReceiveBufferSize min=\"1GB\"")});
+  EXPECT_EQ(big.code, 1);
+  c = checks_of(big);
+  EXPECT_EQ(c["socket_buffers"].find("status")->string, "fail") << big.out;
+  EXPECT_NE(c["socket_buffers"].find("fix")->string.find("sysctl -w net.core.rmem_max=1000000000"),
+            std::string::npos)
+      << big.out;
+
+  auto missing =
+      studioctl({"doctor", "--json"}, "CYCLONEDDS_URI=file://" + (dir_ / "absent.xml").string());
+  EXPECT_EQ(missing.code, 1);
+  c = checks_of(missing);
+  EXPECT_EQ(c["profile"].find("status")->string, "fail");
+  EXPECT_NE(c["profile"].find("message")->string.find("absent.xml cannot be read"),
+            std::string::npos)
+      << missing.out;
+
+  // A host with only lo (a fresh network namespace) and a profile that auto-detects: no multicast
+  // route and no usable interface.
+  const std::string autodetect = write_file(
+      "auto.xml", "<CycloneDDS xmlns=\"https://cdds.io/config\"><Domain Id=\"any\"/></CycloneDDS>");
+  auto isolated = studioctl({"doctor", "--json", "--dds-config", autodetect},
+                            "unshare -n sh -c 'ip link set lo up && exec \"$0\" \"$@\"'");
+  EXPECT_EQ(isolated.code, 1) << isolated.err;
+  c = checks_of(isolated);
+  ASSERT_TRUE(c.count("multicast_route")) << isolated.out << isolated.err;
+  EXPECT_EQ(c["multicast_route"].find("status")->string, "fail") << isolated.out;
+  EXPECT_NE(c["multicast_route"].find("fix")->string.find("ip route add 224.0.0.0/4"),
+            std::string::npos);
+  EXPECT_EQ(c["interfaces"].find("status")->string, "fail") << isolated.out;
+  // Positive control of the same profile on this host (it has a routed, multicast interface).
+  auto host = studioctl({"doctor", "--json", "--dds-config", autodetect});
+  c = checks_of(host);
+  EXPECT_EQ(c["multicast_route"].find("status")->string, "ok") << host.out;
 }
 
 }  // namespace
