@@ -435,7 +435,19 @@ TEST_F(StudioctlTest, CaptureStartAtAFrameProducesATakeFromThatFrame) {
     std::this_thread::sleep_for(100ms);
   }
   EXPECT_NE(text.find("start_frame: " + std::to_string(start) + "\n"), std::string::npos) << text;
-  EXPECT_NE(text.find("first_frame: " + std::to_string(start) + "\n"), std::string::npos) << text;
+  // The take covers [start, stop) exactly: every frame of it is recorded or counted as a drop (a
+  // loaded machine may drop the first frames; then first_frame is later by as many drops).
+  auto value_of = [&](const std::string& key) -> int64_t {
+    const auto at = text.find("\n" + key + ": ");
+    return at == std::string::npos ? -1 : std::stoll(text.substr(at + key.size() + 3));
+  };
+  const int64_t stop = value_of("stop_frame"), first = value_of("first_frame");
+  const int64_t frames = value_of("frames"), drops = value_of("drops");
+  ASSERT_GT(stop, int64_t(start)) << text;
+  EXPECT_EQ(frames + drops, stop - int64_t(start)) << text;
+  EXPECT_GE(first, int64_t(start)) << text;
+  EXPECT_LE(first - int64_t(start), drops) << text;
+  EXPECT_GT(frames, 0) << text;
   EXPECT_NE(text.find("status: complete"), std::string::npos) << text;
   EXPECT_GT(fs::file_size(dir_ / "takes/ctl_take/cam0/frames.raw"), 0u);
 
