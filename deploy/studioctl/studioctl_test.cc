@@ -240,6 +240,14 @@ TEST_F(StudioctlTest, EveryIdlTopicEchoesAsJsonWithTheIdlMemberNames) {
   EXPECT_NE(mask_text.out.find("values)]"), std::string::npos) << mask_text.out;
   EXPECT_NE(mask_text.out.find("encoding: MASK_RUNS"), std::string::npos) << mask_text.out;
 
+  // One instance only: --key (the publisher writes masks of cam0..cam3).
+  auto one = studioctl({"topic", "echo", "studio/camera/mask", "--json", "--count", "3", "--key",
+                        "cam2", "--timeout", "20"});
+  ASSERT_EQ(one.code, 0) << one.err;
+  auto cam2 = json_lines(one);
+  ASSERT_EQ(cam2.size(), 3u);
+  for (const auto& j : cam2) EXPECT_EQ(j.find("camera_id")->string, "cam2");
+
   // A second parser agrees: python3's json module reads every line.
   const std::string file = write_file("echo.jsonl", all_json);
   const std::string py =
