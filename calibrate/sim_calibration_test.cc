@@ -1,4 +1,4 @@
-// Simulated studio images (capture/sim renders the ChArUco target into its cameras): detection
+// Simulated studio images (sim/ renders the ChArUco target into its cameras): detection
 // plus the one-stage solve recover the simulated rig within 5 mm and 0.1° (issue 7), and the
 // detected corners are measured against the simulator's exact projections.
 #include <gtest/gtest.h>
@@ -13,8 +13,8 @@
 #include "calibrate/bundle.h"
 #include "calibrate/camera_calibration.h"
 #include "calibrate/detect.h"
-#include "capture/sim/cameras.h"
-#include "capture/sim/target.h"
+#include "sim/cameras.h"
+#include "sim/target.h"
 
 namespace studio::calibrate {
 namespace {

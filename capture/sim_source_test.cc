@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "capture/sim/cameras.h"
+#include "sim/cameras.h"
 
 namespace studio::capture {
 namespace {

@@ -1,5 +1,5 @@
 // Accuracy of the line-segment hull on the simulated studio (issue 5): the TRUE masks of the
-// default rig (5 ring cameras + 1 overhead, 704x576, capture/sim) → RunMask → visual_hull over the
+// default rig (5 ring cameras + 1 overhead, 704x576, sim/) → RunMask → visual_hull over the
 // acting area → segment marching cubes (+ exact crossings, hull/crossing_refine.h) → the mesh
 // rasterised back into every camera at pixel centres (testing/raster.h) must match the true mask
 // with IoU >= 0.97 in EVERY camera, for frames of the walk, raise-hand and crouch motions.
@@ -15,12 +15,12 @@
 
 #include <cstdio>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
 #include "core/run_mask.h"
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #include "testing/raster.h"
 
 namespace studio::hull {

@@ -27,8 +27,8 @@
 
 #include "core/mask_codec.h"
 #ifdef STUDIO_KEYER_BENCH_SIM
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #endif
 #include "keyer/keyer.h"
 #include "keyer/reference_keyer.h"

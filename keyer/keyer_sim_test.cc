@@ -1,9 +1,9 @@
-// Accuracy of the keyer on the simulated studio (capture/sim): 6 cameras at 704x576, every
+// Accuracy of the keyer on the simulated studio (sim/): 6 cameras at 704x576, every
 // realism knob on (sensor noise, cloth fall-off and seams, blue spill, the cameras' blue ring
 // light on the actor, soft floor shadows, a projected picture on the back wall, area-integrated
 // edges and, in the scene, motion blur over a 1/50 s shutter).
 //
-// Two truths, both from the simulator (capture/sim/studio.h):
+// Two truths, both from the simulator (sim/studio.h):
 // - the true matte, cut at 1/2: a pixel is actor when the actor covers at least half of the
 //   image's own sub-samples of it (16, spread over the pixel's area and the shutter). This is the
 //   mask the image shows, and what the keyer is scored against (the "true mask" for a
@@ -19,10 +19,10 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
 #include "core/mask_codec.h"
 #include "keyer/keyer.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #include "test_frames.h"
 
 namespace studio::keyer {

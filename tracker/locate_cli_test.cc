@@ -11,8 +11,8 @@
 #include <regex>
 #include <string>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #include "yaml_io/rig_yaml.h"
 
 namespace studio::tracker {

@@ -1,5 +1,5 @@
 // Accuracy of the head tracker on the simulated studio (issue 6): true masks of the 6-camera
-// ring (capture/sim) → line-segment visual hull (hull/) → rasterise → head search, scored
+// ring (sim/) → line-segment visual hull (hull/) → rasterise → head search, scored
 // against the simulator's true head centre (the centre of the skull ellipsoid). Targets: head
 // centre error <= 3 cm RMS for each scripted motion, and never the raised hand.
 
@@ -8,10 +8,10 @@
 #include <cmath>
 #include <cstdio>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
 #include "core/run_mask.h"
 #include "hull/silhouette_cut.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #include "tracker/head_search.h"
 #include "tracker/segment_raster.h"
 

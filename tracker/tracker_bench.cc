@@ -11,10 +11,10 @@
 #include <chrono>
 #include <map>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
 #include "core/run_mask.h"
 #include "hull/silhouette_cut.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #include "testing/synthetic_actor.h"
 #include "tracker/head_search.h"
 #include "tracker/segment_raster.h"

@@ -1,12 +1,14 @@
 #include "capture_config.h"
 
-#include <filesystem>
+#include <algorithm>
+#include <optional>
 
-#include "../../keyer/cli/keyer_yaml.h"
 #include "capture/aravis_source.h"
 #include "capture/file_source.h"
-#include "capture/sim/cameras.h"
 #include "capture/sim_source.h"
+#include "keyer/config/keyer_yaml.h"
+#include "sim/cameras.h"
+#include "yaml_io/options.h"
 #include "yaml_io/rig_yaml.h"
 
 namespace studio::capture::node {
@@ -18,7 +20,8 @@ const char kConfigHelp[] =
     "  keyer: FILE                       keyer options, see keyer.example.yaml (optional)\n"
     "  image: {rate: HZ, quality: Q, raw: BOOL}   latest-image service (default 5, 85, false)\n"
     "  masks: BOOL                       key and publish masks here (default true; false when\n"
-    "                                    studio-keyer --config keys image: {rate: 1000, raw: true})\n"
+    "                                    studio-keyer --config keys image: {rate: 1000, raw: "
+    "true})\n"
     "  plate_dir: DIR                    difference key: keep plates captured on command\n"
     "                                    (KeyerPlate) as DIR/<camera>.png, load them at start\n"
     "  recorder: {queue_frames: N}       frames buffered before the disk (default 50)\n"
@@ -33,220 +36,256 @@ const char kConfigHelp[] =
 
 namespace {
 
-using Fail = std::unexpected<Error>;
-
-std::string resolve(const yaml::Node& n, const std::string& path) {
-  if (path.empty() || path.front() == '/') return path;
-  return (std::filesystem::path(n.file()).parent_path() / path).string();
-}
-
-template <class T, class F>
-Expected<void> number(yaml::MapReader& m, std::string_view key, T& out, double lo, double hi,
-                      F convert) {
-  auto n = m.optional(key);
-  if (!n) return {};
-  auto v = convert(*n);
-  if (!v) return Fail(v.error());
-  if (double(*v) < lo || double(*v) > hi)
-    return n->fail("must be in [" + yaml::format_double(lo) + ", " + yaml::format_double(hi) + "]");
-  out = T(*v);
-  return {};
-}
-auto as_double = [](const yaml::Node& n) { return n.as_double(); };
-auto as_int = [](const yaml::Node& n) { return n.as_int(); };
-
-Expected<void> boolean(yaml::MapReader& m, std::string_view key, bool& out) {
-  auto n = m.optional(key);
-  if (!n) return {};
-  auto v = n->as_bool();
-  if (!v) return Fail(v.error());
-  out = *v;
-  return {};
-}
-
-Expected<void> string(yaml::MapReader& m, std::string_view key, std::string& out, bool path) {
-  auto n = m.optional(key);
-  if (!n) return {};
-  auto v = n->as_string();
-  if (!v) return Fail(v.error());
-  if (v->empty()) return n->fail("must not be empty");
-  out = path ? resolve(*n, *v) : *v;
-  return {};
-}
-
-#define TRY(expr)                                       \
-  do {                                                  \
-    if (auto _r = (expr); !_r) return Fail(_r.error()); \
-  } while (0)
-
-Expected<CameraSetup> read_camera(const yaml::Node& node, const CaptureNodeOptions& o) {
-  auto m = yaml::MapReader::from(node);
-  if (!m) return Fail(m.error());
-  CameraSetup setup;
-  auto id_node = m->required("id");
-  if (!id_node) return Fail(id_node.error());
-  auto id = id_node->as_string();
-  if (!id) return Fail(id.error());
-  if (id->empty() || id->size() > 63) return id_node->fail("expected 1..63 characters");
-  setup.id = *id;
-  auto src_node = m->required("source");
-  if (!src_node) return Fail(src_node.error());
-  auto s = yaml::MapReader::from(*src_node);
-  if (!s) return Fail(s.error());
-  auto type_node = s->required("type");
-  if (!type_node) return Fail(type_node.error());
-  auto type = type_node->as_string();
-  if (!type) return Fail(type.error());
-  if (*type == "sim") {
-    sim::RingOptions ring;
-    int index = 0;
-    SimSourceOptions so;
-    TRY(number(*s, "ring", ring.count, 1, 64, as_int));
-    TRY(number(*s, "index", index, 0, 63, as_int));
-    TRY(number(*s, "width", ring.width, 16, 8192, as_int));
-    TRY(number(*s, "height", ring.height, 16, 8192, as_int));
-    TRY(boolean(*s, "paced", so.paced));
-    TRY(s->finish());
-    if (index >= ring.count) return src_node->fail("index: must be below ring");
-    ring.focal_px *= double(ring.width) / 704.0;  // keep the field of view at any size
-    so.camera = sim::ring_cameras(ring)[std::size_t(index)];
-    so.camera.id = setup.id;
-    so.clock = o.clock;
-    so.exposure_us = std::min(so.exposure_us, double(o.clock.period_ns) / 1000.0);
-    setup.calibration = so.camera;
-    auto src = SimFrameSource::create(so);
-    if (!src) return src_node->fail(src.error().message);
-    setup.source = std::move(*src);
-  } else if (*type == "files") {
-    FileSourceOptions fo;
-    fo.id = setup.id;
-    fo.clock = o.clock;
-    auto path = s->required("path");
-    if (!path) return Fail(path.error());
-    auto p = path->as_string();
-    if (!p) return Fail(p.error());
-    fo.path = resolve(*path, *p);
-    TRY(number(*s, "fps", fo.fps, 1e-3, 1000, as_double));
-    TRY(boolean(*s, "loop", fo.loop));
-    TRY(boolean(*s, "paced", fo.paced));
-    TRY(s->finish());
-    auto src = FileSource::create(fo);
-    if (!src) return src_node->fail(src.error().message);
-    setup.source = std::move(*src);
-  } else if (*type == "aravis") {
-    AravisOptions ao;
-    ao.camera_id = setup.id;
-    ao.clock = o.clock;
-    std::string pixel_format, trigger = "free_run";
-    TRY(string(*s, "device", ao.device_id, false));
-    TRY(string(*s, "pixel_format", pixel_format, false));
-    TRY(number(*s, "width", ao.width, 0, 32768, as_int));
-    TRY(number(*s, "height", ao.height, 0, 32768, as_int));
-    TRY(number(*s, "fps", ao.frame_rate, 0, 1000, as_double));
-    TRY(string(*s, "trigger", trigger, false));
-    TRY(string(*s, "line", ao.trigger_line, false));
-    TRY(number(*s, "buffers", ao.buffers, 2, 256, as_int));
-    if (auto n = s->optional("interfaces")) {
-      auto v = n->elements();
-      if (!v) return Fail(v.error());
-      for (const auto& e : *v) {
-        auto name = e.as_string();
-        if (!name) return Fail(name.error());
-        ao.interfaces.push_back(*name);
-      }
-    }
-    TRY(s->finish());
-    if (!pixel_format.empty()) {
-      auto pf = parse_pixel_format(pixel_format);
-      if (!pf) return src_node->fail(pf.error().message);
-      ao.pixel_format = *pf;
-    }
-    if (trigger == "free_run")
-      ao.trigger = TriggerMode::free_run;
-    else if (trigger == "software")
-      ao.trigger = TriggerMode::software;
-    else if (trigger == "line")
-      ao.trigger = TriggerMode::line;
-    else
-      return src_node->fail("trigger: expected free_run, software or line");
-    auto src = AravisSource::open(ao);
-    if (!src) return src_node->fail(src.error().message);
-    setup.source = std::move(*src);
-  } else {
-    return type_node->fail("unknown source type '" + *type + "' (expected sim, files or aravis)");
+// The keys as written; read_capture_config() turns them into CaptureNodeOptions.
+struct ClockKeys {
+  double fps = 0;  // 0: not given
+  int64_t period_ns = 0;
+  int64_t epoch_ns = 0;
+  Expected<void> validate() const {
+    if (fps > 0 && period_ns > 0) return fail("give fps or period_ns, not both");
+    return {};
   }
-  TRY(m->finish());
+  FrameClock clock() const {
+    FrameClock c;
+    c.period_ns = period_ns > 0 ? period_ns : int64_t(1e9 / (fps > 0 ? fps : 25.0) + 0.5);
+    c.epoch_ns = epoch_ns;
+    return c;
+  }
+};
+struct ImageKeys {
+  double rate = 5;
+  int quality = 85;
+  bool raw = false;
+};
+struct RecorderKeys {
+  int queue_frames = 50;
+};
+struct SimKeys {
+  int ring = 6, index = 0, width = 704, height = 576;
+  bool paced = true;
+  Expected<void> validate() const {
+    if (index >= ring) return fail("index: must be below ring");
+    return {};
+  }
+};
+// One camera of `cameras:`; its source is opened once the whole file has been read.
+struct CameraKeys {
+  std::string id;
+  std::optional<yaml::Node> source;  // the source mapping (for errors while opening)
+  std::string type;
+  SimKeys sim;
+  FileSourceOptions files;
+  AravisOptions aravis;
+};
+struct CaptureKeys {
+  ClockKeys clock;
+  std::string takes_dir, rig, plate_dir;
+  keyer::KeyerOptions keyer;
+  ImageKeys image;
+  bool masks = true;
+  RecorderKeys recorder;
+  double state_period = 1.0;
+  std::vector<CameraKeys> cameras;
+  Expected<void> validate() const {
+    if (!plate_dir.empty() && (!masks || keyer.mode != keyer::KeyMode::kDifference))
+      return fail(
+          "plate_dir: clean plates need in-process keying (masks: true) with the difference key");
+    return {};
+  }
+};
+
+const yaml::Schema<SimKeys> kSim{
+    yaml::field("ring", &SimKeys::ring).range(1, 64),
+    yaml::field("index", &SimKeys::index).range(0, 63),
+    yaml::field("width", &SimKeys::width).range(16, 8192),
+    yaml::field("height", &SimKeys::height).range(16, 8192),
+    yaml::field("paced", &SimKeys::paced),
+};
+const yaml::Schema<FileSourceOptions> kFiles{
+    yaml::field("path", &FileSourceOptions::path).required().relative_path(),
+    yaml::field("fps", &FileSourceOptions::fps).range(1e-3, 1000),
+    yaml::field("loop", &FileSourceOptions::loop),
+    yaml::field("paced", &FileSourceOptions::paced),
+};
+const yaml::Schema<AravisOptions> kAravis{
+    yaml::field("device", &AravisOptions::device_id),
+    yaml::field("pixel_format", &AravisOptions::pixel_format,
+                [](const yaml::Node& n) -> Expected<CameraPixelFormat> {
+                  auto s = n.as_string();
+                  if (!s) return std::unexpected(s.error());
+                  auto pf = parse_pixel_format(*s);
+                  if (!pf) return n.fail(pf.error().message);
+                  return pf;
+                }),
+    yaml::field("width", &AravisOptions::width).range(0, 32768),
+    yaml::field("height", &AravisOptions::height).range(0, 32768),
+    yaml::field("fps", &AravisOptions::frame_rate).range(0, 1000),
+    yaml::enum_field("trigger", &AravisOptions::trigger,
+                     {{"free_run", TriggerMode::free_run},
+                      {"software", TriggerMode::software},
+                      {"line", TriggerMode::line}}),
+    yaml::field("line", &AravisOptions::trigger_line),
+    yaml::field("buffers", &AravisOptions::buffers).range(2, 256),
+    yaml::field("interfaces", &AravisOptions::interfaces),
+};
+
+// The source mapping's keys after `type`, by type.
+Expected<void> read_source(const yaml::Node& node, CameraKeys& c) {
+  auto m = yaml::MapReader::from(node);
+  if (!m) return std::unexpected(m.error());
+  auto type_node = m->required("type");
+  if (!type_node) return std::unexpected(type_node.error());
+  auto type = type_node->as_string();
+  if (!type) return std::unexpected(type.error());
+  c.type = *type;
+  c.source = node;
+  auto done = [](const auto& keys, auto& out) -> Expected<void> {
+    if (!keys) return std::unexpected(keys.error());
+    out = *keys;
+    return {};
+  };
+  if (c.type == "sim") return done(kSim.read_fields(*m, {}, true), c.sim);
+  if (c.type == "files") return done(kFiles.read_fields(*m, {}, true), c.files);
+  if (c.type == "aravis") return done(kAravis.read_fields(*m, {}, true), c.aravis);
+  return type_node->fail("unknown source type '" + c.type + "' (expected sim, files or aravis)");
+}
+
+Expected<std::vector<CameraKeys>> read_cameras(const yaml::Node& n) {
+  auto elements = n.elements();
+  if (!elements) return std::unexpected(elements.error());
+  if (elements->empty()) return n.fail("expected at least one camera");
+  std::vector<CameraKeys> cameras;
+  for (const auto& e : *elements) {
+    static const yaml::Schema<CameraKeys> kCamera{
+        yaml::field("id", &CameraKeys::id).required(),
+    };
+    auto m = yaml::MapReader::from(e);
+    if (!m) return std::unexpected(m.error());
+    auto c = kCamera.read_fields(*m);
+    if (!c) return std::unexpected(c.error());
+    if (c->id.empty() || c->id.size() > 63) return e.fail("id: expected 1..63 characters");
+    auto source = m->required("source");
+    if (!source) return std::unexpected(source.error());
+    if (auto r = read_source(*source, *c); !r) return std::unexpected(r.error());
+    if (auto r = m->finish(); !r) return std::unexpected(r.error());
+    for (const auto& other : cameras)
+      if (other.id == c->id) return e.fail("duplicate camera id " + c->id);
+    cameras.push_back(std::move(*c));
+  }
+  return cameras;
+}
+
+// The camera's source, opened with the studio clock; errors name the source mapping.
+Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock) {
+  CameraSetup setup;
+  setup.id = c.id;
+  const yaml::Node& at = *c.source;
+  Expected<std::unique_ptr<FrameSource>> src = fail("unknown source type");
+  if (c.type == "sim") {
+    sim::RingOptions ring;
+    ring.count = c.sim.ring;
+    ring.width = c.sim.width;
+    ring.height = c.sim.height;
+    ring.focal_px *= double(ring.width) / 704.0;  // keep the field of view at any size
+    SimSourceOptions so;
+    so.paced = c.sim.paced;
+    so.camera = sim::ring_cameras(ring)[std::size_t(c.sim.index)];
+    so.camera.id = c.id;
+    so.clock = clock;
+    so.exposure_us = std::min(so.exposure_us, double(clock.period_ns) / 1000.0);
+    setup.calibration = so.camera;
+    src = SimFrameSource::create(so);
+  } else if (c.type == "files") {
+    FileSourceOptions fo = c.files;
+    fo.id = c.id;
+    fo.clock = clock;
+    src = FileSource::create(fo);
+  } else {
+    AravisOptions ao = c.aravis;
+    ao.camera_id = c.id;
+    ao.clock = clock;
+    src = AravisSource::open(ao);
+  }
+  if (!src) return at.fail(src.error().message);
+  setup.source = std::move(*src);
   return setup;
 }
 
 }  // namespace
 
 Expected<CaptureNodeOptions> read_capture_config(yaml::MapReader& config) {
+  static const yaml::Schema<CaptureKeys> schema{
+      yaml::field("clock", &CaptureKeys::clock,
+                  yaml::Schema<ClockKeys>{
+                      yaml::field("fps", &ClockKeys::fps).range(0.1, 1000),
+                      yaml::field("period_ns", &ClockKeys::period_ns).range(1e6, 1e10),
+                      yaml::field("epoch_ns", &ClockKeys::epoch_ns).range(0, 9.2e18),
+                  }),
+      yaml::field("takes_dir", &CaptureKeys::takes_dir).relative_path(),
+      yaml::field("rig", &CaptureKeys::rig).relative_path(),
+      yaml::field("keyer", &CaptureKeys::keyer,
+                  [](const yaml::Node& n) -> Expected<keyer::KeyerOptions> {
+                    auto path = n.as_string();
+                    if (!path) return std::unexpected(path.error());
+                    return keyer::load_keyer_options(yaml::resolve_path(n, *path));
+                  }),
+      yaml::field("image", &CaptureKeys::image,
+                  yaml::Schema<ImageKeys>{
+                      yaml::field("rate", &ImageKeys::rate).range(0, 1000),
+                      yaml::field("quality", &ImageKeys::quality).range(1, 100),
+                      yaml::field("raw", &ImageKeys::raw),
+                  }),
+      yaml::field("masks", &CaptureKeys::masks),
+      yaml::field("plate_dir", &CaptureKeys::plate_dir).relative_path(),
+      yaml::field("recorder", &CaptureKeys::recorder,
+                  yaml::Schema<RecorderKeys>{
+                      yaml::field("queue_frames", &RecorderKeys::queue_frames).range(1, 10000),
+                  }),
+      yaml::field("state_period", &CaptureKeys::state_period).range(0.05, 60),
+      yaml::field("cameras", &CaptureKeys::cameras, read_cameras).required(),
+  };
+  auto keys = schema.read_fields(config);
+  if (!keys) return std::unexpected(keys.error());
   CaptureNodeOptions o;
-  if (auto n = config.optional("clock")) {
-    auto c = yaml::MapReader::from(*n);
-    if (!c) return Fail(c.error());
-    if (c->has("fps") && c->has("period_ns")) return n->fail("give fps or period_ns, not both");
-    double fps = 25;
-    TRY(number(*c, "fps", fps, 0.1, 1000, as_double));
-    o.clock.period_ns = int64_t(1e9 / fps + 0.5);
-    TRY(number(*c, "period_ns", o.clock.period_ns, 1e6, 1e10, as_int));
-    TRY(number(*c, "epoch_ns", o.clock.epoch_ns, 0, 9.2e18, as_int));
-    TRY(c->finish());
+  o.clock = keys->clock.clock();
+  o.takes_dir =
+      yaml::resolve_path(config.node(), keys->takes_dir.empty() ? "takes" : keys->takes_dir);
+  o.queue_frames = std::size_t(keys->recorder.queue_frames);
+  o.keyer = keys->keyer;
+  o.image_rate = keys->image.rate;
+  o.jpeg_quality = keys->image.quality;
+  o.image_raw = keys->image.raw;
+  o.publish_masks = keys->masks;
+  o.plate_dir = keys->plate_dir;
+  o.state_period = keys->state_period;
+  for (const CameraKeys& c : keys->cameras) {
+    auto setup = open_camera(c, o.clock);
+    if (!setup) return std::unexpected(setup.error());
+    o.cameras.push_back(std::move(*setup));
   }
-  o.takes_dir = resolve(config.node(), "takes");
-  TRY(string(config, "takes_dir", o.takes_dir, true));
-  std::string rig_path, keyer_path;
-  TRY(string(config, "rig", rig_path, true));
-  TRY(string(config, "keyer", keyer_path, true));
-  if (auto n = config.optional("image")) {
-    auto c = yaml::MapReader::from(*n);
-    if (!c) return Fail(c.error());
-    TRY(number(*c, "rate", o.image_rate, 0, 1000, as_double));
-    TRY(number(*c, "quality", o.jpeg_quality, 1, 100, as_int));
-    TRY(boolean(*c, "raw", o.image_raw));
-    TRY(c->finish());
-  }
-  if (auto n = config.optional("recorder")) {
-    auto c = yaml::MapReader::from(*n);
-    if (!c) return Fail(c.error());
-    TRY(number(*c, "queue_frames", o.queue_frames, 1, 10000, as_int));
-    TRY(c->finish());
-  }
-  TRY(number(config, "state_period", o.state_period, 0.05, 60, as_double));
-  TRY(boolean(config, "masks", o.publish_masks));
-  if (!keyer_path.empty()) {
-    auto k = keyer::load_keyer_options(keyer_path);
-    if (!k) return Fail(k.error());
-    o.keyer = *k;
-  }
-  if (auto n = config.optional("plate_dir")) {
-    auto dir = n->as_string();
-    if (!dir) return Fail(dir.error());
-    if (dir->empty()) return n->fail("expected a folder");
-    if (!o.publish_masks || o.keyer.mode != keyer::KeyMode::kDifference)
-      return n->fail("clean plates need in-process keying (masks: true) with the difference key");
-    o.plate_dir = resolve(*n, *dir);
-  }
-  auto cams = config.required("cameras");
-  if (!cams) return Fail(cams.error());
-  auto elements = cams->elements();
-  if (!elements) return Fail(elements.error());
-  if (elements->empty()) return cams->fail("expected at least one camera");
-  for (const auto& e : *elements) {
-    auto c = read_camera(e, o);
-    if (!c) return Fail(c.error());
-    for (const auto& other : o.cameras)
-      if (other.id == c->id) return e.fail("duplicate camera id " + c->id);
-    o.cameras.push_back(std::move(*c));
-  }
-  if (!rig_path.empty()) {
-    auto rig = yaml::read_rig(rig_path);
-    if (!rig) return Fail(rig.error());
+  if (!keys->rig.empty()) {
+    auto rig = yaml::read_rig(keys->rig);
+    if (!rig) return std::unexpected(rig.error());
     for (auto& c : o.cameras)
       if (const Camera* rc = rig->find_camera(c.id)) c.calibration = *rc;
   }
   return o;
+}
+
+runtime::ServiceDefinition capture_service_definition() {
+  runtime::ServiceDefinition d;
+  d.name = "capture";
+  d.summary =
+      "Capture server: per camera publishes alpha masks, images and state, applies camera "
+      "control and records takes on command. Also: studio-capture verify-take DIR.";
+  d.config_help = kConfigHelp;
+  d.create = [](yaml::MapReader& config,
+                runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
+    auto options = read_capture_config(config);
+    if (!options) return std::unexpected(options.error());
+    return make_capture_node(std::move(*options), ctx);
+  };
+  return d;
 }
 
 }  // namespace studio::capture::node

@@ -8,30 +8,30 @@
 //   - records takes on command (TakeSchedule + Recorder, frame-accurate, DESIGN §5);
 //   - publishes CameraState (features read back, fps, drops, recording, take, state, error) every
 //     `state_period` and whenever something changes.
-// A control thread waits on studio/camera/control and studio/capture/command: CameraControl for
-// an allow-listed GenICam feature (Gain, ExposureTime, Focus, Zoom, Iris) is applied through
-// FrameSource::set_feature and the read-back value is published in CameraState; ImageRate and
-// ImageRaw are the node's own pseudo-features; KeyerPlate (keyer/keyer.h) captures a clean plate
-// for an in-process difference key (ignored with masks: false: the keyer node honours it then).
-// CaptureCommand schedules start/stop per camera.
+// The loop thread of runtime::ServiceLoop (runtime/service_loop.h) takes studio/camera/control
+// and studio/capture/command: CameraControl for an allow-listed GenICam feature (Gain,
+// ExposureTime, Focus, Zoom, Iris) is applied through FrameSource::set_feature and the read-back
+// value is published in CameraState; ImageRate and ImageRaw are the node's own pseudo-features;
+// KeyerPlate (keyer/keyer.h) captures a clean plate for an in-process difference key (ignored with
+// masks: false: the keyer node honours it then). CaptureCommand schedules start/stop per camera.
+// Each camera's capture thread is a loop thread (camera_worker.h).
 // The calibration of every camera (rig file, else the source's own) is published on
 // studio/camera/calibration (transient-local) at start.
+//
+// Counters: masks_published, images_published, frames_captured, frames_recorded, frames_dropped,
+// frames_unkeyed, plates_captured, plate_saves_failed; controls_rejected and commands_rejected
+// (totals of their reasons: controls_rejected_<reason>, commands_rejected_<reason>).
 
-#include <atomic>
 #include <memory>
-#include <mutex>
+#include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "capture/frame_clock.h"
 #include "capture/frame_source.h"
-#include "capture/recorder.h"
-#include "capture/take_schedule.h"
 #include "core/camera.h"
 #include "core/mask_codec.h"
 #include "keyer/keyer_options.h"
-#include "kept_plates.h"
 #include "runtime/service.h"
 
 namespace studio::capture::node {
@@ -57,40 +57,11 @@ struct CaptureNodeOptions {
   std::vector<CameraSetup> cameras;
 };
 
-class CaptureNode : public runtime::Node {
- public:
-  CaptureNode(CaptureNodeOptions options, runtime::NodeContext& context);
-  ~CaptureNode() override;
-  Expected<void> start() override;
-  void stop() override;
-  runtime::NodeHealth health() override;
+// The node, built from its options (cameras and sources already made by the config reader).
+Expected<std::unique_ptr<runtime::Node>> make_capture_node(CaptureNodeOptions options,
+                                                           runtime::NodeContext& context);
 
-  struct Camera;  // per-camera state (capture_node.cc)
-  struct Wire;
-
- private:
-  void capture_loop(Camera& cam);
-  void control_loop();
-  void handle_control(const struct CameraControlCore& c);
-  void handle_command(const struct CaptureCommandCore& c);
-  void publish_state(Camera& cam);
-
-  CaptureNodeOptions options_;
-  const keyer::KeptPlates kept_plates_;  // options_.plate_dir
-  runtime::NodeContext& context_;
-  std::unique_ptr<Wire> wire_;
-  std::vector<std::unique_ptr<Camera>> cameras_;
-  std::atomic<bool> running_{false};
-  std::thread control_thread_;
-  runtime::Counter& masks_published_;
-  runtime::Counter& images_published_;
-  runtime::Counter& frames_recorded_;
-  runtime::Counter& frames_dropped_;
-  runtime::Counter& frames_unkeyed_;   // difference key without a clean plate yet
-  runtime::Counter& plates_captured_;  // KeyerPlate requests completed
-  runtime::Counter& plate_saves_failed_;  // completed plates that could not be kept in plate_dir
-  runtime::Counter& controls_rejected_;
-  runtime::Counter& commands_rejected_;
-};
+// service_main's definition of the capture service (name "capture"; capture_config.cc).
+runtime::ServiceDefinition capture_service_definition();
 
 }  // namespace studio::capture::node

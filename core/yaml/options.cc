@@ -49,6 +49,12 @@ Expected<void> check_size(const Node& n, const char* what, const Constraints& c)
 
 }  // namespace
 
+std::string resolve_path(const Node& node, const std::string& path) {
+  const std::filesystem::path p(path);
+  if (path.empty() || !p.is_relative()) return path;
+  return (std::filesystem::path(node.file()).parent_path() / p).lexically_normal().string();
+}
+
 Expected<void> read_value(const Node& n, bool& out, const Constraints&) {
   Expected<bool> v = n.as_bool();
   if (!v) return std::unexpected(v.error());
@@ -103,13 +109,7 @@ Expected<void> read_value(const Node& n, std::string& out, const Constraints& c)
     }
     if (!found) return n.fail("expected one of " + list + ", got '" + *v + "'");
   }
-  if (c.relative_path && !v->empty()) {
-    const std::filesystem::path p(*v);
-    if (p.is_relative()) {
-      *v = (std::filesystem::path(n.file()).parent_path() / p).lexically_normal().string();
-    }
-  }
-  out = std::move(*v);
+  out = c.relative_path ? resolve_path(n, *v) : std::move(*v);
   return {};
 }
 

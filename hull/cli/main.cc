@@ -24,7 +24,7 @@
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
 #include "hull_node.h"
-#include "keyer_yaml.h"
+#include "keyer/config/keyer_yaml.h"
 #include "yaml_io/rig_yaml.h"
 
 namespace fs = std::filesystem;

@@ -11,12 +11,12 @@
 #include <map>
 #include <thread>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
 #include "keyer/keyer.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 
 namespace studio::hull {
 namespace {

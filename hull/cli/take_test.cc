@@ -14,10 +14,10 @@
 #include <sstream>
 
 #include "capture/recorder.h"
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
 #include "core/rig.h"
 #include "keyer/keyer.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #include "testing/mesh_read.h"
 #include "testing/raster.h"
 #include "yaml_io/rig_yaml.h"

@@ -1,31 +1,25 @@
 #include "hull_node.h"
 
-#include <atomic>
 #include <chrono>
-#include <algorithm>
-#include <cmath>
-#include <deque>
-#include <thread>
+#include <optional>
 #include <utility>
 
-#include "core/clock.h"
 #include "core/frame_assembler.h"
 #include "core/log.h"
+#include "hull/camera_poses.h"
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
+#include "runtime/service_loop.h"
 #include "segments_wire.h"
 #include "wire/convert.h"
-#include "wire/endpoint.h"
-#include "wire/pubsub.h"
 #include "wire/sample.h"
-#include "yaml_io/options.h"
-#include "yaml_io/rig_yaml.h"
 
 namespace studio::hull {
 namespace {
 
 constexpr const char* kLog = "hull";
 using SteadyClock = std::chrono::steady_clock;
+using Assembler = FrameAssembler<RunMask>;
 
 void mesh_to_wire(const Mesh& mesh, studio_ActorMesh& s) {
   std::vector<float> v, n;
@@ -41,172 +35,102 @@ void mesh_to_wire(const Mesh& mesh, studio_ActorMesh& s) {
   wire::assign(s.triangles, t);
 }
 
+Assembler::Options assembler_options(const HullNodeOptions& o, const std::vector<Camera>& cams) {
+  Assembler::Options a;
+  for (const Camera& c : cams) a.sources.push_back(c.id);
+  a.deadline = std::chrono::microseconds(int64_t(o.deadline_ms * 1000));
+  a.min_sources = std::size_t(o.min_cameras);
+  return a;
+}
+
+// Runs on runtime::ServiceLoop: masks and calibrations in, per frame a cut and per actor its
+// segments and mesh out (hull_node.h).
 class HullNode : public runtime::Node {
  public:
   HullNode(HullNodeOptions options, std::vector<Camera> cameras, runtime::NodeContext& ctx)
       : options_(std::move(options)),
-        cameras_(std::move(cameras)),
-        participant_(ctx.participant),
-        metrics_(ctx.metrics),
-        masks_in_(ctx.metrics.counter("masks_in")),
-        masks_bad_(ctx.metrics.counter("masks_rejected")),
-        frames_complete_(ctx.metrics.counter("frames_complete")),
-        frames_partial_(ctx.metrics.counter("frames_partial")),
-        frames_dropped_(ctx.metrics.counter("frames_dropped")),
-        masks_late_(ctx.metrics.counter("masks_late")),
-        hulls_out_(ctx.metrics.counter("segment_sets_out")),
-        meshes_out_(ctx.metrics.counter("meshes_out")),
-        calibrations_in_(ctx.metrics.counter("calibrations_in")),
-        calibrations_stale_(ctx.metrics.counter("calibrations_not_of_frame")),
-        tracked_(cameras_.size()),
-        assembler_(make_assembler_options(options_, cameras_)) {}
-
+        assembler_(assembler_options(options_, cameras)),
+        poses_(std::move(cameras)),
+        loop_(ctx, kLog) {
+    segs_ = &loop_.output<studio_SegmentSet>({.counter = "segment_sets_out"});
+    meshes_ = &loop_.output<studio_ActorMesh>({.counter = "meshes_out", .rate = false});
+    // Every per-frame pose of a tracked camera, even when a cut holds this node up (the topic
+    // keeps only the newest per camera).
+    loop_.input<studio_CameraCalibration>(
+        {.received = "calibrations_in",
+         .rejected = "calibrations_rejected",
+         .reason_prefix = "calibrations_rejected_",
+         .rate = false,
+         .history_depth = int32_t(CameraPoses::kDefaultHistory)},
+        [this](const studio_CameraCalibration& s, const wire::SampleMeta&) {
+          return on_calibration(s);
+        });
+    loop_.input<studio_AlphaMask>(
+        {.received = "masks_in", .rejected = "masks_rejected", .reason_prefix = "masks_rejected_"},
+        [this](const studio_AlphaMask& s, const wire::SampleMeta&) { return on_mask(s); });
+    loop_.after_inputs([this](SteadyClock::time_point now) { emit(now); });
+    loop_.deadline([this] { return assembler_.next_deadline(); },
+                   [this](SteadyClock::time_point now) { emit(now); });
+    for (const char* name : {"frames_complete", "frames_partial", "frames_dropped", "masks_late"})
+      frame_counts_.push_back(&loop_.counter(name));
+    stale_ = &loop_.counter("calibrations_not_of_frame");
+  }
   ~HullNode() override { stop(); }
 
-  Expected<void> start() override {
-    auto io = wire::gather([](auto&&... e) { return Io{std::move(e)...}; },
-                           wire::Subscription<studio_AlphaMask>::create(participant_),
-                           // Every per-frame pose of a tracked camera, even when a cut
-                           // holds this node up (the topic keeps only the newest per camera).
-                           wire::Subscription<studio_CameraCalibration>::create(
-                               participant_, {}, int32_t(kTrackedHistory)),
-                           wire::Publication<studio_SegmentSet>::create(participant_),
-                           wire::Publication<studio_ActorMesh>::create(participant_),
-                           wire::WaitSet::create(participant_),
-                           wire::GuardCondition::create(participant_));
-    if (!io) return std::unexpected(io.error());
-    if (auto r = io->waitset.attach(*io->masks, 1); !r) return std::unexpected(r.error());
-    if (auto r = io->waitset.attach(*io->cals, 2); !r) return std::unexpected(r.error());
-    if (auto r = io->waitset.attach(io->guard, 3); !r) return std::unexpected(r.error());
-    io_.emplace(std::move(*io));
-    running_ = true;
-    worker_ = std::thread([this] { run(); });
-    return {};
-  }
-
-  void stop() override {
-    if (!running_.exchange(false)) return;
-    io_->guard.trigger();
-    if (worker_.joinable()) worker_.join();
-    io_.reset();
-  }
-
+  Expected<void> start() override { return loop_.start(); }
+  void stop() override { loop_.stop(); }
   runtime::NodeHealth health() override {
-    runtime::NodeHealth h;
-    h.frame = last_frame_.load();
-    h.capture_ns = last_capture_ns_.load();
-    h.degraded = last_partial_.load();
-    const auto snap_time = SteadyClock::now();
-    const double dt = std::chrono::duration<double>(snap_time - last_health_).count();
-    const uint64_t masks = masks_in_.value(), hulls = hulls_out_.value();
-    if (dt > 0) {
-      h.input_hz = double(masks - last_masks_) / dt;
-      h.output_hz = double(hulls - last_hulls_) / dt;
-    }
-    last_health_ = snap_time;
-    last_masks_ = masks;
-    last_hulls_ = hulls;
+    runtime::NodeHealth h = loop_.health();
+    h.degraded = last_partial_;
     return h;
   }
 
  private:
-  struct Io {
-    wire::Subscription<studio_AlphaMask> masks;
-    wire::Subscription<studio_CameraCalibration> cals;
-    wire::Publication<studio_SegmentSet> segs;
-    wire::Publication<studio_ActorMesh> meshes;
-    wire::WaitSet waitset;
-    wire::GuardCondition guard;
-  };
-
-  static typename FrameAssembler<RunMask>::Options make_assembler_options(
-      const HullNodeOptions& o, const std::vector<Camera>& cams) {
-    typename FrameAssembler<RunMask>::Options a;
-    for (const Camera& c : cams) a.sources.push_back(c.id);
-    a.deadline = std::chrono::microseconds(int64_t(o.deadline_ms * 1000));
-    a.min_sources = std::size_t(o.min_cameras);
-    return a;
-  }
-
-  void run() {
-    while (running_) {
-      auto timeout = std::chrono::nanoseconds(std::chrono::milliseconds(100));
-      if (auto d = assembler_.next_deadline())
-        timeout = std::max(std::chrono::nanoseconds(0), std::min(timeout, *d - SteadyClock::now()));
-      io_->waitset.wait(timeout);
-      if (!running_) break;
-      io_->cals->visit([&](const studio_CameraCalibration& s, const wire::SampleMeta& meta) {
-        if (!meta.valid_data) return;
-        update_camera(s);
-      });
-      io_->masks->visit([&](const studio_AlphaMask& s, const wire::SampleMeta& meta) {
-        if (!meta.valid_data) return;
-        masks_in_.add();
-        auto mask = wire::to_core(s);
-        if (!mask) {
-          masks_bad_.add();
-          STUDIO_LOG(debug, kLog) << mask.error().message;
-          return;
-        }
-        const int index = assembler_.source_index(s.camera_id);
-        if (index >= 0 &&
-            (mask->width() != cameras_[index].width || mask->height() != cameras_[index].height)) {
-          masks_bad_.add();
-          STUDIO_LOG(warn, kLog) << "mask " << s.camera_id << ": " << mask->width() << "x"
-                                 << mask->height() << " differs from the camera's "
-                                 << cameras_[index].width << "x" << cameras_[index].height;
-          return;
-        }
-        assembler_.add(s.camera_id, s.frame, s.capture_ns, std::move(*mask), SteadyClock::now());
-      });
-      while (auto frame = assembler_.pop(SteadyClock::now())) process(*frame);
-      sync_counts();
-    }
-  }
-
-  // A fixed camera's calibration replaces the camera. A tracked camera (Free-D) sends one per
-  // frame; the last kTrackedHistory are kept so that frame N is cut with the pose of frame N even
-  // when the calibration of N+1 has already arrived (DESIGN §5: everything is stamped by frame).
-  void update_camera(const studio_CameraCalibration& s) {
-    auto cam = wire::to_core(s);
+  // A calibration of one of our cameras: fixed ones are replaced, tracked ones kept by frame.
+  runtime::Outcome on_calibration(const studio_CameraCalibration& s) {
     const int index = assembler_.source_index(s.camera_id);
-    if (!cam || index < 0) return;
-    calibrations_in_.add();
-    auto& history = tracked_[std::size_t(index)];
-    if (s.tracked) {
-      auto at = std::lower_bound(history.begin(), history.end(), s.frame,
-                                 [](const auto& e, uint64_t f) { return e.first < f; });
-      if (at != history.end() && at->first == s.frame)
-        at->second = *cam;
-      else
-        history.insert(at, {s.frame, *cam});
-      while (history.size() > kTrackedHistory) history.pop_front();
-    } else {
-      history.clear();
-    }
-    cameras_[std::size_t(index)] = std::move(*cam);
+    if (index < 0) return {};  // another rig's camera
+    auto cam = wire::to_core(s);
+    if (!cam) return runtime::reject("to_core", cam.error().message);
+    poses_.update(std::size_t(index), s.frame, s.tracked, std::move(*cam));
+    return {};
   }
 
-  // The camera to cut `frame` with: a tracked camera's calibration of that frame, else its
-  // latest one before it (counted: the pose may be a frame off), else the rig's or the last.
-  const Camera& camera_for(std::size_t index, uint64_t frame) {
-    const auto& history = tracked_[index];
-    if (history.empty()) return cameras_[index];
-    auto after = std::upper_bound(history.begin(), history.end(), frame,
-                                  [](uint64_t f, const auto& e) { return f < e.first; });
-    if (after == history.begin()) {
-      calibrations_stale_.add();
-      return history.front().second;
+  runtime::Outcome on_mask(const studio_AlphaMask& s) {
+    auto mask = wire::to_core(s);
+    if (!mask) return runtime::reject("to_core", mask.error().message);
+    const int index = assembler_.source_index(s.camera_id);
+    if (index >= 0) {
+      const Camera& c = poses_.latest(std::size_t(index));
+      if (mask->width() != c.width || mask->height() != c.height)
+        return runtime::reject(
+            "size", "mask " + std::string(s.camera_id) + ": " + std::to_string(mask->width()) +
+                        "x" + std::to_string(mask->height()) + " differs from the camera's " +
+                        std::to_string(c.width) + "x" + std::to_string(c.height));
     }
-    const auto& [at, camera] = *std::prev(after);
-    if (at != frame) calibrations_stale_.add();
-    return camera;
+    assembler_.add(s.camera_id, s.frame, s.capture_ns, std::move(*mask), SteadyClock::now());
+    return {};
   }
 
-  void process(const FrameAssembler<RunMask>::Frame& frame) {
+  // Cuts every frame the assembler lets go (complete, or at its deadline) and mirrors its counts.
+  void emit(SteadyClock::time_point now) {
+    while (auto frame = assembler_.pop(now)) process(*frame);
+    const FrameAssemblerCounts& c = assembler_.counts();
+    const uint64_t counts[] = {c.complete, c.partial, c.dropped, c.late};
+    const uint64_t seen[] = {seen_.complete, seen_.partial, seen_.dropped, seen_.late};
+    for (std::size_t k = 0; k < frame_counts_.size(); ++k)
+      frame_counts_[k]->add(counts[k] - seen[k]);
+    seen_ = c;
+  }
+
+  void process(const Assembler::Frame& frame) {
     std::vector<View> views;
-    for (std::size_t i = 0; i < frame.items.size(); ++i)
-      if (frame.items[i]) views.push_back(View{&camera_for(i, frame.frame), &*frame.items[i]});
+    for (std::size_t i = 0; i < frame.items.size(); ++i) {
+      if (!frame.items[i]) continue;
+      const CameraPoses::Pose pose = poses_.camera_for(i, frame.frame);
+      if (pose.stale) stale_->add();
+      views.push_back(View{pose.camera, &*frame.items[i]});
+    }
     CutOptions cut;
     cut.outside = options_.outside;
     cut.threads = options_.threads;
@@ -221,21 +145,18 @@ class HullNode : public runtime::Node {
     for (std::size_t k = actors.size(); k < published_actors_; ++k)
       dispose(options_.actor_prefix + std::to_string(k));
     published_actors_ = actors.size();
-    metrics_.latency().record(realtime_ns() - frame.capture_ns);
-    last_frame_ = frame.frame;
-    last_capture_ns_ = frame.capture_ns;
-    last_partial_ = views.size() < cameras_.size();
+    loop_.completed(frame.frame, frame.capture_ns);
+    last_partial_ = views.size() < poses_.size();
   }
 
-  void publish(const SegmentSet& set, const std::string& actor_id,
-               const FrameAssembler<RunMask>::Frame& frame, std::span<const View> views,
-               const CutOptions& cut) {
+  void publish(const SegmentSet& set, const std::string& actor_id, const Assembler::Frame& frame,
+               std::span<const View> views, const CutOptions& cut) {
     wire::Owned<studio_SegmentSet> s;
     wire::set(s->actor_id, actor_id);
     s->frame = frame.frame;
     s->capture_ns = frame.capture_ns;
     wire::from_core(set, *s);
-    if (auto r = io_->segs->write(*s); r) hulls_out_.add();
+    (void)segs_->write(*s);
     if (!options_.mesh) return;
     wire::Owned<studio_ActorMesh> m;
     wire::set(m->actor_id, actor_id);
@@ -245,76 +166,36 @@ class HullNode : public runtime::Node {
     Mesh mesh = segment_marching_cubes(set);
     if (options_.refine) {
       // Only fails on a mask of the wrong size, which the frame's cut already rejected.
-      if (auto ok = refine_crossings(mesh, set, views, cut); !ok) {
+      if (auto ok = refine_crossings(mesh, set, views, cut); !ok)
         STUDIO_LOG(warn, kLog) << "frame " << frame.frame << ": " << ok.error().message;
-      }
     }
     mesh_to_wire(mesh, *m);
-    if (auto r = io_->meshes->write(*m); r) meshes_out_.add();
+    (void)meshes_->write(*m);
   }
 
   void dispose(const std::string& actor_id) {
     wire::Owned<studio_SegmentSet> s;
     wire::set(s->actor_id, actor_id);
-    (void)io_->segs->dispose(*s);
+    (void)segs_->dispose(*s);
     wire::Owned<studio_ActorMesh> m;
     wire::set(m->actor_id, actor_id);
-    (void)io_->meshes->dispose(*m);
-  }
-
-  // Mirrors the assembler's counts into the service metrics.
-  void sync_counts() {
-    const FrameAssemblerCounts& c = assembler_.counts();
-    frames_complete_.add(c.complete - seen_.complete);
-    frames_partial_.add(c.partial - seen_.partial);
-    frames_dropped_.add(c.dropped - seen_.dropped);
-    masks_late_.add(c.late - seen_.late);
-    seen_ = c;
+    (void)meshes_->dispose(*m);
   }
 
   HullNodeOptions options_;
-  std::vector<Camera> cameras_;
-  const wire::Participant& participant_;
-  runtime::Metrics& metrics_;
-  runtime::Counter &masks_in_, &masks_bad_, &frames_complete_, &frames_partial_, &frames_dropped_,
-      &masks_late_, &hulls_out_, &meshes_out_, &calibrations_in_, &calibrations_stale_;
-  static constexpr std::size_t kTrackedHistory = 64;
-  std::vector<std::deque<std::pair<uint64_t, Camera>>> tracked_;  // per camera, by frame
-  FrameAssembler<RunMask> assembler_;
+  Assembler assembler_;
+  CameraPoses poses_;
   FrameAssemblerCounts seen_;
-  std::optional<Io> io_;
-  std::atomic<bool> running_{false};
-  std::thread worker_;
   std::size_t published_actors_ = 0;
-  std::atomic<uint64_t> last_frame_{0};
-  std::atomic<int64_t> last_capture_ns_{0};
   std::atomic<bool> last_partial_{false};
-  SteadyClock::time_point last_health_ = SteadyClock::now();
-  uint64_t last_masks_ = 0, last_hulls_ = 0;
+  runtime::Output<studio_SegmentSet>* segs_ = nullptr;
+  runtime::Output<studio_ActorMesh>* meshes_ = nullptr;
+  std::vector<runtime::Counter*> frame_counts_;
+  runtime::Counter* stale_ = nullptr;
+  runtime::ServiceLoop loop_;  // last: stopped before the state above goes
 };
 
 }  // namespace
-
-Expected<void> HullNodeOptions::validate() const {
-  if (box.size() != 6) return fail("box: expected 6 numbers x0,y0,z0,x1,y1,z1");
-  if (auto g = grid_spec().validate(); !g) return g;
-  if (min_cameras < 1) return fail("min_cameras: must be >= 1");
-  if (actor_prefix.empty() || actor_prefix.size() > 40)
-    return fail("actor_prefix: 1..40 characters");
-  return {};
-}
-
-GridSpec HullNodeOptions::grid_spec() const {
-  GridSpec g;
-  if (box.size() == 6) {
-    g.box_min = Eigen::Vector3d(box[0], box[1], box[2]);
-    g.box_max = Eigen::Vector3d(box[3], box[4], box[5]);
-  }
-  g.axis = axis;
-  g.cells_u = grid;
-  g.cells_v = grid;
-  return g;
-}
 
 Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& options,
                                                         std::vector<Camera> cameras,
@@ -325,54 +206,6 @@ Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& o
     return fail("min_cameras " + std::to_string(options.min_cameras) + " exceeds the rig's " +
                 std::to_string(cameras.size()) + " cameras");
   return std::unique_ptr<runtime::Node>(new HullNode(options, std::move(cameras), context));
-}
-
-runtime::ServiceDefinition hull_service_definition() {
-  runtime::ServiceDefinition d;
-  d.name = "hull";
-  d.summary =
-      "Real-time line-segment visual hull: masks of every camera -> per-actor segments and mesh.";
-  d.config_help =
-      "  hull:                     (required section)\n"
-      "    rig: FILE               rig.yaml with the cameras (relative to the config file)\n"
-      "    box: [x0,y0,z0,x1,y1,z1] reconstruction volume, studio frame, metres\n"
-      "    grid: 128               columns per side (8..2048)\n"
-      "    axis: y                 continuous axis of the segments: x|y|z\n"
-      "    deadline_ms: 40         wait for a frame's missing masks at most this long\n"
-      "    min_cameras: 2          drop a frame with fewer masks at its deadline\n"
-      "    outside: keep           column parts outside an image: keep|cut\n"
-      "    threads: 2              cut threads\n"
-      "    mesh: true              publish studio/actor/mesh\n"
-      "    refine: true            exact crossings on the mesh (else half-cell vertices)\n"
-      "    min_actor_volume: 0.01  smaller components (m^3) are noise\n"
-      "    actor_prefix: actor     actor ids <prefix>0, <prefix>1, ... largest first\n";
-  d.create = [](yaml::MapReader& config,
-                runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
-    auto section = config.required("hull");
-    if (!section) return std::unexpected(section.error());
-    static const yaml::Schema<HullNodeOptions> schema{
-        yaml::field("rig", &HullNodeOptions::rig).required().relative_path(),
-        yaml::field("box", &HullNodeOptions::box).required().size(6),
-        yaml::field("grid", &HullNodeOptions::grid).range(8, 2048),
-        yaml::enum_field("axis", &HullNodeOptions::axis,
-                         {{"x", Axis::x}, {"y", Axis::y}, {"z", Axis::z}}),
-        yaml::field("deadline_ms", &HullNodeOptions::deadline_ms).range(1, 1000),
-        yaml::field("min_cameras", &HullNodeOptions::min_cameras).range(1, 64),
-        yaml::enum_field("outside", &HullNodeOptions::outside,
-                         {{"keep", Outside::keep}, {"cut", Outside::cut}}),
-        yaml::field("threads", &HullNodeOptions::threads).range(1, 64),
-        yaml::field("mesh", &HullNodeOptions::mesh),
-        yaml::field("refine", &HullNodeOptions::refine),
-        yaml::field("min_actor_volume", &HullNodeOptions::min_actor_volume).min(0),
-        yaml::field("actor_prefix", &HullNodeOptions::actor_prefix),
-    };
-    auto options = schema.read(*section);
-    if (!options) return std::unexpected(options.error());
-    auto rig = yaml::read_rig(options->rig);
-    if (!rig) return std::unexpected(rig.error());
-    return make_hull_node(*options, rig->cameras, ctx);
-  };
-  return d;
 }
 
 }  // namespace studio::hull

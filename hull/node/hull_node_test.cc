@@ -10,13 +10,13 @@
 #include <fstream>
 #include <map>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
 #include "harness/fixture.h"
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
 #include "segments_wire.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #include "wire/convert.h"
 #include "wire/endpoint.h"
 #include "wire/sample.h"

@@ -19,10 +19,10 @@
 #include <vector>
 
 #include "core/mask_codec.h"
-#include "image_io.h"
+#include "keyer/config/image_io.h"
 #include "keyer/keyer.h"
 #include "keyer_node.h"
-#include "keyer_yaml.h"
+#include "keyer/config/keyer_yaml.h"
 #include "runtime/service.h"
 
 namespace fs = std::filesystem;

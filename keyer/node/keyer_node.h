@@ -6,13 +6,13 @@
 // frame and capture_ns. The capture node then runs with `masks: false` and
 // `image: {rate: 1000, raw: true}` (every frame, raw).
 //
-// Bounded work: a reader thread copies each accepted image into its camera's single "newest
+// Runs on runtime::ServiceLoop (runtime/service_loop.h). Bounded work: the loop thread copies each accepted image into its camera's single "newest
 // frame" slot; keying threads take whichever camera has a frame waiting. A frame replaced in its
 // slot before a keying thread got to it is counted as dropped, so a node that falls behind
 // drops frames (and says so) instead of queueing them.
 //
 // Rejections are counted, never fatal (counters in studio/service/status):
-//   images_rejected        total of the reasons below
+//   images_rejected        total of the reasons below (rejected_<reason>)
 //   rejected_malformed     samples the wire validator refused (sizes inconsistent, bad id, ...)
 //   rejected_format        MONO8 and JPEG images (the chroma and difference keys need colour
 //                          pixels; the capture node sends raw RGB8 with `image.raw: true`)
@@ -48,7 +48,6 @@
 #include <string>
 #include <vector>
 
-#include "core/image.h"
 #include "keyer/keyer_options.h"
 #include "runtime/service.h"
 
@@ -56,10 +55,10 @@ namespace studio::keyer {
 
 struct KeyerNodeOptions {
   KeyerOptions keyer;
-  std::vector<std::string> cameras;  // empty: every camera seen (up to max_cameras)
+  std::vector<std::string> cameras;         // empty: every camera seen (up to max_cameras)
   int max_cameras = 16;
   int threads = 1;
-  std::map<std::string, Image<Rgb8>> plates;  // clean plates by camera id
+  std::map<std::string, std::string> plates;  // clean plate files by camera id (resolved paths)
   std::string plate_dir;                      // empty: plates on command are not kept
 
   Expected<void> validate() const;
@@ -67,7 +66,10 @@ struct KeyerNodeOptions {
 
 runtime::ServiceDefinition keyer_service_definition();
 
-// Builds the node (plates already read) — exposed for tests that host the node in-process.
+// Reads the node's keys of the service config (the common keys are service_main's).
+Expected<KeyerNodeOptions> read_keyer_node_options(yaml::MapReader& config);
+
+// Builds the node (reads the plate files) — exposed for tests that host the node in-process.
 Expected<std::unique_ptr<runtime::Node>> make_keyer_node(KeyerNodeOptions options,
                                                          runtime::NodeContext& context);
 

@@ -21,12 +21,12 @@
 #include <mutex>
 #include <thread>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
 #include "core/clock.h"
 #include "core/mask_codec.h"
 #include "harness/process.h"
 #include "keyer/keyer.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #include "wire/endpoint.h"
 #include "wire/sample.h"
 

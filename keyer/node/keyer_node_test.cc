@@ -19,9 +19,9 @@
 
 #include "core/clock.h"
 #include "harness/fixture.h"
-#include "image_io.h"
+#include "keyer/config/image_io.h"
 #include "keyer/keyer.h"
-#include "keyer_yaml.h"
+#include "keyer/config/keyer_yaml.h"
 #include "wire/convert.h"
 #include "wire/endpoint.h"
 #include "wire/sample.h"

@@ -40,6 +40,15 @@ const yaml::Schema<HeadTrackerOptions>& filter_schema() {
   return schema;
 }
 
+// A number in [lo, hi]; out of range: "expected <what>".
+auto number_in(double lo, double hi, std::string what) {
+  return [lo, hi, what](const yaml::Node& n) -> Expected<double> {
+    auto v = n.as_double();
+    if (v && !(*v >= lo && *v <= hi)) return n.fail("expected " + what);
+    return v;
+  };
+}
+
 }  // namespace
 
 const char* const kConfigHelp =
@@ -79,42 +88,22 @@ Expected<void> NodeOptions::validate() const {
 }
 
 Expected<NodeOptions> read_node_options(yaml::MapReader& config) {
-  NodeOptions o;
-  if (auto n = config.optional("actor_id")) {
-    auto v = n->as_string();
-    if (!v) return std::unexpected(v.error());
-    if (v->empty() || v->size() > 50) return n->fail("expected a name of 1..50 characters");
-    o.actor_id = *v;
-  }
-  if (auto n = config.optional("publish_tracks")) {
-    auto v = n->as_bool();
-    if (!v) return std::unexpected(v.error());
-    o.publish_tracks = *v;
-  }
-  if (auto n = config.optional("publish_rate")) {
-    auto v = n->as_double();
-    if (!v) return std::unexpected(v.error());
-    if (!(*v >= 0.5 && *v <= 1000)) return n->fail("expected Hz in 0.5..1000");
-    o.publish_rate = *v;
-  }
-  if (auto n = config.optional("gather_ms")) {
-    auto v = n->as_double();
-    if (!v) return std::unexpected(v.error());
-    if (!(*v >= 0 && *v <= 100)) return n->fail("expected 0..100 ms");
-    o.gather_ms = *v;
-  }
-  if (auto n = config.optional("search")) {
-    auto v = search_schema().read(*n);
-    if (!v) return std::unexpected(v.error());
-    o.search = *v;
-  }
-  if (auto n = config.optional("filter")) {
-    auto v = filter_schema().read(*n);
-    if (!v) return std::unexpected(v.error());
-    o.filter = *v;
-  }
-  if (auto ok = o.validate(); !ok) return config.node().fail(ok.error().message);
-  return o;
+  static const yaml::Schema<NodeOptions> schema{
+      yaml::field("actor_id", &NodeOptions::actor_id,
+                  [](const yaml::Node& n) -> Expected<std::string> {
+                    auto v = n.as_string();
+                    if (v && (v->empty() || v->size() > 50))
+                      return n.fail("expected a name of 1..50 characters");
+                    return v;
+                  }),
+      yaml::field("publish_tracks", &NodeOptions::publish_tracks),
+      yaml::field("publish_rate", &NodeOptions::publish_rate,
+                  number_in(0.5, 1000, "Hz in 0.5..1000")),
+      yaml::field("gather_ms", &NodeOptions::gather_ms, number_in(0, 100, "0..100 ms")),
+      yaml::field("search", &NodeOptions::search, search_schema()),
+      yaml::field("filter", &NodeOptions::filter, filter_schema()),
+  };
+  return schema.read_fields(config);
 }
 
 }  // namespace studio::tracker::node

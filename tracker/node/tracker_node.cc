@@ -1,49 +1,56 @@
-#include "core/clock.h"
 #include "tracker_node.h"
 
-#include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/log.h"
+#include "runtime/service_loop.h"
 #include "segments_wire.h"
+#include "tracker/keep_alive.h"
 #include "tracker/segment_raster.h"
-#include "wire/endpoint.h"
-#include "wire/pubsub.h"
 
 namespace studio::tracker::node {
 namespace {
 
-constexpr std::string_view kCategory = "tracker";
+constexpr const char* kLog = "tracker";
 using Clock = std::chrono::steady_clock;
 
+class TrackerNode : public runtime::Node {
+ public:
+  TrackerNode(NodeOptions options, HeadSearch search, HeadTracker tracker,
+              runtime::NodeContext& context)
+      : options_(std::move(options)),
+        search_(std::move(search)),
+        tracker_(std::move(tracker)),
+        keep_alive_(options_.filter, options_.publish_rate, tracker_.primary(), Clock::now()),
+        loop_(context, kLog) {
+    heads_ = &loop_.output<studio_HeadPose>({.counter = "heads_out"});
+    empty_hulls_ = &loop_.counter("empty_hulls");
+    keepalives_ = &loop_.counter("keepalives");
+    late_sets_ = &loop_.counter("late_segment_sets");
+    loop_.input<studio_SegmentSet>(
+        {.received = "segment_sets_in"},
+        [this](const studio_SegmentSet& s, const wire::SampleMeta&) { return on_segments(s); });
+    // The gather window of the frame being gathered, then the keep-alive.
+    loop_.deadline(
+        [this] { return gathering_ ? std::optional(gathering_->deadline) : std::nullopt; },
+        [this](Clock::time_point) { flush(); });
+    loop_.deadline([this] { return std::optional(keep_alive_.due()); },
+                   [this](Clock::time_point now) { keep_alive(now); });
+  }
+  ~TrackerNode() override { stop(); }
 
-}  // namespace
+  Expected<void> start() override { return loop_.start(); }
+  void stop() override { loop_.stop(); }
+  runtime::NodeHealth health() override {
+    runtime::NodeHealth h = loop_.health();
+    h.degraded = lost_;  // running, but no head tracked
+    return h;
+  }
 
-// Everything the worker thread owns; created by start(), destroyed by stop().
-struct TrackerNode::Worker {
-  enum : dds_attach_t { kData = 1, kStop = 2 };
-
-  const NodeOptions& options;
-  runtime::Metrics& metrics;
-  wire::Subscription<studio_SegmentSet> segments;
-  wire::Publication<studio_HeadPose> heads;
-  wire::GuardCondition stop_guard;
-  wire::WaitSet waitset;
-  HeadSearch search;
-  HeadTracker tracker;
-
-  runtime::Counter& sets_in;
-  runtime::Counter& heads_out;
-  runtime::Counter& empty_hulls;
-  runtime::Counter& keepalives;
-  runtime::Counter& rejected;
-  runtime::Counter& late_sets;
-  uint64_t reader_rejects_seen = 0;
-
+ private:
   // The frame being gathered: the hull publishes each actor (connected component) of a frame as
   // its own SegmentSet, and the tracker must see every head of a frame in one update, or each
   // update would miss the other actors' heads.
@@ -53,202 +60,95 @@ struct TrackerNode::Worker {
     std::vector<HeadDetection> heads;
     Clock::time_point deadline;
   };
-  std::optional<Gathered> gathering{};
-
-  std::atomic<bool> running{true};
-  std::atomic<uint64_t> last_frame{0};
-  std::atomic<int64_t> last_capture_ns{0};
-  std::atomic<bool> lost{true};
-
-  OccupancyGrid grid{};
-  HeadPose last_pose{};     // last published primary pose (coasted by keep-alives)
-  uint64_t pose_frame = 0;  // source frame of last_pose
-  int64_t source_ns = 0;    // capture_ns of the last real frame
-  Clock::time_point source_arrival = Clock::now();
-  Clock::time_point last_publish = Clock::now();
-  int coasted_ticks = 0;
-  bool have_source = false;
-  wire::Owned<studio_HeadPose> out{};
-
-  void publish(const HeadPose& pose, const std::string& id, uint64_t frame) {
-    wire::set(out->actor_id, id);
-    out->frame = frame;
-    wire::from_core(pose, *out);
-    if (auto r = heads->write(*out); !r) {
-      STUDIO_LOG(warn, kCategory) << r.error().message;
-      return;
-    }
-    heads_out.add();
-  }
-
-  void publish_primary(const HeadPose& pose, uint64_t frame) {
-    last_pose = pose;
-    pose_frame = frame;
-    lost = pose.confidence <= 0;
-    publish(pose, options.actor_id, frame);
-    last_publish = Clock::now();
-  }
 
   // One SegmentSet: its heads join the frame being gathered (another frame first flushes that).
-  void on_segments(const studio_SegmentSet& s) {
-    sets_in.add();
+  runtime::Outcome on_segments(const studio_SegmentSet& s) {
     auto set = wire::to_core(s);
-    if (!set) {
-      rejected.add();
-      STUDIO_LOG(warn, kCategory) << set.error().message;
-      return;
-    }
-    if (gathering && (gathering->frame != s.frame || gathering->capture_ns != s.capture_ns)) {
+    if (!set) return runtime::reject("to_core", set.error().message);
+    if (gathering_ && (gathering_->frame != s.frame || gathering_->capture_ns != s.capture_ns))
       flush();
-    }
-    if (!gathering) {
+    if (!gathering_) {
       // A set of the frame last updated came after its window closed: a separate update.
-      if (have_source && s.frame == last_frame && s.capture_ns == source_ns) late_sets.add();
-      gathering = Gathered{s.frame, s.capture_ns, {},
-                           Clock::now() + std::chrono::microseconds(
-                                              int64_t(options.gather_ms * 1000))};
+      if (have_source_ && s.frame == source_frame_ && s.capture_ns == source_ns_) late_sets_->add();
+      const auto window = std::chrono::microseconds(int64_t(options_.gather_ms * 1000));
+      gathering_ = Gathered{s.frame, s.capture_ns, {}, Clock::now() + window};
     }
     if (set->interval_count() == 0) {
-      empty_hulls.add();
+      empty_hulls_->add();
     } else {
-      rasterise(*set, &grid);
-      for (const HeadDetection& h : search.find(grid)) gathering->heads.push_back(h);
+      rasterise(*set, &grid_);
+      for (const HeadDetection& h : search_.find(grid_)) gathering_->heads.push_back(h);
     }
+    return {};
   }
 
   // The gathered frame's heads as one tracker update, and its poses out.
   void flush() {
-    if (!gathering) return;
-    Gathered g = std::move(*gathering);
-    gathering.reset();
+    if (!gathering_) return;
+    Gathered g = std::move(*gathering_);
+    gathering_.reset();
     // A source clock that jumps back (a replay looping) would freeze the filter: start over.
-    if (have_source && g.capture_ns + int64_t(1'000'000'000) < source_ns) {
-      STUDIO_LOG(info, kCategory) << "capture time went back " << (source_ns - g.capture_ns) * 1e-9
-                                  << " s: tracks reset";
-      tracker = HeadTracker::create(options.filter).value();
+    if (have_source_ && g.capture_ns + int64_t(1'000'000'000) < source_ns_) {
+      STUDIO_LOG(info, kLog) << "capture time went back " << (source_ns_ - g.capture_ns) * 1e-9
+                             << " s: tracks reset";
+      tracker_ = HeadTracker::create(options_.filter).value();
     }
-    tracker.update(g.heads, g.capture_ns);
-    have_source = true;
-    source_ns = g.capture_ns;
-    source_arrival = Clock::now();
-    coasted_ticks = 0;
-    last_frame = g.frame;
-    last_capture_ns = g.capture_ns;
+    tracker_.update(g.heads, g.capture_ns);
+    have_source_ = true;
+    source_ns_ = g.capture_ns;
+    source_frame_ = g.frame;
 
-    HeadPose primary = tracker.primary();
+    HeadPose primary = tracker_.primary();
     primary.capture_ns = g.capture_ns;
-    publish_primary(primary, g.frame);
-    if (options.publish_tracks)
-      for (const HeadPose& p : tracker.poses())
-        publish(p, options.actor_id + "/" + std::to_string(p.actor_id), g.frame);
-    metrics.latency().record(realtime_ns() - g.capture_ns);
+    publish(primary, options_.actor_id, g.frame);
+    keep_alive_.frame(primary, g.frame, Clock::now());
+    lost_ = keep_alive_.lost();
+    if (options_.publish_tracks)
+      for (const HeadPose& p : tracker_.poses())
+        publish(p, options_.actor_id + "/" + std::to_string(p.actor_id), g.frame);
+    loop_.completed(g.frame, g.capture_ns);
   }
 
-  void keep_alive() {
-    const double dt = 1.0 / options.publish_rate;
-    HeadPose p = last_pose;
-    ++coasted_ticks;
-    if (coasted_ticks > options.filter.max_missed || p.confidence <= 0) {
-      p.velocity.setZero();
-      p.confidence = 0;
-    } else {
-      p.position += p.velocity * dt;
-      p.velocity *= options.filter.coast_decay;
-      p.confidence *= options.filter.coast_decay;
-    }
-    if (have_source)
-      p.capture_ns = source_ns + std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                     Clock::now() - source_arrival)
-                                     .count();
-    keepalives.add();
-    publish_primary(p, pose_frame);
+  void keep_alive(Clock::time_point now) {
+    const HeadPose p = keep_alive_.tick(now);
+    keepalives_->add();
+    lost_ = keep_alive_.lost();
+    publish(p, options_.actor_id, keep_alive_.frame_number());
   }
 
-  void run() {
-    const auto period = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(1.0 / options.publish_rate));
-    while (running) {
-      Clock::time_point wake = last_publish + period;
-      if (gathering) wake = std::min(wake, gathering->deadline);
-      const auto wait = std::max(Clock::duration::zero(), wake - Clock::now());
-      const auto triggered = waitset.wait(wait);
-      if (std::find(triggered.begin(), triggered.end(), dds_attach_t(kStop)) != triggered.end())
-        break;
-      segments->visit([&](const studio_SegmentSet& s, const wire::SampleMeta& meta) {
-        if (meta.valid_data) on_segments(s);
-      });
-      if (gathering && Clock::now() >= gathering->deadline) flush();
-      const uint64_t total = segments->rejected().total();
-      if (total > reader_rejects_seen) {
-        rejected.add(total - reader_rejects_seen);
-        reader_rejects_seen = total;
-      }
-      if (Clock::now() >= last_publish + period) keep_alive();
-    }
+  void publish(const HeadPose& pose, const std::string& id, uint64_t frame) {
+    wire::set(out_->actor_id, id);
+    out_->frame = frame;
+    wire::from_core(pose, *out_);
+    (void)heads_->write(*out_);
   }
+
+  NodeOptions options_;
+  HeadSearch search_;
+  HeadTracker tracker_;
+  KeepAlive keep_alive_;
+  std::optional<Gathered> gathering_;
+  OccupancyGrid grid_{};
+  bool have_source_ = false;
+  uint64_t source_frame_ = 0;  // frame and capture_ns of the last real update
+  int64_t source_ns_ = 0;
+  std::atomic<bool> lost_{true};
+  wire::Owned<studio_HeadPose> out_{};
+  runtime::Output<studio_HeadPose>* heads_ = nullptr;
+  runtime::Counter *empty_hulls_ = nullptr, *keepalives_ = nullptr, *late_sets_ = nullptr;
+  runtime::ServiceLoop loop_;  // last: stopped before the state above goes
 };
 
-TrackerNode::TrackerNode(NodeOptions options, runtime::NodeContext& context)
-    : options_(std::move(options)), participant_(context.participant), metrics_(context.metrics) {
-  // Registered up front so the status shows them at zero.
-  for (const char* name : {"segment_sets_in", "heads_out", "empty_hulls", "keepalives", "rejected",
-                           "late_segment_sets"})
-    metrics_.counter(name);
-}
+}  // namespace
 
-TrackerNode::~TrackerNode() { stop(); }
-
-Expected<void> TrackerNode::start() {
-  if (worker_) return {};
-  auto segments = wire::Subscription<studio_SegmentSet>::create(participant_);
-  if (!segments) return std::unexpected(segments.error());
-  auto heads = wire::Publication<studio_HeadPose>::create(participant_);
-  if (!heads) return std::unexpected(heads.error());
-  auto guard = wire::GuardCondition::create(participant_);
-  if (!guard) return std::unexpected(guard.error());
-  auto waitset = wire::WaitSet::create(participant_);
-  if (!waitset) return std::unexpected(waitset.error());
-  if (auto r = waitset->attach(segments->reader, Worker::kData); !r) return std::unexpected(r.error());
-  if (auto r = waitset->attach(*guard, Worker::kStop); !r) return std::unexpected(r.error());
-  auto search = HeadSearch::create(options_.search);
+Expected<std::unique_ptr<runtime::Node>> make_tracker_node(NodeOptions options,
+                                                           runtime::NodeContext& context) {
+  auto search = HeadSearch::create(options.search);
   if (!search) return std::unexpected(search.error());
-  auto tracker = HeadTracker::create(options_.filter);
+  auto tracker = HeadTracker::create(options.filter);
   if (!tracker) return std::unexpected(tracker.error());
-
-  worker_.reset(new Worker{.options = options_,
-                           .metrics = metrics_,
-                           .segments = std::move(*segments),
-                           .heads = std::move(*heads),
-                           .stop_guard = std::move(*guard),
-                           .waitset = std::move(*waitset),
-                           .search = std::move(*search),
-                           .tracker = std::move(*tracker),
-                           .sets_in = metrics_.counter("segment_sets_in"),
-                           .heads_out = metrics_.counter("heads_out"),
-                           .empty_hulls = metrics_.counter("empty_hulls"),
-                           .keepalives = metrics_.counter("keepalives"),
-                           .rejected = metrics_.counter("rejected"),
-                           .late_sets = metrics_.counter("late_segment_sets")});
-  worker_->last_pose = worker_->tracker.primary();  // rest position, confidence 0
-  thread_ = std::thread([w = worker_.get()] { w->run(); });
-  return {};
-}
-
-void TrackerNode::stop() {
-  if (!worker_) return;
-  worker_->running = false;
-  worker_->stop_guard.trigger();
-  if (thread_.joinable()) thread_.join();
-  worker_.reset();
-}
-
-runtime::NodeHealth TrackerNode::health() {
-  runtime::NodeHealth h;
-  if (!worker_) return h;
-  h.frame = worker_->last_frame;
-  h.capture_ns = worker_->last_capture_ns;
-  h.degraded = worker_->lost;  // running, but no head tracked
-  return h;
+  return std::make_unique<TrackerNode>(std::move(options), std::move(*search), std::move(*tracker),
+                                       context);
 }
 
 runtime::ServiceDefinition service_definition() {
@@ -263,7 +163,7 @@ runtime::ServiceDefinition service_definition() {
                 runtime::NodeContext& context) -> Expected<std::unique_ptr<runtime::Node>> {
     auto options = read_node_options(config);
     if (!options) return std::unexpected(options.error());
-    return std::make_unique<TrackerNode>(std::move(*options), context);
+    return make_tracker_node(std::move(*options), context);
   };
   return d;
 }

@@ -22,36 +22,22 @@
 // is predicted for, on the source's clock). Keep-alives never enter the tracker, so the next real
 // frame is filtered against the last real one.
 //
-// Metrics: counters segment_sets_in, heads_out, empty_hulls, keepalives, rejected (to_core
-// failures plus the reader's validator rejections), late_segment_sets; latency = publish time −
-// capture_ns of real frames (includes the gather window).
+// Runs on runtime::ServiceLoop (runtime/service_loop.h). Metrics: counters segment_sets_in,
+// heads_out, empty_hulls, keepalives, late_segment_sets and rejected (the total of
+// rejected_malformed, the reader's validator rejections, and rejected_to_core, SegmentSets the
+// hull library refuses); latency = publish time − capture_ns of real frames (includes the gather
+// window). Status DEGRADED while no head is tracked.
 
-#include <atomic>
 #include <memory>
-#include <mutex>
-#include <thread>
 
 #include "runtime/service.h"
 #include "tracker_config.h"
 
 namespace studio::tracker::node {
 
-class TrackerNode : public runtime::Node {
- public:
-  TrackerNode(NodeOptions options, runtime::NodeContext& context);
-  ~TrackerNode() override;
-  Expected<void> start() override;
-  void stop() override;
-  runtime::NodeHealth health() override;
-
- private:
-  struct Worker;
-  NodeOptions options_;
-  const wire::Participant& participant_;
-  runtime::Metrics& metrics_;
-  std::unique_ptr<Worker> worker_;
-  std::thread thread_;
-};
+// Builds the node (options validated) — exposed for tests that host the node in-process.
+Expected<std::unique_ptr<runtime::Node>> make_tracker_node(NodeOptions options,
+                                                           runtime::NodeContext& context);
 
 // service_main's definition of the tracker service (name "tracker").
 runtime::ServiceDefinition service_definition();

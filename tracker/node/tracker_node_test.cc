@@ -14,12 +14,12 @@
 #include <map>
 #include <optional>
 
-#include "capture/sim/cameras.h"
-#include "capture/sim/studio.h"
 #include "core/run_mask.h"
 #include "harness/fixture.h"
 #include "hull/silhouette_cut.h"
 #include "segments_wire.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
 #include "wire/endpoint.h"
 
 namespace studio::tracker {

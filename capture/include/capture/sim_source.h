@@ -1,6 +1,6 @@
 #pragma once
 // A simulated camera behind the FrameSource interface (libcamera's fake camera): one camera of the
-// simulated studio (capture/sim/studio.h), paced by the studio clock (capture/frame_clock.h) in
+// simulated studio (sim/studio.h), paced by the studio clock (capture/frame_clock.h) in
 // real time like a genlocked camera, with simulated GenICam features.
 //
 // Timing (paced): frame f is exposed at the genlock instant clock.time_of(f) + period/2 and
@@ -28,7 +28,7 @@
 
 #include "capture/frame_clock.h"
 #include "capture/frame_source.h"
-#include "capture/sim/studio.h"
+#include "sim/studio.h"
 
 namespace studio::capture {
 

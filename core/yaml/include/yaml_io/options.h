@@ -42,6 +42,10 @@ struct Constraints {
   bool relative_path = false;
 };
 
+// A path as written in the YAML file of `node`: relative ones resolve against that file's folder,
+// absolute (and empty) ones are left alone. The built-in readers apply it for relative_path().
+std::string resolve_path(const Node& node, const std::string& path);
+
 // Built-in readers (node.cc / options.cc), one per supported member type.
 Expected<void> read_value(const Node& node, bool& out, const Constraints& c);
 Expected<void> read_value(const Node& node, int& out, const Constraints& c);
@@ -167,29 +171,44 @@ class Schema {
  public:
   Schema(std::initializer_list<Field<T>> fields) : fields_(fields) {}
 
+  bool has_field(std::string_view name) const {
+    for (const Field<T>& f : fields_)
+      if (f.name() == name) return true;
+    return false;
+  }
+
   // Reads a mapping on top of `defaults`.
   Expected<T> read(const Node& node, T defaults = T{}) const {
     Expected<MapReader> map = MapReader::from(node);
     if (!map) return std::unexpected(map.error());
+    return read_fields(*map, std::move(defaults), true);
+  }
+
+  // Reads this schema's keys out of `map`, a mapping that holds other keys too (a service
+  // config, whose common keys runtime::service_main reads): the keys are consumed and the caller
+  // finishes the map (`finish` = true finishes it here). validate() runs as in read().
+  Expected<T> read_fields(MapReader& map, T defaults = T{}, bool finish = false) const {
     T out = std::move(defaults);
     for (const Field<T>& f : fields_) {
       std::optional<Node> value;
       if (f.is_required()) {
-        Expected<Node> v = map->required(f.name());
+        Expected<Node> v = map.required(f.name());
         if (!v) return std::unexpected(v.error());
         value = *v;
       } else {
-        value = map->optional(f.name());
+        value = map.optional(f.name());
       }
       if (value) {
         if (Expected<void> ok = f.read(*value, out); !ok) return std::unexpected(ok.error());
       }
     }
-    if (Expected<void> ok = map->finish(); !ok) return std::unexpected(ok.error());
+    if (finish) {
+      if (Expected<void> ok = map.finish(); !ok) return std::unexpected(ok.error());
+    }
     if constexpr (requires(const T& t) {
                     { t.validate() } -> std::same_as<Expected<void>>;
                   }) {
-      if (Expected<void> ok = out.validate(); !ok) return node.fail(ok.error().message);
+      if (Expected<void> ok = out.validate(); !ok) return map.node().fail(ok.error().message);
     }
     return out;
   }

@@ -1,0 +1,259 @@
+#include "camera_worker.h"
+
+#include <algorithm>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <thread>
+
+#include "core/clock.h"
+#include "core/log.h"
+
+namespace studio::capture::node {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr const char* kLog = "capture";
+constexpr std::string_view kCameraFeatures[] = {"Gain", "ExposureTime", "Focus", "Zoom", "Iris"};
+
+}  // namespace
+
+CameraWorker::CameraWorker(CameraSetup setup, const CaptureIo& io)
+    : io_(io),
+      id_(std::move(setup.id)),
+      source_(std::move(setup.source)),
+      calibration_(std::move(setup.calibration)),
+      image_rate_(io.options.image_rate),
+      image_raw_(io.options.image_raw) {}
+
+Expected<void> CameraWorker::start() {
+  auto k = keyer::Keyer::create(io_.options.keyer);
+  if (!k) return fail("camera " + id_ + ": keyer: " + k.error().message);
+  keyer_.emplace(std::move(*k));
+  // A plate captured on command before a restart. Unreadable: the camera waits for a new one.
+  io_.kept_plates.restore(id_, keyer_->keyer(), kLog);
+  if (auto s = source_->start(); !s) return fail("camera " + id_ + ": " + s.error().message);
+  return {};
+}
+
+void CameraWorker::run() {
+  while (io_.loop.running()) {
+    auto next = source_->next(std::chrono::milliseconds(200));
+    if (!next) {
+      on_source_error(next.error());
+      continue;
+    }
+    const auto now = Clock::now();
+    if (*next) on_frame(**next, now);
+    if (state_due(now)) publish_state();
+  }
+}
+
+void CameraWorker::on_source_error(const Error& error) {
+  if (!source_failed_) STUDIO_LOG(error, kLog) << id_ << ": " << error.message;
+  source_failed_ = true;
+  {
+    std::lock_guard lock(mutex_);
+    source_error_ = true;
+    error_ = error.message;
+  }
+  publish_state();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+}
+
+void CameraWorker::on_frame(Frame& frame, Clock::time_point now) {
+  source_failed_ = false;
+  io_.frames_captured.add();
+  bool send = false, raw = false;
+  {
+    std::lock_guard lock(mutex_);
+    if (source_error_) {  // the source recovered
+      source_error_ = false;
+      error_.clear();
+    }
+    last_frame_ = frame.frame;
+    last_capture_ns_ = frame.capture_ns;
+    ++frames_in_window_;
+    record(frame);
+    send = image_due(now, raw);
+  }
+  // Key → mask codec → AlphaMask (unless keying runs elsewhere: masks: false).
+  if (io_.options.publish_masks) key(frame);
+  if (send) send_image(frame, raw);
+}
+
+bool CameraWorker::image_due(Clock::time_point now, bool& raw) {
+  const double rate = image_raw_ && image_rate_ <= 0 ? 1.0 : image_rate_;
+  if (rate <= 0 || (last_image_ != Clock::time_point::min() &&
+                    now - last_image_ < std::chrono::duration<double>(1.0 / rate)))
+    return false;
+  raw = image_raw_;
+  last_image_ = now;
+  return true;
+}
+
+void CameraWorker::key(const Frame& frame) {
+  const keyer::PlateKeyer::Result r = keyer_->frame(frame.image.view(), mask_);
+  if (r.cleared) io_.kept_plates.remove(id_);
+  using Step = keyer::PlateKeyer::Step;
+  switch (r.step) {
+    case Step::kPlateFrame:  // clean plate on command: no mask meanwhile
+      return;
+    case Step::kPlateCaptured:
+      io_.plates_captured.add();
+      STUDIO_LOG(info, kLog) << id_ << ": clean plate captured (" << keyer_->keyer().plate_frames()
+                             << " frames)";
+      if (!io_.kept_plates.keep(id_, keyer_->keyer(), kLog)) io_.plate_saves_failed.add();
+      return;
+    case Step::kNoPlate:
+      io_.frames_unkeyed.add();
+      if (r.first)
+        STUDIO_LOG(warn, kLog) << id_ << ": no clean plate yet (send CameraControl "
+                               << keyer::kPlateControl << " N); frames are not keyed";
+      return;
+    case Step::kRefused:
+      STUDIO_LOG(warn, kLog) << id_ << ": keyer: " << r.error.message;
+      return;
+    case Step::kKeyed:
+      break;
+  }
+  encode_mask(mask_, io_.options.coding, mask_bytes_);
+  from_core(id_, frame.frame, frame.capture_ns, mask_bytes_, mask_.width(), mask_.height(),
+            mask_sample_);
+  if (io_.masks.write(*mask_sample_)) io_.loop.completed(frame.frame, frame.capture_ns);
+}
+
+void CameraWorker::send_image(const Frame& frame, bool raw) {
+  const int w = frame.image.width(), h = frame.image.height();
+  if (raw) {
+    const auto* p = reinterpret_cast<const uint8_t*>(frame.image.data());
+    image_bytes_.assign(p, p + std::size_t(w) * h * 3);
+  } else {
+    cv::Mat rgb(h, w, CV_8UC3, const_cast<Rgb8*>(frame.image.data()));
+    cv::Mat bgr;
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    cv::imencode(".jpg", bgr, image_bytes_, {cv::IMWRITE_JPEG_QUALITY, io_.options.jpeg_quality});
+  }
+  from_core(id_, frame.frame, frame.capture_ns, w, h, !raw, image_bytes_, image_sample_);
+  (void)io_.images.write(*image_sample_);
+}
+
+bool CameraWorker::state_due(Clock::time_point now) {
+  std::lock_guard lock(mutex_);
+  const auto elapsed = std::chrono::duration<double>(now - window_start_);
+  bool due = dirty_;
+  if (elapsed.count() >= io_.options.state_period) {
+    fps_ = double(frames_in_window_) / elapsed.count();
+    frames_in_window_ = 0;
+    window_start_ = now;
+    due = true;
+  }
+  return due;
+}
+
+std::string CameraWorker::control(const CameraControlCore& c) {
+  std::string problem;
+  if (c.feature == keyer::kPlateControl) {
+    // For whichever process keys this camera: here only when it keys in-process.
+    if (!io_.options.publish_masks) return {};
+    if (!keyer::valid_plate_request(c.value)) {
+      problem = "camera " + id_ + ": " + std::string(keyer::kPlateControl) + " " +
+                std::to_string(c.value) + ": expected 0 (clear) or a frame count 1.." +
+                std::to_string(keyer::kMaxPlateFrames);
+    } else {
+      keyer_->request(int(c.value));
+      STUDIO_LOG(info, kLog) << id_ << ": "
+                             << (c.value == 0 ? std::string("clean plate cleared")
+                                              : "capturing a clean plate from the next " +
+                                                    std::to_string(int(c.value)) + " frame(s)");
+    }
+  } else if (c.feature == "ImageRate") {
+    std::lock_guard lock(mutex_);
+    image_rate_ = std::clamp(c.value, 0.0, 1e9 / double(io_.options.clock.period_ns));
+  } else if (c.feature == "ImageRaw") {
+    std::lock_guard lock(mutex_);
+    image_raw_ = c.value != 0;
+  } else if (std::find(std::begin(kCameraFeatures), std::end(kCameraFeatures), c.feature) ==
+             std::end(kCameraFeatures)) {
+    problem = "camera " + id_ + ": feature '" + c.feature +
+              "' is not allowed (allowed: Gain, ExposureTime, Focus, Zoom, Iris, ImageRate, "
+              "ImageRaw)";
+  } else if (auto v = source_->set_feature(c.feature, c.value); !v) {
+    problem = v.error().message;
+  } else {
+    STUDIO_LOG(info, kLog) << id_ << ": " << c.feature << " = " << *v << " (asked " << c.value
+                           << ")";
+  }
+  {
+    std::lock_guard lock(mutex_);
+    if (!problem.empty())
+      error_ = problem;
+    else if (!error_state_)
+      error_.clear();
+  }
+  publish_state();
+  return problem;
+}
+
+std::string CameraWorker::command(const CaptureCommandCore& c) {
+  std::string problem;
+  {
+    std::lock_guard lock(mutex_);
+    if (c.start) {
+      if (auto r = schedule_.start(c.take, c.at_frame); !r) problem = r.error().message;
+    } else if (auto r = schedule_.stop(c.take, c.at_frame); !r) {
+      problem = r.error().message;
+    } else if (*r != c.at_frame) {
+      problem = "take " + c.take + ": stop frame " + std::to_string(c.at_frame) +
+                " had passed; stopping at " + std::to_string(*r);
+    }
+    if (!problem.empty())
+      error_ = problem;
+    else if (!error_state_)
+      error_.clear();
+  }
+  if (problem.empty())
+    STUDIO_LOG(info, kLog) << id_ << ": take " << c.take << (c.start ? " starts" : " stops")
+                           << " at frame " << c.at_frame;
+  publish_state();
+  return problem;
+}
+
+void CameraWorker::publish_state() {
+  CameraStateCore s;
+  s.camera_id = id_;
+  s.features = source_->features();
+  const auto source_stats = source_->stats();
+  {
+    std::lock_guard lock(mutex_);
+    const double max_rate = 1e9 / double(io_.options.clock.period_ns);
+    s.features.push_back({"ImageRate", image_rate_, 0, max_rate, true});
+    s.features.push_back({"ImageRaw", image_raw_ ? 1.0 : 0.0, 0, 1, true});
+    s.frame = last_frame_;
+    s.capture_ns = last_capture_ns_;
+    s.fps = fps_;
+    s.drops =
+        source_stats.drops + recorder_drops_ + (recorder_ ? recorder_->stats().queue_drops : 0);
+    s.recording = recorder_ != nullptr;
+    if (schedule_.recording())
+      s.take = schedule_.recording()->name;
+    else if (schedule_.pending())
+      s.take = schedule_.pending()->name;
+    using Run = CameraStateCore::Run;
+    s.state = error_state_ || source_error_ ? Run::kError
+              : !io_.loop.running()         ? Run::kStopped
+              : s.recording                 ? Run::kRecording
+                                            : Run::kStreaming;
+    s.error = error_;
+    dirty_ = false;
+  }
+  wire::Owned<studio_CameraState> sample;
+  from_core(s, sample);
+  (void)io_.states.write(*sample);
+}
+
+CameraWorker::Health CameraWorker::health() {
+  std::lock_guard lock(mutex_);
+  return {error_state_ || source_error_, last_frame_, last_capture_ns_};
+}
+
+}  // namespace studio::capture::node

@@ -1,0 +1,121 @@
+#pragma once
+// One camera of the capture node (capture_node.h): its grab thread's work per frame — takes
+// recorded on command (TakeSchedule + Recorder), the in-process key (keyer::PlateKeyer) and its
+// AlphaMask, the latest-image service (CameraImage) — and its CameraState. The node's loop
+// thread applies CameraControl and CaptureCommand through control() and command().
+//
+// Threads: run() is the camera's grab thread (a runtime::ServiceLoop thread); control(),
+// command(), publish_state() and health() may be called from the loop thread meanwhile. The
+// state they share is guarded by the worker's mutex; the keyer and the image buffers belong to
+// the grab thread.
+
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "capture/recorder.h"
+#include "capture/take_schedule.h"
+#include "capture_node.h"
+#include "convert.h"
+#include "keyer/config/kept_plates.h"
+#include "keyer/plate_keyer.h"
+#include "runtime/service_loop.h"
+
+namespace studio::capture::node {
+
+// What every camera publishes through and counts into; owned by the node.
+struct CaptureIo {
+  const CaptureNodeOptions& options;
+  const keyer::KeptPlates& kept_plates;
+  runtime::ServiceLoop& loop;
+  runtime::Output<studio_AlphaMask>& masks;
+  runtime::Output<studio_CameraImage>& images;
+  runtime::Output<studio_CameraState>& states;
+  runtime::Counter& frames_captured;
+  runtime::Counter& frames_recorded;
+  runtime::Counter& frames_dropped;
+  runtime::Counter& frames_unkeyed;      // difference key without a clean plate yet
+  runtime::Counter& plates_captured;     // KeyerPlate requests completed
+  runtime::Counter& plate_saves_failed;  // completed plates that could not be kept in plate_dir
+};
+
+class CameraWorker {
+ public:
+  CameraWorker(CameraSetup setup, const CaptureIo& io);
+
+  const std::string& id() const { return id_; }
+  const std::optional<studio::Camera>& calibration() const { return calibration_; }
+
+  // Creates the keyer (with a plate kept from before a restart) and starts the source.
+  Expected<void> start();
+  // The grab thread: frames until the loop stops.
+  void run();
+  // Unblocks run() (the source stops delivering).
+  void interrupt() { source_->stop(); }
+  // After run() ended: ends a take still recording (its frames so far kept, take.yaml completed)
+  // and publishes the last state.
+  void finish();
+
+  // CameraControl for this camera; the problem, or "" when applied.
+  std::string control(const CameraControlCore& c);
+  // CaptureCommand (take name already checked); the problem, or "" when scheduled.
+  std::string command(const CaptureCommandCore& c);
+  void publish_state();
+
+  struct Health {
+    bool error = false;
+    uint64_t frame = 0;
+    int64_t capture_ns = 0;
+  };
+  Health health();
+
+ private:
+  void on_frame(Frame& frame, std::chrono::steady_clock::time_point now);
+  void on_source_error(const Error& error);
+  // Under mutex_: the take schedule's decision for this frame, applied.
+  void record(const Frame& frame);
+  void begin_take(const Frame& frame, const TakeSchedule::Decision& d);
+  void reap_finished_takes();
+  // Whether an image is due (mutex_ held); sets `raw`.
+  bool image_due(std::chrono::steady_clock::time_point now, bool& raw);
+  void key(const Frame& frame);
+  void send_image(const Frame& frame, bool raw);
+  // Every state_period: the fps over the window; true when a state should go out.
+  bool state_due(std::chrono::steady_clock::time_point now);
+
+  const CaptureIo& io_;
+  std::string id_;
+  std::unique_ptr<FrameSource> source_;
+  std::optional<studio::Camera> calibration_;
+  // Grab thread only.
+  std::optional<keyer::PlateKeyer> keyer_;
+  RunMask mask_;
+  std::vector<uint8_t> mask_bytes_, image_bytes_;
+  wire::Owned<studio_AlphaMask> mask_sample_;
+  wire::Owned<studio_CameraImage> image_sample_;
+  bool source_failed_ = false;
+
+  std::mutex mutex_;  // everything below
+  TakeSchedule schedule_;
+  std::unique_ptr<Recorder> recorder_;
+  std::vector<std::unique_ptr<Recorder>> finishing_;
+  uint64_t take_frames_seen_ = 0;  // frames of the recording take the source delivered (+ missed)
+  uint64_t recorder_drops_ = 0;    // queue drops of finished takes
+  bool error_state_ = false;       // a take failed (disk full, ...): stays until restart
+  bool source_error_ = false;      // the source fails now
+  std::string error_;
+  uint64_t last_frame_ = 0;
+  int64_t last_capture_ns_ = 0;
+  double image_rate_ = 0;
+  bool image_raw_ = false;
+  double fps_ = 0;
+  uint64_t frames_in_window_ = 0;
+  std::chrono::steady_clock::time_point window_start_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point last_image_ = std::chrono::steady_clock::time_point::min();
+  bool dirty_ = true;
+};
+
+}  // namespace studio::capture::node

@@ -1,0 +1,77 @@
+// The hull service's options and its definition for runtime::service_main (hull_node.h).
+#include "hull_node.h"
+#include "yaml_io/options.h"
+#include "yaml_io/rig_yaml.h"
+
+namespace studio::hull {
+
+Expected<void> HullNodeOptions::validate() const {
+  if (box.size() != 6) return fail("box: expected 6 numbers x0,y0,z0,x1,y1,z1");
+  if (auto g = grid_spec().validate(); !g) return g;
+  if (min_cameras < 1) return fail("min_cameras: must be >= 1");
+  if (actor_prefix.empty() || actor_prefix.size() > 40)
+    return fail("actor_prefix: 1..40 characters");
+  return {};
+}
+
+GridSpec HullNodeOptions::grid_spec() const {
+  GridSpec g;
+  if (box.size() == 6) {
+    g.box_min = Eigen::Vector3d(box[0], box[1], box[2]);
+    g.box_max = Eigen::Vector3d(box[3], box[4], box[5]);
+  }
+  g.axis = axis;
+  g.cells_u = grid;
+  g.cells_v = grid;
+  return g;
+}
+
+runtime::ServiceDefinition hull_service_definition() {
+  runtime::ServiceDefinition d;
+  d.name = "hull";
+  d.summary =
+      "Real-time line-segment visual hull: masks of every camera -> per-actor segments and mesh.";
+  d.config_help =
+      "  hull:                     (required section)\n"
+      "    rig: FILE               rig.yaml with the cameras (relative to the config file)\n"
+      "    box: [x0,y0,z0,x1,y1,z1] reconstruction volume, studio frame, metres\n"
+      "    grid: 128               columns per side (8..2048)\n"
+      "    axis: y                 continuous axis of the segments: x|y|z\n"
+      "    deadline_ms: 40         wait for a frame's missing masks at most this long\n"
+      "    min_cameras: 2          drop a frame with fewer masks at its deadline\n"
+      "    outside: keep           column parts outside an image: keep|cut\n"
+      "    threads: 2              cut threads\n"
+      "    mesh: true              publish studio/actor/mesh\n"
+      "    refine: true            exact crossings on the mesh (else half-cell vertices)\n"
+      "    min_actor_volume: 0.01  smaller components (m^3) are noise\n"
+      "    actor_prefix: actor     actor ids <prefix>0, <prefix>1, ... largest first\n";
+  d.create = [](yaml::MapReader& config,
+                runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
+    auto section = config.required("hull");
+    if (!section) return std::unexpected(section.error());
+    static const yaml::Schema<HullNodeOptions> schema{
+        yaml::field("rig", &HullNodeOptions::rig).required().relative_path(),
+        yaml::field("box", &HullNodeOptions::box).required().size(6),
+        yaml::field("grid", &HullNodeOptions::grid).range(8, 2048),
+        yaml::enum_field("axis", &HullNodeOptions::axis,
+                         {{"x", Axis::x}, {"y", Axis::y}, {"z", Axis::z}}),
+        yaml::field("deadline_ms", &HullNodeOptions::deadline_ms).range(1, 1000),
+        yaml::field("min_cameras", &HullNodeOptions::min_cameras).range(1, 64),
+        yaml::enum_field("outside", &HullNodeOptions::outside,
+                         {{"keep", Outside::keep}, {"cut", Outside::cut}}),
+        yaml::field("threads", &HullNodeOptions::threads).range(1, 64),
+        yaml::field("mesh", &HullNodeOptions::mesh),
+        yaml::field("refine", &HullNodeOptions::refine),
+        yaml::field("min_actor_volume", &HullNodeOptions::min_actor_volume).min(0),
+        yaml::field("actor_prefix", &HullNodeOptions::actor_prefix),
+    };
+    auto options = schema.read(*section);
+    if (!options) return std::unexpected(options.error());
+    auto rig = yaml::read_rig(options->rig);
+    if (!rig) return std::unexpected(rig.error());
+    return make_hull_node(*options, rig->cameras, ctx);
+  };
+  return d;
+}
+
+}  // namespace studio::hull

@@ -1,0 +1,86 @@
+#pragma once
+// The one OpenGL renderer of the project (the projector and the director's preview both use it):
+// OpenGL 3.3 core, context-agnostic (a HeadlessContext, a GLFW window, anything current).
+//
+// draw() renders the scene graph from a given view (cam_from_world) and projection
+// (clip_from_cam, taken as given: the projector passes an off-axis frustum): every visible model
+// node's meshes with its asset material (base colour x texture x node colour), every actor node's
+// latest ActorMesh, lit by the scene's light nodes (up to 8; Blinn-Phong with inverse-square
+// fall-off for point and spot lights) plus an ambient term; high-contrast nodes (paper §V-F) and
+// emissive materials are drawn unlit at full intensity. Faces are two-sided.
+//
+// Assets are uploaded once (upload(), cached by path; re-uploaded when the content hash differs)
+// and actor meshes into buffers that only grow; a steady-state draw() allocates nothing.
+// A node naming an asset the renderer lacks, or one with a different hash, is skipped and listed
+// by check_assets() (what a renderer reports in its status).
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "scene/actor_mesh.h"
+#include "scene/scene.h"
+#include "scene_assets/asset.h"
+
+namespace studio::scene_render {
+
+struct RendererOptions {
+  Eigen::Vector4f clear_colour{0.05f, 0.05f, 0.07f, 1.0f};
+  Eigen::Vector3f ambient{0.22f, 0.22f, 0.24f};
+  // Scale from light units (candela, lux) to the shader's unit radiance.
+  float exposure = 0.3f;
+  Expected<void> validate() const;
+};
+
+struct View {
+  Eigen::Matrix4d cam_from_world = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d clip_from_cam = Eigen::Matrix4d::Identity();
+};
+
+struct AssetStatus {
+  enum class State { missing, different };
+  std::string path;
+  std::string wanted_sha256;
+  std::string have_sha256;  // empty when missing
+  State state = State::missing;
+};
+
+class Renderer {
+ public:
+  // Compiles the shaders; needs a current OpenGL 3.3 core context.
+  static Expected<Renderer> create(const RendererOptions& options = {});
+  Renderer(Renderer&&) noexcept;
+  Renderer& operator=(Renderer&&) noexcept;
+  ~Renderer();
+
+  // Uploads meshes and textures of an asset (no-op when the same path and hash are loaded).
+  Expected<void> upload(const scene_assets::Asset& asset);
+  // The latest mesh of an actor (replaces the previous one; buffers grow, never shrink).
+  Expected<void> set_actor_mesh(const scene::ActorMesh& mesh);
+
+  // Assets the scene's model nodes name that are not uploaded or differ, one per path.
+  std::vector<AssetStatus> check_assets(const scene::Scene& scene) const;
+
+  // Clears colour and depth of the bound framebuffer and draws the scene.
+  void draw(const scene::Scene& scene, const View& view);
+  // The actor mask of the projector: the actor's mesh in one flat colour (black), depth test
+  // off, every vertex moved `inflate_m` metres along its normal (the security margin).
+  void draw_actor_flat(const std::string& actor_id, const View& view, float inflate_m = 0.0f,
+                       const Eigen::Vector4f& colour = Eigen::Vector4f(0, 0, 0, 1));
+  // Draws a texture (e.g. a RenderTarget's colour texture) over the whole bound framebuffer;
+  // the output pixel at normalised coordinates p in [0,1]^2 samples the texture at
+  // dehomogenised tex_from_screen * (p, 1) (identity: a plain copy; the projector passes its
+  // homography). Depth test off.
+  void draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen = Eigen::Matrix3f::Identity());
+
+  int draw_calls_last_frame() const;
+
+ private:
+  struct Impl;
+  explicit Renderer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace studio::scene_render

@@ -1,0 +1,419 @@
+#include "scene_render/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <unordered_map>
+
+#include "gl.h"
+#include "gl_program.h"
+#include "shaders.h"
+
+namespace studio::scene_render {
+namespace {
+
+constexpr int kMaxLights = 8;
+
+struct GpuMesh {
+  GLuint vao = 0, vbo = 0, ebo = 0;
+  GLsizei index_count = 0;
+  int material = -1;
+  std::size_t vbo_bytes = 0, ebo_bytes = 0;  // capacity (actor meshes grow)
+};
+
+struct GpuAsset {
+  std::string sha256;
+  std::vector<GpuMesh> meshes;
+  std::vector<GLuint> textures;
+  std::vector<scene_assets::MaterialData> materials;
+};
+
+void release(GpuMesh& m) {
+  if (m.vao) glDeleteVertexArrays(1, &m.vao);
+  if (m.vbo) glDeleteBuffers(1, &m.vbo);
+  if (m.ebo) glDeleteBuffers(1, &m.ebo);
+  m = GpuMesh{};
+}
+
+void release(GpuAsset& a) {
+  for (GpuMesh& m : a.meshes) release(m);
+  if (!a.textures.empty()) glDeleteTextures(static_cast<GLsizei>(a.textures.size()), a.textures.data());
+  a = GpuAsset{};
+}
+
+GLuint upload_texture(int width, int height, const std::uint8_t* rgba_bottom_first) {
+  GLuint t = 0;
+  glGenTextures(1, &t);
+  glBindTexture(GL_TEXTURE_2D, t);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba_bottom_first);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  return t;
+}
+
+// Interleaved vertex layout: position, normal, uv, colour (11 floats).
+constexpr int kFloats = 11;
+
+void set_layout() {
+  const GLsizei stride = kFloats * sizeof(float);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(0));
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(3 * sizeof(float)));
+  glEnableVertexAttribArray(2);
+  glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(6 * sizeof(float)));
+  glEnableVertexAttribArray(3);
+  glVertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(8 * sizeof(float)));
+}
+
+// Writes vertices into `mesh`'s buffers, growing them when needed (never shrinking).
+void fill(GpuMesh& mesh, const std::vector<float>& vertices, const std::vector<std::uint32_t>& indices) {
+  if (!mesh.vao) {
+    glGenVertexArrays(1, &mesh.vao);
+    glGenBuffers(1, &mesh.vbo);
+    glGenBuffers(1, &mesh.ebo);
+    glBindVertexArray(mesh.vao);
+    glBindBuffer(GL_ARRAY_BUFFER, mesh.vbo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.ebo);
+    set_layout();
+  }
+  glBindVertexArray(mesh.vao);
+  const std::size_t vb = vertices.size() * sizeof(float), ib = indices.size() * sizeof(std::uint32_t);
+  glBindBuffer(GL_ARRAY_BUFFER, mesh.vbo);
+  if (vb > mesh.vbo_bytes) {
+    mesh.vbo_bytes = std::max(vb, mesh.vbo_bytes * 3 / 2);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vbo_bytes), nullptr, GL_DYNAMIC_DRAW);
+  }
+  glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(vb), vertices.data());
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.ebo);
+  if (ib > mesh.ebo_bytes) {
+    mesh.ebo_bytes = std::max(ib, mesh.ebo_bytes * 3 / 2);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.ebo_bytes), nullptr, GL_DYNAMIC_DRAW);
+  }
+  glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(ib), indices.data());
+  mesh.index_count = static_cast<GLsizei>(indices.size());
+  glBindVertexArray(0);
+}
+
+struct Uniforms {
+  GLint clip_from_world, world_from_model, normal_matrix, inflate, base, textured, texture,
+      emissive, unlit, eye, ambient, light_count, light_position, light_radiance, light_spot,
+      light_spot_inner, light_range;
+};
+
+}  // namespace
+
+Expected<void> RendererOptions::validate() const {
+  if (!clear_colour.allFinite() || !ambient.allFinite() || !std::isfinite(exposure) || exposure < 0)
+    return fail("renderer options: colours and exposure must be finite, exposure >= 0");
+  return {};
+}
+
+struct Renderer::Impl {
+  RendererOptions options;
+  GLuint program = 0, quad_program = 0, quad_vao = 0;
+  Uniforms u{};
+  GLint quad_texture = -1, quad_tex_from_screen = -1;
+  std::unordered_map<std::string, GpuAsset> assets;
+  std::unordered_map<std::string, GpuMesh> actors;
+  std::map<std::string, GLuint> override_textures;  // Material::texture paths
+  // Per-frame scratch, reused.
+  std::vector<Eigen::Matrix4d> world;
+  std::vector<char> visible;
+  std::vector<float> vertex_scratch;
+  std::vector<std::uint32_t> index_scratch;
+  int draw_calls = 0;
+
+  ~Impl() {
+    for (auto& [p, a] : assets) release(a);
+    for (auto& [id, m] : actors) release(m);
+    for (auto& [p, t] : override_textures) glDeleteTextures(1, &t);
+    if (program) glDeleteProgram(program);
+    if (quad_program) glDeleteProgram(quad_program);
+    if (quad_vao) glDeleteVertexArrays(1, &quad_vao);
+  }
+
+  GLuint texture_for_path(const std::string& path) {
+    if (auto it = override_textures.find(path); it != override_textures.end()) return it->second;
+    cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
+    GLuint t = 0;
+    if (!image.empty()) {  // an unreadable texture draws untextured (and is tried only once)
+      cv::cvtColor(image, image, cv::COLOR_BGR2RGBA);
+      cv::flip(image, image, 0);
+      t = upload_texture(image.cols, image.rows, image.data);
+    }
+    override_textures.emplace(path, t);
+    return t;
+  }
+
+  void set_matrices(const Eigen::Matrix4d& world_from_model) {
+    const Eigen::Matrix4f m = world_from_model.cast<float>();
+    const Eigen::Matrix3f n = m.topLeftCorner<3, 3>().inverse().transpose();
+    glUniformMatrix4fv(u.world_from_model, 1, GL_FALSE, m.data());
+    glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, n.data());
+  }
+
+  void set_lights(const scene::Scene& scene) {
+    GLfloat position[kMaxLights * 4], radiance[kMaxLights * 3], spot[kMaxLights * 4],
+        inner[kMaxLights], range[kMaxLights];
+    int count = 0;
+    const auto& order = scene.order();
+    for (std::size_t i = 0; i < order.size() && count < kMaxLights; ++i) {
+      const scene::Node& n = *order[i];
+      if (n.kind != scene::NodeKind::light || !visible[i]) continue;
+      const Eigen::Matrix4d& w = world[i];
+      const Eigen::Vector3d origin = w.col(3).head<3>();
+      const Eigen::Vector3d axis = (-w.col(2).head<3>()).normalized();  // the light shines along -z
+      const scene::Light& l = n.light;
+      if (l.type == scene::LightType::directional) {
+        position[4 * count + 0] = static_cast<float>(-axis.x());
+        position[4 * count + 1] = static_cast<float>(-axis.y());
+        position[4 * count + 2] = static_cast<float>(-axis.z());
+        position[4 * count + 3] = 0;
+      } else {
+        for (int k = 0; k < 3; ++k) position[4 * count + k] = static_cast<float>(origin[k]);
+        position[4 * count + 3] = 1;
+      }
+      for (int k = 0; k < 3; ++k) radiance[3 * count + k] = l.colour[k] * l.intensity * options.exposure;
+      for (int k = 0; k < 3; ++k) spot[4 * count + k] = static_cast<float>(axis[k]);
+      spot[4 * count + 3] = l.type == scene::LightType::spot ? std::cos(l.outer_cone) : -2.0f;
+      inner[count] = std::cos(l.inner_cone);
+      range[count] = l.range;
+      ++count;
+    }
+    glUniform1i(u.light_count, count);
+    if (count == 0) return;
+    glUniform4fv(u.light_position, count, position);
+    glUniform3fv(u.light_radiance, count, radiance);
+    glUniform4fv(u.light_spot, count, spot);
+    glUniform1fv(u.light_spot_inner, count, inner);
+    glUniform1fv(u.light_range, count, range);
+  }
+
+  void draw_mesh(const GpuMesh& m) {
+    glBindVertexArray(m.vao);
+    glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+    ++draw_calls;
+  }
+};
+
+Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+Renderer::~Renderer() = default;
+
+Expected<Renderer> Renderer::create(const RendererOptions& options) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  const char* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  if (!version) return fail("renderer: no current OpenGL context");
+  auto impl = std::make_unique<Impl>();
+  impl->options = options;
+  auto program = build_program(shaders::kSceneVertex, shaders::kSceneFragment, "scene");
+  if (!program) return std::unexpected(program.error());
+  impl->program = *program;
+  auto quad = build_program(shaders::kQuadVertex, shaders::kQuadFragment, "texture quad");
+  if (!quad) return std::unexpected(quad.error());
+  impl->quad_program = *quad;
+  const GLuint p = impl->program;
+  auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
+  impl->u = Uniforms{loc("u_clip_from_world"), loc("u_world_from_model"), loc("u_normal_matrix"),
+                     loc("u_inflate"), loc("u_base"), loc("u_textured"), loc("u_texture"),
+                     loc("u_emissive"), loc("u_unlit"), loc("u_eye"), loc("u_ambient"),
+                     loc("u_light_count"), loc("u_light_position[0]"), loc("u_light_radiance[0]"),
+                     loc("u_light_spot[0]"), loc("u_light_spot_inner[0]"), loc("u_light_range[0]")};
+  impl->quad_texture = glGetUniformLocation(impl->quad_program, "u_texture");
+  impl->quad_tex_from_screen = glGetUniformLocation(impl->quad_program, "u_tex_from_screen");
+  glGenVertexArrays(1, &impl->quad_vao);
+  return Renderer(std::move(impl));
+}
+
+Expected<void> Renderer::upload(const scene_assets::Asset& asset) {
+  auto& slot = impl_->assets[asset.path];
+  if (!slot.sha256.empty() && slot.sha256 == asset.sha256) return {};
+  release(slot);
+  GpuAsset g;
+  g.sha256 = asset.sha256;
+  g.materials = asset.materials;
+  for (const scene_assets::Texture& t : asset.textures) {
+    if (t.width < 1 || t.height < 1 || t.rgba.size() != static_cast<std::size_t>(t.width) * t.height * 4)
+      return fail(asset.path + ": texture '" + t.name + "' has a bad size");
+    g.textures.push_back(upload_texture(t.width, t.height, t.rgba.data()));
+  }
+  std::vector<float> v;
+  for (const scene_assets::MeshData& m : asset.meshes) {
+    v.clear();
+    for (std::size_t i = 0; i < m.positions.size(); ++i) {
+      const Eigen::Vector2f uv = m.uvs.empty() ? Eigen::Vector2f::Zero() : m.uvs[i];
+      const Eigen::Vector3f c = m.colours.empty() ? Eigen::Vector3f::Ones() : m.colours[i];
+      v.insert(v.end(), {m.positions[i].x(), m.positions[i].y(), m.positions[i].z(), m.normals[i].x(),
+                         m.normals[i].y(), m.normals[i].z(), uv.x(), uv.y(), c.x(), c.y(), c.z()});
+    }
+    GpuMesh gm;
+    fill(gm, v, m.indices);
+    gm.material = m.material;
+    g.meshes.push_back(gm);
+  }
+  slot = std::move(g);
+  return {};
+}
+
+Expected<void> Renderer::set_actor_mesh(const scene::ActorMesh& mesh) {
+  if (auto ok = mesh.validate(); !ok) return ok;
+  if (mesh.actor_id.empty()) return fail("actor mesh: empty actor id");
+  auto& v = impl_->vertex_scratch;
+  auto& idx = impl_->index_scratch;
+  v.clear();
+  idx.clear();
+  scene::ActorMesh with_normals;
+  const std::vector<Eigen::Vector3f>* normals = &mesh.normals;
+  if (mesh.normals.empty()) {
+    with_normals.vertices = mesh.vertices;
+    with_normals.triangles = mesh.triangles;
+    with_normals.compute_normals();
+    normals = &with_normals.normals;
+  }
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3f& p = mesh.vertices[i];
+    const Eigen::Vector3f& n = (*normals)[i];
+    const Eigen::Vector3f c = mesh.colours.empty() ? Eigen::Vector3f::Ones() : mesh.colours[i];
+    v.insert(v.end(), {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), 0.0f, 0.0f, c.x(), c.y(), c.z()});
+  }
+  for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t[0], t[1], t[2]});
+  fill(impl_->actors[mesh.actor_id], v, idx);
+  return {};
+}
+
+std::vector<AssetStatus> Renderer::check_assets(const scene::Scene& scene) const {
+  std::map<std::string, AssetStatus> out;
+  for (const auto& [id, n] : scene.nodes()) {
+    if (n.kind != scene::NodeKind::model || out.contains(n.asset.path)) continue;
+    auto it = impl_->assets.find(n.asset.path);
+    if (it == impl_->assets.end())
+      out[n.asset.path] = {n.asset.path, n.asset.sha256, "", AssetStatus::State::missing};
+    else if (it->second.sha256 != n.asset.sha256)
+      out[n.asset.path] = {n.asset.path, n.asset.sha256, it->second.sha256, AssetStatus::State::different};
+  }
+  std::vector<AssetStatus> v;
+  for (auto& [p, s] : out) v.push_back(std::move(s));
+  return v;
+}
+
+void Renderer::draw(const scene::Scene& scene, const View& view) {
+  Impl& r = *impl_;
+  r.draw_calls = 0;
+  const Eigen::Vector4f& cc = r.options.clear_colour;
+  glClearColor(cc[0], cc[1], cc[2], cc[3]);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glUseProgram(r.program);
+
+  scene.world_from_nodes(r.world);
+  const auto& order = scene.order();
+  const auto& parent = scene.parent_index();
+  r.visible.resize(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+    r.visible[i] = order[i]->visible && (parent[i] < 0 || r.visible[static_cast<std::size_t>(parent[i])]);
+
+  const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
+  const Eigen::Vector3f eye = view.cam_from_world.inverse().col(3).head<3>().cast<float>();
+  glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+  glUniform3fv(r.u.eye, 1, eye.data());
+  glUniform3fv(r.u.ambient, 1, r.options.ambient.data());
+  glUniform1f(r.u.inflate, 0.0f);
+  glUniform1i(r.u.texture, 0);
+  glActiveTexture(GL_TEXTURE0);
+  r.set_lights(scene);
+
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const scene::Node& n = *order[i];
+    if (!r.visible[i]) continue;
+    if (n.kind == scene::NodeKind::model) {
+      auto it = r.assets.find(n.asset.path);
+      if (it == r.assets.end() || it->second.sha256 != n.asset.sha256) continue;  // check_assets()
+      const GpuAsset& a = it->second;
+      r.set_matrices(r.world[i]);
+      const GLuint override_texture = n.material.texture.empty() ? 0 : r.texture_for_path(n.material.texture);
+      auto draw_one = [&](std::size_t m) {
+        if (m >= a.meshes.size()) return;
+        const GpuMesh& mesh = a.meshes[m];
+        Eigen::Vector4f base = n.material.colour;
+        Eigen::Vector3f emissive = Eigen::Vector3f::Zero();
+        GLuint texture = override_texture;
+        if (mesh.material >= 0) {
+          const scene_assets::MaterialData& md = a.materials[static_cast<std::size_t>(mesh.material)];
+          base = base.cwiseProduct(md.base_colour);
+          emissive = md.emissive;
+          if (!texture && md.texture >= 0) texture = a.textures[static_cast<std::size_t>(md.texture)];
+        }
+        glUniform4fv(r.u.base, 1, base.data());
+        glUniform3fv(r.u.emissive, 1, emissive.data());
+        glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
+        glUniform1i(r.u.textured, texture ? 1 : 0);
+        if (texture) glBindTexture(GL_TEXTURE_2D, texture);
+        r.draw_mesh(mesh);
+      };
+      if (n.asset.meshes.empty())
+        for (std::size_t m = 0; m < a.meshes.size(); ++m) draw_one(m);
+      else
+        for (std::uint32_t m : n.asset.meshes) draw_one(m);
+    } else if (n.kind == scene::NodeKind::actor) {
+      auto it = r.actors.find(n.actor_id);
+      if (it == r.actors.end() || it->second.index_count == 0) continue;
+      r.set_matrices(r.world[i]);
+      glUniform4fv(r.u.base, 1, n.material.colour.data());
+      const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
+      glUniform3fv(r.u.emissive, 1, zero.data());
+      glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
+      glUniform1i(r.u.textured, 0);
+      r.draw_mesh(it->second);
+    }
+  }
+  glBindVertexArray(0);
+}
+
+void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, float inflate_m,
+                               const Eigen::Vector4f& colour) {
+  Impl& r = *impl_;
+  auto it = r.actors.find(actor_id);
+  if (it == r.actors.end() || it->second.index_count == 0) return;
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(r.program);
+  const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
+  glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+  r.set_matrices(Eigen::Matrix4d::Identity());  // actor meshes are in the studio frame
+  glUniform1f(r.u.inflate, inflate_m);
+  glUniform4fv(r.u.base, 1, colour.data());
+  glUniform1i(r.u.unlit, 1);
+  glUniform1i(r.u.textured, 0);
+  r.draw_mesh(it->second);
+  glUniform1f(r.u.inflate, 0.0f);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+}
+
+void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen) {
+  Impl& r = *impl_;
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(r.quad_program);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glUniform1i(r.quad_texture, 0);
+  glUniformMatrix3fv(r.quad_tex_from_screen, 1, GL_FALSE, tex_from_screen.data());
+  glBindVertexArray(r.quad_vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+}
+
+int Renderer::draw_calls_last_frame() const { return impl_->draw_calls; }
+
+}  // namespace studio::scene_render

@@ -1,0 +1,111 @@
+#pragma once
+// GLSL 3.30 core sources of the renderer.
+
+namespace studio::scene_render::shaders {
+
+// Lit pass: per-fragment Blinn-Phong over up to 8 lights, base colour x texture x vertex colour.
+inline constexpr const char* kSceneVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+layout(location = 3) in vec3 a_colour;
+uniform mat4 u_clip_from_world;
+uniform mat4 u_world_from_model;
+uniform mat3 u_normal_matrix;
+uniform float u_inflate;
+out vec3 v_world;
+out vec3 v_normal;
+out vec2 v_uv;
+out vec3 v_colour;
+void main() {
+  vec4 world = u_world_from_model * vec4(a_position + u_inflate * a_normal, 1.0);
+  v_world = world.xyz;
+  v_normal = u_normal_matrix * a_normal;
+  v_uv = a_uv;
+  v_colour = a_colour;
+  gl_Position = u_clip_from_world * world;
+}
+)";
+
+inline constexpr const char* kSceneFragment = R"(#version 330 core
+in vec3 v_world;
+in vec3 v_normal;
+in vec2 v_uv;
+in vec3 v_colour;
+out vec4 o_colour;
+uniform vec4 u_base;
+uniform bool u_textured;
+uniform sampler2D u_texture;
+uniform vec3 u_emissive;
+uniform bool u_unlit;
+uniform vec3 u_eye;
+uniform vec3 u_ambient;
+uniform int u_light_count;
+uniform vec4 u_light_position[8];   // w = 0: xyz = unit direction towards the light
+uniform vec3 u_light_radiance[8];   // colour x intensity x exposure
+uniform vec4 u_light_spot[8];       // xyz = unit spot direction, w = cos(outer); w < -1: no cone
+uniform float u_light_spot_inner[8];
+uniform float u_light_range[8];
+void main() {
+  vec4 base = u_base * vec4(v_colour, 1.0);
+  if (u_textured) base *= texture(u_texture, v_uv);
+  if (u_unlit) { o_colour = vec4(base.rgb, 1.0); return; }
+  vec3 n = normalize(v_normal);
+  vec3 v = normalize(u_eye - v_world);
+  if (dot(n, v) < 0.0) n = -n;  // two-sided
+  vec3 c = u_ambient * base.rgb + u_emissive;
+  for (int i = 0; i < u_light_count; ++i) {
+    vec3 l;
+    float attenuation = 1.0;
+    if (u_light_position[i].w == 0.0) {
+      l = u_light_position[i].xyz;
+    } else {
+      vec3 d = u_light_position[i].xyz - v_world;
+      float d2 = max(dot(d, d), 1e-4);
+      l = d * inversesqrt(d2);
+      attenuation = 1.0 / max(d2, 1.0);
+      if (u_light_range[i] > 0.0) {
+        float r = sqrt(d2) / u_light_range[i];
+        attenuation *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
+      }
+      if (u_light_spot[i].w >= -1.0) {
+        float cd = dot(-l, u_light_spot[i].xyz);
+        attenuation *= smoothstep(u_light_spot[i].w, u_light_spot_inner[i], cd);
+      }
+    }
+    float ndl = max(dot(n, l), 0.0);
+    if (ndl <= 0.0) continue;
+    float spec = pow(max(dot(n, normalize(l + v)), 0.0), 32.0) * 0.15;
+    c += u_light_radiance[i] * attenuation * (base.rgb * ndl + vec3(spec));
+  }
+  o_colour = vec4(clamp(c, 0.0, 1.0), 1.0);
+}
+)";
+
+// Full-screen textured pass with a homography on the texture coordinates.
+inline constexpr const char* kQuadVertex = R"(#version 330 core
+out vec2 v_screen;
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));  // (0,0) (2,0) (0,2)
+  v_screen = p;
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+inline constexpr const char* kQuadFragment = R"(#version 330 core
+in vec2 v_screen;
+out vec4 o_colour;
+uniform sampler2D u_texture;
+uniform mat3 u_tex_from_screen;
+void main() {
+  vec3 t = u_tex_from_screen * vec3(v_screen, 1.0);
+  vec2 uv = t.xy / t.z;
+  if (t.z <= 0.0 || any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) {
+    o_colour = vec4(0.0, 0.0, 0.0, 1.0);
+    return;
+  }
+  o_colour = texture(u_texture, uv);
+}
+)";
+
+}  // namespace studio::scene_render::shaders

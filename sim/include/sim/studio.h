@@ -1,0 +1,122 @@
+#pragma once
+// The simulated studio (issue 3 item 1): N calibrated virtual cameras around an animated
+// articulated actor (sim/actor.h) on a blue retro-reflective cyclorama, producing per
+// frame the camera images, the TRUE masks and the true actor geometry / head centre. It is the
+// ground truth the keyer, the visual hull, the head tracker and calibration are scored against.
+//
+// Contracts
+// - True mask: pixel (u, v) is 255 iff the ray through the pixel CENTRE (studio::Camera
+//   convention: pixel (0,0) is the centre of the top-left pixel; distortion honoured) hits the
+//   actor's solid at the frame's instant, 0 otherwise. Exact, not anti-aliased: the geometric
+//   silhouette the visual hull is scored against.
+// - True matte: per pixel, the fraction (0..255) of the image's own sub-samples (over the
+//   pixel's area and, with motion blur, the shutter) that see the actor: the alpha a perfect
+//   keyer would recover from the image. It differs from the true mask only where the silhouette
+//   crosses a pixel, and where motion blur smears it (a part moving further than its own width
+//   during the exposure covers no pixel for more than half of it).
+// - Image: RGB, the cyclorama seen by the camera with realism knobs (all modest and on by
+//   default except motion blur and the projected image): sensor noise, illumination fall-off
+//   on the cloth (vignetting, distance and angle of the retro-reflection, seams), blue spill on
+//   the actor's edges, soft shadows of the actor on the floor, anti-aliased silhouette edges
+//   (area-integrated: see aa_samples). Motion blur integrates each pixel over the shutter.
+//   Background pixels are keyable: blue dominates (b > r + 60 and b > g + 60 before noise).
+// - Determinism: image and mask depend only on (cameras, options, frame); threads change nothing.
+// - Time: frame f shows the instant t = f / fps (motion blur integrates around it).
+// - Cyclorama: floor (y = 0) and four walls of an open-topped box |x|, |z| <= half_width,
+//   0 <= y <= height, larger than the 3 m x 3 m x 3 m acting area so that ring cameras see cloth
+//   everywhere. Rays leaving the box see a dark studio (not keyable as blue).
+// Speed: the background (cloth, fall-off, seams, projected image) is cached per camera; per
+// frame only the actor's projected bounding rectangles are ray cast, the shadow is a small
+// floor map, noise comes from a table at a per-frame offset, and cameras run on `threads`
+// threads. See BENCHMARKS.md ("Simulated studio") for the measured rate.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "sim/actor.h"
+
+namespace studio::sim {
+
+struct StudioOptions {
+  uint64_t seed = 1;  // sensor noise (the actor has its own seed in `actor`)
+  double fps = 25;
+  Actor::Options actor;
+
+  // Cyclorama.
+  double cyclorama_half_width = 4.5;  // metres
+  double cyclorama_height = 4.0;
+  Rgb8 cloth{30, 66, 212};            // the lit cloth at the image centre, before fall-off
+
+  // Realism knobs (0 disables each).
+  double noise_sigma = 2.0;     // Gaussian sensor noise, grey levels per channel
+  double cloth_falloff = 0.35;  // darkening of the cloth towards the image edges and far away
+  double spill = 0.30;          // blue spill at grazing angles on the actor's edges
+  double shadow = 0.40;         // darkness of the actor's soft floor shadow
+  double ring_light = 0.12;     // the camera's own blue LED ring lighting the actor
+  // Image formation at the silhouette integrates over the pixel's area (and, with motion blur,
+  // over the shutter) like a sensor does, with sub-samples spread so that an edge's position
+  // is resolved to ~1/samples px in any direction (render.cc: pixel_samples).
+  bool antialias = true;        // area-integrated silhouette edges (the mask stays exact)
+  int aa_samples = 16;          // sub-samples per edge pixel, in [2, 64]
+  bool motion_blur = false;     // integrate the actor over the shutter
+  double shutter = 0.5;         // exposure as a fraction of the frame period
+  int blur_samples = 16;        // instants, in [2, 64]; with antialias each has its own
+                                // sub-pixel sample where the silhouette crosses the pixel
+  bool projected_image = false;  // a faint projected picture on the back wall (z = -half_width)
+  double projection_strength = 0.12;
+  Image<Rgb8> projection;        // the projected picture; empty = a built-in test scene
+
+  int threads = 2;  // render_all() threads over cameras
+
+  Expected<void> validate() const;
+};
+
+// Ground truth of one frame.
+struct FrameTruth {
+  int64_t frame = 0;
+  double time = 0;
+  ActorPose pose;
+  ActorBody body;  // the true solid and surface at `time`
+  Eigen::Vector3d head_centre() const { return body.head_centre(); }
+};
+
+class SimulatedStudio {
+ public:
+  // Fails with one line on invalid options or cameras (empty list, bad size, bad intrinsics).
+  static Expected<SimulatedStudio> create(std::vector<Camera> cameras,
+                                          const StudioOptions& options = {});
+  SimulatedStudio(SimulatedStudio&&) noexcept;
+  SimulatedStudio& operator=(SimulatedStudio&&) noexcept;
+  ~SimulatedStudio();
+
+  const StudioOptions& options() const;
+  const Actor& actor() const;
+  const std::vector<Camera>& cameras() const;
+  int camera_count() const { return static_cast<int>(cameras().size()); }
+  double time_of(int64_t frame) const { return static_cast<double>(frame) / options().fps; }
+
+  FrameTruth truth(int64_t frame) const;
+
+  // One camera. image, true_mask and true_matte are (re)sized to the camera; any may be null.
+  void render(int camera, int64_t frame, Image<Rgb8>* image, Mask* true_mask,
+              Image<uint8_t>* true_matte = nullptr) const;
+  // All cameras of one frame, `threads` at a time; vectors are resized to camera_count().
+  // Returns the frame's ground truth.
+  FrameTruth render_all(int64_t frame, std::vector<Image<Rgb8>>* images,
+                        std::vector<Mask>* true_masks,
+                        std::vector<Image<uint8_t>>* true_mattes = nullptr) const;
+  // The empty studio as camera `camera` sees it, without noise (for difference keying).
+  const Image<Rgb8>& background(int camera) const;
+
+  struct Impl;
+
+ private:
+  explicit SimulatedStudio(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace studio::sim

@@ -1,0 +1,99 @@
+// Simulated studio speed (issue 3 item 1: >= 25 fps for 6 cameras at 704x576 on 2 cores).
+// BM_Studio6Cameras renders all six cameras of consecutive frames with render_all() (images +
+// true masks, every realism knob at its default); the `fps` counter is studio frames per second.
+// BM_StudioVsNaive runs, in the same process, a naive renderer of the same scene: every pixel of
+// every camera ray cast against every part (ActorBody::ray_hit) over a plain background, and
+// reports `speedup` = naive time / studio time.
+// `process_cpu_ms_per_frame` is the CPU time of all render threads per studio frame: on this
+// shared machine wall-clock fps depends on what else runs, CPU cost per frame does not.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <ctime>
+
+#include "sim/cameras.h"
+#include "sim/studio.h"
+
+namespace studio::sim {
+namespace {
+
+SimulatedStudio make_studio(int threads) {
+  StudioOptions o;
+  o.threads = threads;
+  return SimulatedStudio::create(ring_cameras(), o).value();
+}
+
+void BM_Studio6Cameras(benchmark::State& state) {
+  const SimulatedStudio studio = make_studio(static_cast<int>(state.range(0)));
+  std::vector<Image<Rgb8>> images;
+  std::vector<Mask> masks;
+  int64_t frame = 0;
+  // CPU time of the whole process (all render threads): what a frame costs on an idle machine.
+  auto process_cpu = [] {
+    timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+  };
+  const double cpu0 = process_cpu();
+  for (auto _ : state) {
+    studio.render_all(frame++, &images, &masks);
+    benchmark::DoNotOptimize(images[0].data());
+  }
+  const double cpu_per_frame = (process_cpu() - cpu0) / static_cast<double>(state.iterations());
+  state.counters["process_cpu_ms_per_frame"] = 1e3 * cpu_per_frame;
+  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()),
+                                             benchmark::Counter::kIsRate);
+  state.counters["camera_frames_per_s"] = benchmark::Counter(
+      static_cast<double>(state.iterations() * studio.camera_count()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Studio6Cameras)->Arg(2)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// The naive renderer: per pixel, the world ray against every part; single thread.
+void naive_frame(const SimulatedStudio& studio, int64_t frame, std::vector<Image<Rgb8>>* images,
+                 std::vector<Mask>* masks) {
+  const ActorBody body = studio.truth(frame).body;
+  images->resize(studio.camera_count());
+  masks->resize(studio.camera_count());
+  for (int c = 0; c < studio.camera_count(); ++c) {
+    const Camera& cam = studio.cameras()[c];
+    (*images)[c] = Image<Rgb8>(cam.width, cam.height);
+    (*masks)[c] = Mask(cam.width, cam.height);
+    const Eigen::Vector3d centre = cam.centre_in_world();
+    for (int v = 0; v < cam.height; ++v) {
+      for (int u = 0; u < cam.width; ++u) {
+        const auto hit = body.ray_hit(centre, cam.pixel_ray_in_world(Eigen::Vector2d(u, v)));
+        (*masks)[c](u, v) = hit ? 255 : 0;
+        (*images)[c](u, v) = hit ? Rgb8{200, 150, 120} : studio.background(c)(u, v);
+      }
+    }
+  }
+}
+
+double seconds_per(const auto& fn) {
+  const auto t0 = std::chrono::steady_clock::now();
+  int n = 0;
+  do {
+    fn(n++);
+  } while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(1500));
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / n;
+}
+
+void BM_StudioVsNaive(benchmark::State& state) {
+  const SimulatedStudio studio = make_studio(1);  // single thread on both sides
+  std::vector<Image<Rgb8>> images;
+  std::vector<Mask> masks;
+  double fast = 0, slow = 0;
+  for (auto _ : state) {
+    fast = seconds_per([&](int n) { studio.render_all(n, &images, &masks); });
+    slow = seconds_per([&](int n) { naive_frame(studio, n, &images, &masks); });
+  }
+  state.counters["studio_fps_1thread"] = 1.0 / fast;
+  state.counters["naive_fps_1thread"] = 1.0 / slow;
+  state.counters["speedup"] = slow / fast;
+}
+BENCHMARK(BM_StudioVsNaive)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
+
+}  // namespace
+}  // namespace studio::sim
+
+BENCHMARK_MAIN();

@@ -1,0 +1,409 @@
+// The simulated studio: options, per-camera caches (rays, cyclorama background), sensor noise,
+// and threading over cameras (sim/studio.h). The per-frame actor work is in render.cc.
+#include "sim/studio.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <thread>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "studio_impl.h"
+
+#include "message.h"
+
+namespace studio::sim {
+
+using detail::CameraCache;
+using detail::Rect;
+
+Expected<void> StudioOptions::validate() const {
+  if (auto ok = actor.validate(); !ok) return ok;
+  if (!(fps > 0 && fps <= 1000)) return fail(detail::cat("studio fps ", fps, " outside (0, 1000]"));
+  if (!(cyclorama_half_width >= 1.5 && cyclorama_half_width <= 50)) {
+    return fail(detail::cat("cyclorama_half_width ", cyclorama_half_width, " m outside [1.5, 50] (must enclose the acting area)"));
+  }
+  if (!(cyclorama_height >= 3 && cyclorama_height <= 50)) {
+    return fail(detail::cat("cyclorama_height ", cyclorama_height, " m outside [3, 50]"));
+  }
+  auto unit = [](double v) { return v >= 0 && v <= 1; };
+  if (!(noise_sigma >= 0 && noise_sigma <= 40)) {
+    return fail(detail::cat("noise_sigma ", noise_sigma, " outside [0, 40] grey levels"));
+  }
+  if (!unit(cloth_falloff) || !unit(spill) || !unit(shadow) || !unit(ring_light) ||
+      !unit(projection_strength) || !unit(shutter)) {
+    return fail("cloth_falloff, spill, shadow, ring_light, projection_strength and shutter must "
+                "lie in [0, 1]");
+  }
+  if (blur_samples < 2 || blur_samples > 64) {
+    return fail(detail::cat("blur_samples ", blur_samples, " outside [2, 64]"));
+  }
+  if (aa_samples < 2 || aa_samples > 64) {
+    return fail(detail::cat("aa_samples ", aa_samples, " outside [2, 64]"));
+  }
+  if (threads < 1 || threads > 64) return fail(detail::cat("threads ", threads, " outside [1, 64]"));
+  return {};
+}
+
+namespace detail {
+
+Rect CameraCache::project_hull(const Eigen::Vector3d* points, int n, int margin) const {
+  const int W = camera.width, H = camera.height;
+  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
+  for (int k = 0; k < n; ++k) {
+    if (!(points[k].z() > 0.05)) return {0, 0, W, H};
+    const double x = points[k].x() / points[k].z(), y = points[k].y() / points[k].z();
+    xmin = std::min(xmin, x);
+    xmax = std::max(xmax, x);
+    ymin = std::min(ymin, y);
+    ymax = std::max(ymax, y);
+  }
+  const auto& k = camera.intrinsics;
+  double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
+  auto add = [&](double x, double y) {
+    if (!pinhole) {
+      const Eigen::Vector2d o = distort(camera.distortion, Eigen::Vector2d(x, y));
+      x = o.x();
+      y = o.y();
+    }
+    const double u = k.fx * x + k.skew * y + k.cx, v = k.fy * y + k.cy;
+    umin = std::min(umin, u);
+    umax = std::max(umax, u);
+    vmin = std::min(vmin, v);
+    vmax = std::max(vmax, v);
+  };
+  const int steps = pinhole ? 1 : 16;
+  for (int s = 0; s <= steps; ++s) {
+    const double a = static_cast<double>(s) / steps;
+    add(xmin + a * (xmax - xmin), ymin);
+    add(xmin + a * (xmax - xmin), ymax);
+    add(xmin, ymin + a * (ymax - ymin));
+    add(xmax, ymin + a * (ymax - ymin));
+  }
+  if (!pinhole) margin += 2;
+  auto clampi = [](double v, int lo, int hi) {
+    return static_cast<int>(std::clamp(v, static_cast<double>(lo), static_cast<double>(hi)));
+  };
+  return {clampi(std::floor(umin) - margin, 0, W), clampi(std::floor(vmin) - margin, 0, H),
+          clampi(std::ceil(umax) + margin + 1, 0, W), clampi(std::ceil(vmax) + margin + 1, 0, H)};
+}
+
+}  // namespace detail
+
+namespace {
+
+// Deterministic value noise in [-1, 1] on a 2-D lattice (cloth weave irregularity).
+double hash01(int64_t i, int64_t j, uint64_t salt) {
+  uint64_t h = static_cast<uint64_t>(i) * 0x9E3779B97F4A7C15ull ^
+               (static_cast<uint64_t>(j) + 0x632BE59BD9B4E019ull) * 0xC2B2AE3D27D4EB4Full ^ salt;
+  h ^= h >> 31;
+  h *= 0x94D049BB133111EBull;
+  h ^= h >> 29;
+  return static_cast<double>(h >> 11) / static_cast<double>(1ull << 53) * 2 - 1;
+}
+double value_noise(double x, double y, uint64_t salt) {
+  const double fx = std::floor(x), fy = std::floor(y);
+  const double ax = x - fx, ay = y - fy;
+  const int64_t i = static_cast<int64_t>(fx), j = static_cast<int64_t>(fy);
+  const double sx = ax * ax * (3 - 2 * ax), sy = ay * ay * (3 - 2 * ay);
+  const double a = hash01(i, j, salt), b = hash01(i + 1, j, salt), c = hash01(i, j + 1, salt),
+               d = hash01(i + 1, j + 1, salt);
+  return (a * (1 - sx) + b * sx) * (1 - sy) + (c * (1 - sx) + d * sx) * sy;
+}
+
+// The built-in projected picture: a sky gradient, a sun and a chequered ground, 256x192.
+Image<Rgb8> builtin_projection() {
+  Image<Rgb8> img(256, 192);
+  for (int y = 0; y < 192; ++y) {
+    for (int x = 0; x < 256; ++x) {
+      Rgb8 c;
+      if (y < 120) {
+        c = {static_cast<uint8_t>(120 + y), static_cast<uint8_t>(160 + y / 2), 230};
+        const double dx = x - 190, dy = y - 40;
+        if (dx * dx + dy * dy < 400) c = {255, 230, 120};
+      } else {
+        c = ((x / 32 + (y - 120) / 24) % 2) ? Rgb8{200, 180, 120} : Rgb8{90, 140, 60};
+      }
+      img(x, y) = c;
+    }
+  }
+  return img;
+}
+
+// Cyclorama background for one camera (static, cached).
+void build_background(const StudioOptions& o, const Image<Rgb8>& projection, CameraCache* cam) {
+  const int W = cam->camera.width, H = cam->camera.height;
+  cam->background = Image<Rgb8>(W, H);
+  cam->surface = Image<uint8_t>(W, H);
+  const double hw = o.cyclorama_half_width, ht = o.cyclorama_height;
+  const Eigen::Matrix3d Rt = cam->R.transpose();
+  const Eigen::Vector3d C = cam->centre;
+  const double d_ref = std::max(1.0, C.norm());
+  for (int v = 0; v < H; ++v) {
+    for (int u = 0; u < W; ++u) {
+      const Eigen::Vector3d d_cam = cam->ray(u, v);
+      const Eigen::Vector3d dir = (Rt * d_cam).normalized();
+      // Nearest of the floor and the four walls, within their extents.
+      double best = 1e300;
+      int surface = detail::kNone;
+      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+      auto consider = [&](double t, const Eigen::Vector3d& n, int kind) {
+        if (!(t > 1e-9 && t < best)) return;
+        const Eigen::Vector3d x = C + t * dir;
+        const double eps = 1e-9;
+        if (std::abs(x.x()) > hw + eps || std::abs(x.z()) > hw + eps || x.y() < -eps ||
+            x.y() > ht + eps) {
+          return;
+        }
+        best = t;
+        surface = kind;
+        normal = n;
+      };
+      if (dir.y() != 0) consider(-C.y() / dir.y(), Eigen::Vector3d::UnitY(), detail::kFloor);
+      for (int axis : {0, 2}) {
+        if (dir[axis] == 0) continue;
+        for (double side : {-hw, hw}) {
+          Eigen::Vector3d n = Eigen::Vector3d::Zero();
+          n[axis] = side > 0 ? -1 : 1;
+          consider((side - C[axis]) / dir[axis], n, detail::kWall);
+        }
+      }
+      cam->surface(u, v) = static_cast<uint8_t>(surface);
+      if (surface == detail::kNone) {
+        const uint8_t g = static_cast<uint8_t>(std::clamp(28.0 + 10 * dir.y(), 0.0, 255.0));
+        cam->background(u, v) = {g, g, static_cast<uint8_t>(g + 4)};
+        continue;
+      }
+      const Eigen::Vector3d x = C + best * dir;
+      // Retro-reflection of the lens's LED ring: vignetting, distance and incidence angle.
+      const double cos_axis = d_cam.z() / d_cam.norm();
+      const double vignette = std::pow(cos_axis, 3);
+      const double distance = std::pow(d_ref / std::max(best, 0.5), 0.5);
+      const double incidence = 0.7 + 0.3 * std::abs(normal.dot(dir));
+      double g = std::min(1.1, vignette * distance * incidence);
+      double f = 1 - o.cloth_falloff * (1 - g);
+      // Cloth: weave irregularity, darker seams every 1.2 m on the walls, a darker floor.
+      const Eigen::Vector2d uv = surface == detail::kFloor ? Eigen::Vector2d(x.x(), x.z())
+                                 : std::abs(normal.x()) > 0 ? Eigen::Vector2d(x.z(), x.y())
+                                                            : Eigen::Vector2d(x.x(), x.y());
+      f *= 1 + 0.025 * value_noise(uv.x() * 6, uv.y() * 6, surface) +
+           0.015 * value_noise(uv.x() * 25, uv.y() * 25, 7 + surface);
+      if (surface == detail::kWall) {
+        const double m = std::fmod(std::abs(uv.x()) + 0.6, 1.2);
+        if (m < 0.012) f *= 0.88;
+      } else {
+        f *= 0.94;
+      }
+      double rgb[3] = {o.cloth.r * f, o.cloth.g * f, o.cloth.b * f};
+      if (o.projected_image && surface == detail::kWall && normal.z() > 0.5 && !projection.pixels().empty()) {
+        // Back wall screen x in [-1.5, 1.5], y in [0.2, 2.8] (the acting area's width).
+        const double px = (x.x() + 1.5) / 3.0, py = (2.8 - x.y()) / 2.6;
+        if (px >= 0 && px < 1 && py >= 0 && py < 1) {
+          const Rgb8& p = projection(static_cast<int>(px * projection.width()),
+                                     static_cast<int>(py * projection.height()));
+          rgb[0] += o.projection_strength * p.r;
+          rgb[1] += o.projection_strength * p.g;
+          rgb[2] += o.projection_strength * p.b;
+        }
+      }
+      cam->background(u, v) = {static_cast<uint8_t>(std::clamp(rgb[0] + 0.5, 0.0, 255.0)),
+                               static_cast<uint8_t>(std::clamp(rgb[1] + 0.5, 0.0, 255.0)),
+                               static_cast<uint8_t>(std::clamp(rgb[2] + 0.5, 0.0, 255.0))};
+    }
+  }
+}
+
+uint64_t mix(uint64_t a, uint64_t b) {
+  uint64_t h = a * 0x9E3779B97F4A7C15ull + b + 0x7F4A7C15ull;
+  h ^= h >> 33;
+  h *= 0xFF51AFD7ED558CCDull;
+  h ^= h >> 33;
+  h *= 0xC4CEB9FE1A85EC53ull;
+  return h ^ (h >> 33);
+}
+
+// Adds table noise to n bytes with saturation: out = clamp(in + noise, 0, 255).
+void add_noise(uint8_t* data, const int8_t* noise, std::size_t n) {
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  const __m128i bias = _mm_set1_epi8(static_cast<char>(0x80));
+  for (; i + 16 <= n; i += 16) {
+    const __m128i v = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(data + i)), bias);
+    const __m128i z = _mm_loadu_si128(reinterpret_cast<const __m128i*>(noise + i));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(data + i), _mm_xor_si128(_mm_adds_epi8(v, z), bias));
+  }
+#endif
+  for (; i < n; ++i) data[i] = static_cast<uint8_t>(std::clamp(data[i] + noise[i], 0, 255));
+}
+
+constexpr std::size_t kNoiseWindow = 1 << 20;
+
+}  // namespace
+
+struct SimulatedStudio::Impl {
+  StudioOptions options;
+  Actor actor;
+  std::vector<Camera> cameras;
+  std::vector<CameraCache> caches;
+  std::vector<int8_t> noise;  // N(0, sigma) per byte, kNoiseWindow longer than any image
+
+  explicit Impl(const StudioOptions& o) : options(o), actor(o.actor) {}
+
+  detail::PreparedFrame prepare(int64_t frame) const {
+    detail::PreparedFrame f;
+    f.truth.frame = frame;
+    f.truth.time = static_cast<double>(frame) / options.fps;
+    f.truth.pose = actor.pose_at(f.truth.time);
+    f.truth.body = actor.body(f.truth.pose, f.truth.time);
+    if (options.motion_blur) {
+      const double exposure = options.shutter / options.fps;
+      for (int k = 0; k < options.blur_samples; ++k) {
+        const double t =
+            f.truth.time + exposure * ((k + 0.5) / options.blur_samples - 0.5);
+        f.blur_bodies.push_back(actor.body_at(t));
+      }
+    }
+    f.shadow = detail::make_shadow(f.truth.body, options.shadow);
+    return f;
+  }
+
+  void render(int index, const detail::PreparedFrame& f, Image<Rgb8>* image, Mask* mask,
+              Image<uint8_t>* matte) const {
+    const CameraCache& cam = caches.at(index);
+    const int W = cam.camera.width, H = cam.camera.height;
+    Image<Rgb8> local_image;
+    Mask local_mask;
+    if (image == nullptr) image = &local_image;
+    if (mask == nullptr) mask = &local_mask;
+    if (image->width() != W || image->height() != H) *image = Image<Rgb8>(W, H);
+    if (mask->width() != W || mask->height() != H) *mask = Mask(W, H);
+    std::memcpy(image->data(), cam.background.data(), sizeof(Rgb8) * W * H);
+    std::memset(mask->data(), 0, static_cast<std::size_t>(W) * H);
+    if (matte) *matte = Image<uint8_t>(W, H, 0);
+    detail::render_actor(options, cam, f, image, mask, matte);
+    if (options.noise_sigma > 0) {
+      const uint64_t key = mix(mix(options.seed, static_cast<uint64_t>(f.truth.frame)),
+                               static_cast<uint64_t>(index));
+      add_noise(reinterpret_cast<uint8_t*>(image->data()), noise.data() + key % kNoiseWindow,
+                sizeof(Rgb8) * W * H);
+    }
+  }
+};
+
+SimulatedStudio::SimulatedStudio(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+SimulatedStudio::SimulatedStudio(SimulatedStudio&&) noexcept = default;
+SimulatedStudio& SimulatedStudio::operator=(SimulatedStudio&&) noexcept = default;
+SimulatedStudio::~SimulatedStudio() = default;
+
+Expected<SimulatedStudio> SimulatedStudio::create(std::vector<Camera> cameras,
+                                                  const StudioOptions& options) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  if (cameras.empty()) return fail("simulated studio needs at least one camera");
+  std::size_t max_bytes = 0;
+  for (const Camera& c : cameras) {
+    const auto& k = c.intrinsics;
+    if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384) {
+      return fail(detail::cat("camera '", c.id, "': size ", c.width, "x", c.height, " outside [1, 16384]"));
+    }
+    if (!(k.fx > 0 && k.fy > 0 && std::isfinite(k.cx) && std::isfinite(k.cy) &&
+          std::isfinite(k.skew))) {
+      return fail(detail::cat("camera '", c.id, "': focal lengths must be positive and finite"));
+    }
+    if (!c.cam_from_world.translation.allFinite() || !c.cam_from_world.rotation.coeffs().allFinite()) {
+      return fail(detail::cat("camera '", c.id, "': cam_from_world is not finite"));
+    }
+    max_bytes = std::max(max_bytes, sizeof(Rgb8) * c.width * c.height);
+  }
+  auto impl = std::make_unique<Impl>(options);
+  impl->cameras = std::move(cameras);
+  if (options.noise_sigma > 0) {
+    impl->noise.resize(max_bytes + kNoiseWindow);
+    std::mt19937_64 rng(mix(options.seed, 0xC0FFEE));
+    std::normal_distribution<double> gauss(0.0, options.noise_sigma);
+    for (int8_t& v : impl->noise) v = static_cast<int8_t>(std::clamp(std::lround(gauss(rng)), -127L, 127L));
+  }
+  const Image<Rgb8> projection = options.projection.pixels().empty() ? builtin_projection()
+                                                                     : options.projection;
+  impl->caches.resize(impl->cameras.size());
+  // Backgrounds are independent per camera: build them on the worker threads too.
+  std::atomic<std::size_t> next{0};
+  auto build = [&] {
+    for (std::size_t i; (i = next++) < impl->cameras.size();) {
+      CameraCache& cache = impl->caches[i];
+      cache.camera = impl->cameras[i];
+      cache.pinhole = cache.camera.distortion.is_identity();
+      cache.R = cache.camera.cam_from_world.R();
+      cache.t = cache.camera.cam_from_world.translation;
+      cache.centre = cache.camera.centre_in_world();
+      if (!cache.pinhole) {
+        const auto& k = cache.camera.intrinsics;
+        cache.rays.resize(static_cast<std::size_t>(cache.camera.width) * cache.camera.height);
+        for (int v = 0; v < cache.camera.height; ++v) {
+          for (int u = 0; u < cache.camera.width; ++u) {
+            const double y = (v - k.cy) / k.fy;
+            cache.rays[static_cast<std::size_t>(v) * cache.camera.width + u] = undistort(
+                cache.camera.distortion, Eigen::Vector2d((u - k.cx - k.skew * y) / k.fx, y));
+          }
+        }
+      }
+      build_background(impl->options, projection, &cache);
+    }
+  };
+  {
+    std::vector<std::jthread> workers;
+    for (int t = 1; t < options.threads; ++t) workers.emplace_back(build);
+    build();
+  }
+  return SimulatedStudio(std::move(impl));
+}
+
+const StudioOptions& SimulatedStudio::options() const { return impl_->options; }
+const Actor& SimulatedStudio::actor() const { return impl_->actor; }
+const std::vector<Camera>& SimulatedStudio::cameras() const { return impl_->cameras; }
+const Image<Rgb8>& SimulatedStudio::background(int camera) const {
+  return impl_->caches.at(camera).background;
+}
+
+FrameTruth SimulatedStudio::truth(int64_t frame) const {
+  FrameTruth t;
+  t.frame = frame;
+  t.time = time_of(frame);
+  t.pose = impl_->actor.pose_at(t.time);
+  t.body = impl_->actor.body(t.pose, t.time);
+  return t;
+}
+
+void SimulatedStudio::render(int camera, int64_t frame, Image<Rgb8>* image, Mask* true_mask,
+                             Image<uint8_t>* true_matte) const {
+  impl_->render(camera, impl_->prepare(frame), image, true_mask, true_matte);
+}
+
+FrameTruth SimulatedStudio::render_all(int64_t frame, std::vector<Image<Rgb8>>* images,
+                                       std::vector<Mask>* true_masks,
+                                       std::vector<Image<uint8_t>>* true_mattes) const {
+  const detail::PreparedFrame f = impl_->prepare(frame);
+  const int n = camera_count();
+  if (images) images->resize(n);
+  if (true_masks) true_masks->resize(n);
+  if (true_mattes) true_mattes->resize(n);
+  std::atomic<int> next{0};
+  auto work = [&] {
+    for (int i; (i = next++) < n;) {
+      impl_->render(i, f, images ? &(*images)[i] : nullptr, true_masks ? &(*true_masks)[i] : nullptr,
+                    true_mattes ? &(*true_mattes)[i] : nullptr);
+    }
+  };
+  {
+    std::vector<std::jthread> workers;
+    for (int t = 1; t < std::min(impl_->options.threads, n); ++t) workers.emplace_back(work);
+    work();
+  }
+  return f.truth;
+}
+
+}  // namespace studio::sim
