@@ -41,9 +41,9 @@ const char kCameraHelp[] =
     "  set   sends CameraControl (studio/camera/control) and waits for the camera's read-back:\n"
     "        prints the value the camera applied (it may clamp it to its range); exit 1 when the\n"
     "        camera reports an error for FEATURE or no read-back arrives within --wait S\n"
-    "        (default 10). Features the camera does not report (commands such as KeyerPlate N) "
-    "are\n"
-    "        confirmed by the absence of an error in the next state.\n"
+    "        (default 10). Features the camera does not report (commands such as KeyerPlate N)\n"
+    "        are confirmed by the absence of an error naming them in the states of the next\n"
+    "        second.\n"
     "\n"
     "Common options: --domain N, --dds-config FILE, --json, --help.\n";
 
