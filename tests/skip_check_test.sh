@@ -37,6 +37,13 @@ no middlebury_dino (shared test data)
   <testcase name="Wire.Echo" classname="Wire.Echo" time="0.02" status="run"><system-out/></testcase>
 </testsuite>
 XML
+cat >"$dir/disabled.xml" <<'XML'
+<?xml version="1.0" encoding="UTF-8"?>
+<testsuite name="(empty)" tests="2" failures="0" disabled="1" skipped="0" hostname="" time="0">
+  <testcase name="Keyer.Analysis" classname="Keyer.Analysis" time="0" status="disabled"><system-out>Disabled</system-out></testcase>
+  <testcase name="Hull.Cuts" classname="Hull.Cuts" time="0.02" status="run"><system-out/></testcase>
+</testsuite>
+XML
 cat >"$dir/clean.xml" <<'XML'
 <?xml version="1.0" encoding="UTF-8"?>
 <testsuite name="(empty)" tests="1" failures="0" disabled="0" skipped="0" hostname="" time="0">
@@ -62,6 +69,11 @@ expect "allow-list entry without a reason is refused" 1 'needs a reason' -- \
 expect "dataset skip with missing data says so" 1 'shared test data is missing: .*/nowhere does not exist' -- \
   --junit "$dir/junit.xml" --allow-list "$dir/empty.txt" --tests-json "$dir/tests.json" \
   --shared-data "$dir/nowhere"
+expect "a disabled test counts as skipped" 1 'Keyer.Analysis: disabled' -- \
+  --junit "$dir/disabled.xml" --allow-list "$dir/empty.txt"
+printf 'Keyer.Analysis  an analysis aid that asserts nothing\n' >"$dir/disabled-listed.txt"
+expect "a listed disabled test passes" 0 '2 tests, 1 skipped: 1 allowed' -- \
+  --junit "$dir/disabled.xml" --allow-list "$dir/disabled-listed.txt"
 expect "no skips passes" 0 '1 tests, 0 skipped' -- \
   --junit "$dir/clean.xml" --allow-list "$dir/empty.txt"
 expect "missing report fails" 1 'cannot read the ctest report' -- \

@@ -41,9 +41,9 @@ const char kCameraHelp[] =
     "  set   sends CameraControl (studio/camera/control) and waits for the camera's read-back:\n"
     "        prints the value the camera applied (it may clamp it to its range); exit 1 when the\n"
     "        camera reports an error for FEATURE or no read-back arrives within --wait S\n"
-    "        (default 10). Features the camera does not report (commands such as KeyerPlate N) "
-    "are\n"
-    "        confirmed by the absence of an error in the next state.\n"
+    "        (default 10). Features the camera does not report (commands such as KeyerPlate N)\n"
+    "        are confirmed by the absence of an error naming them in the states of the next\n"
+    "        second.\n"
     "\n"
     "Common options: --domain N, --dds-config FILE, --json, --help.\n";
 
@@ -336,9 +336,13 @@ int camera(const std::string& verb, const Args& a) {
 
   // The camera publishes its state right after handling a control: the first fresh state that
   // shows the value (or a change, when the camera clamped it) or an error naming the feature.
+  // A feature without read-back (a command such as KeyerPlate) has no value to wait for: a
+  // periodic state may arrive before the control was handled, so every state of the next
+  // second is checked for an error naming it.
   std::string error;
   bool done = false;
-  states->poll_until(deadline, [&](auto& latest, auto& fresh) {
+  const auto settle = std::min(deadline, Clock::now() + std::chrono::seconds(1));
+  states->poll_until(reported ? deadline : settle, [&](auto& latest, auto& fresh) {
     if (!fresh.count(cam)) return false;
     const auto& s = *latest.at(cam);
     const std::string err(wire::str(s.error));
@@ -349,11 +353,12 @@ int camera(const std::string& verb, const Args& a) {
       return true;
     }
     const studio_CameraFeature* f = find_feature(s, feature);
-    if (!reported) return done = true;  // no read-back for this feature, and no error
+    if (!reported) return false;  // keep watching until `settle`
     if (f && (f->value == value || f->value != old_value)) return done = true;
     return false;
   });
   if (!error.empty()) return complain(what, cam + ": " + error);
+  if (!reported) done = true;  // no error within the settle time
   if (!done)
     return complain(what, cam + ": no read-back of " + feature + " within " +
                               std::to_string(*wait).substr(0, 4) + " s");

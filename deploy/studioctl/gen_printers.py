@@ -5,7 +5,8 @@ the build tree and is never committed).
 For every struct of the IDL it writes print_<Struct>(Printer&, const studio_<Struct>&) that visits
 each member by its IDL name (arrays as arrays, enums by name, nested structs as objects), a key
 function (the @key members joined by '/'), and a table of the structs that have a topic
-descriptor (all top-level structs: idlc makes one for each). A construct this script does not know
+descriptor (every struct idlc makes one for: all but @nested ones, or only the @topic ones when
+any struct is annotated @topic). A construct this script does not know
 stops the build with the IDL line, so a new IDL type can never be silently unprintable.
 
 usage: gen_printers.py studio.idl OUT.h OUT.cc
@@ -50,6 +51,10 @@ class Parser:
         self.enums = {}     # name -> [enumerators]
         self.structs = []   # (name, [member dict])
         self.struct_names = set()
+        self.nested = set()
+        self.topics = set()
+        self.scope = []     # enclosing modules
+        self.c_name = {}    # IDL name -> C name (idlc: modules joined by '_')
 
     def peek(self):
         return self.t[self.i][0] if self.i < len(self.t) else None
@@ -77,12 +82,13 @@ class Parser:
             annotations.append(self.next())
         kw = self.next()
         if kw == "module":
-            self.next()
+            self.scope.append(self.next())
             self.expect("{")
             while self.peek() != "}":
                 self.definition()
             self.expect("}")
             self.expect(";")
+            self.scope.pop()
         elif kw == "enum":
             name = self.next()
             self.expect("{")
@@ -94,6 +100,10 @@ class Parser:
             self.expect("}")
             self.expect(";")
             self.enums[name] = values
+            prefix = "".join(m + "_" for m in self.scope)
+            self.c_name[name] = prefix + name
+            for v in values:
+                self.c_name[name + "::" + v] = prefix + v
         elif kw == "const":
             while self.next() != ";":
                 pass
@@ -107,6 +117,13 @@ class Parser:
             self.expect(";")
             self.structs.append((name, members))
             self.struct_names.add(name)
+            self.c_name[name] = "".join(m + "_" for m in self.scope) + name
+            # idlc makes no topic descriptor for a @nested struct (nor, once any struct says
+            # @topic, for the others): those are printed only inside their parents.
+            if "@nested" in annotations or any(a.startswith("@nested(TRUE") for a in annotations):
+                self.nested.add(name)
+            if any(a == "@topic" or a.startswith("@topic(") for a in annotations):
+                self.topics.add(name)
         else:
             raise IdlError(f"line {self.line()}: studioctl's printer generator does not know '{kw}'")
 
@@ -224,14 +241,14 @@ def generate(parser, idl_path):
         c.append(f"const char* enum_name_{name}(int64_t v) {{")
         c.append("  switch (v) {")
         for v in values:
-            c.append(f"    case studio_{v}: return \"{v}\";")
+            c.append(f"    case {parser.c_name[name + '::' + v]}: return \"{v}\";")
         c.append("  }")
         c.append("  return nullptr;")
         c.append("}")
     for name, _ in parser.structs:
-        c.append(f"void print_{name}(Printer& p, const studio_{name}& s);")
+        c.append(f"void print_{name}(Printer& p, const {parser.c_name[name]}& s);")
     for name, members in parser.structs:
-        c.append(f"void print_{name}(Printer& p, const studio_{name}& s) {{")
+        c.append(f"void print_{name}(Printer& p, const {parser.c_name[name]}& s) {{")
         for m in members:
             c.append(f"  p.key(\"{m['name']}\");")
             ty = m["type"]
@@ -245,7 +262,7 @@ def generate(parser, idl_path):
         c.append("}")
         keys = [m for m in members if m["key"]]
         c.append(f"std::string key_{name}(const void* v) {{")
-        c.append(f"  [[maybe_unused]] const auto& s = *static_cast<const studio_{name}*>(v);")
+        c.append(f"  [[maybe_unused]] const auto& s = *static_cast<const {parser.c_name[name]}*>(v);")
         c.append("  std::string k;")
         for i, m in enumerate(keys):
             if i:
@@ -257,10 +274,13 @@ def generate(parser, idl_path):
         c.append("  return k;")
         c.append("}")
     c.append("}  // namespace")
-    c.append(f"constexpr std::array<IdlType, {len(parser.structs)}> kTypes{{{{")
-    for name, _ in parser.structs:
-        c.append(f"  {{\"{name}\", &studio_{name}_desc, [](Printer& p, const void* s) "
-                 f"{{ print_{name}(p, *static_cast<const studio_{name}*>(s)); }}, &key_{name}}},")
+    with_descriptor = [name for name, _ in parser.structs
+                       if name not in parser.nested and (not parser.topics or name in parser.topics)]
+    c.append(f"constexpr std::array<IdlType, {len(with_descriptor)}> kTypes{{{{")
+    for name in with_descriptor:
+        cn = parser.c_name[name]
+        c.append(f"  {{\"{name}\", &{cn}_desc, [](Printer& p, const void* s) "
+                 f"{{ print_{name}(p, *static_cast<const {cn}*>(s)); }}, &key_{name}}},")
     c.append("}};")
     c.append("std::span<const IdlType> idl_types() { return kTypes; }")
     c.append("}  // namespace studio::ctl")

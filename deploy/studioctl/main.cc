@@ -8,6 +8,7 @@
 
 #include "studioctl/cli.h"
 #include "studioctl/control.h"
+#include "studioctl/doctor.h"
 #include "studioctl/status.h"
 #include "studioctl/topics.h"
 
@@ -20,6 +21,8 @@ const char kHelp[] =
     "  topic list|info|hz|echo [TOPIC]              topics of the domain; samples with IDL names\n"
     "  capture start|stop [--take NAME] [--at-frame N]   frame-accurate recording on every camera\n"
     "  camera get|set CAM [FEATURE [VALUE]]        camera features, with the camera's read-back\n"
+    "  doctor                                       checks this host against the DDS profile, says "
+    "what to fix\n"
     "\n"
     "Every command takes:\n"
     "  --domain N         DDS domain id (default: $STUDIO_DDS_DOMAIN, else Cyclone's default)\n"
@@ -52,7 +55,7 @@ int main(int argc, char** argv) {
   const std::string command = args[0];
   std::vector<std::string> rest(args.begin() + 1, args.end());
   // Leading common flags go after the verb (topic list --json), where every parser accepts them.
-  const std::size_t at = (command == "status" || rest.empty()) ? 0 : 1;
+  const std::size_t at = (command == "status" || command == "doctor" || rest.empty()) ? 0 : 1;
   rest.insert(rest.begin() + std::ptrdiff_t(std::min(at, rest.size())), leading.begin(),
               leading.end());
   try {
@@ -60,8 +63,10 @@ int main(int argc, char** argv) {
     if (command == "topic") return topic_command(rest);
     if (command == "capture") return capture_command(rest);
     if (command == "camera") return camera_command(rest);
+    if (command == "doctor") return doctor_command(rest);
   } catch (const std::exception& e) {
     return complain(command, std::string("internal error: ") + e.what());
   }
-  return complain(command, "unknown command (status, topic, capture, camera; see --help)", 2);
+  return complain(command, "unknown command (status, topic, capture, camera, doctor; see --help)",
+                  2);
 }

@@ -122,6 +122,9 @@ int status_command(const std::vector<std::string>& argv) {
                   st.pid, st.input_hz, st.output_hz, st.latency_ms, age);
     }
   }
+  if (seen.empty() && !a->common.json)
+    std::fprintf(stderr, "studioctl status: no service heard within %.1f s on this domain\n",
+                 *wait);
   std::fflush(stdout);
 
   std::string missing;

@@ -98,8 +98,10 @@ class StudioctlTest : public studio::testing::ProcessTest {
 
   // Runs studioctl in this test's DDS domain (the fixture exported it into this process's
   // environment) and collects stdout and stderr.
-  Run studioctl(const std::vector<std::string>& args) {
-    std::string cmd = studio::testing::built_binary("deploy/studioctl/studioctl").string();
+  // prefix: prepended to the command line (environment overrides, a wrapper such as unshare).
+  Run studioctl(const std::vector<std::string>& args, const std::string& prefix = "") {
+    std::string cmd =
+        prefix + " " + studio::testing::built_binary("deploy/studioctl/studioctl").string();
     for (const auto& a : args) cmd += " '" + a + "'";
     const fs::path err = dir_ / ("studioctl." + std::to_string(runs_++) + ".err");
     cmd += " 2>'" + err.string() + "'";
@@ -155,7 +157,8 @@ TEST_F(StudioctlTest, HelpEverywhereAndBadUsageIsOneLine) {
                                         {"capture", "--help"},
                                         {"capture", "start", "--help"},
                                         {"camera", "--help"},
-                                        {"camera", "set", "--help"}}) {
+                                        {"camera", "set", "--help"},
+                                        {"doctor", "--help"}}) {
     auto r = studioctl(args);
     EXPECT_EQ(r.code, 0) << args[0] << r.err;
     EXPECT_NE(r.out.find("usage: studioctl"), std::string::npos) << r.out;
@@ -236,6 +239,14 @@ TEST_F(StudioctlTest, EveryIdlTopicEchoesAsJsonWithTheIdlMemberNames) {
       studioctl({"topic", "echo", "studio/camera/mask", "--count", "1", "--timeout", "20"});
   EXPECT_NE(mask_text.out.find("values)]"), std::string::npos) << mask_text.out;
   EXPECT_NE(mask_text.out.find("encoding: MASK_RUNS"), std::string::npos) << mask_text.out;
+
+  // One instance only: --key (the publisher writes masks of cam0..cam3).
+  auto one = studioctl({"topic", "echo", "studio/camera/mask", "--json", "--count", "3", "--key",
+                        "cam2", "--timeout", "20"});
+  ASSERT_EQ(one.code, 0) << one.err;
+  auto cam2 = json_lines(one);
+  ASSERT_EQ(cam2.size(), 3u);
+  for (const auto& j : cam2) EXPECT_EQ(j.find("camera_id")->string, "cam2");
 
   // A second parser agrees: python3's json module reads every line.
   const std::string file = write_file("echo.jsonl", all_json);
@@ -399,7 +410,7 @@ TEST_F(StudioctlTest, CaptureStartAtAFrameProducesATakeFromThatFrame) {
     for (const auto& j : json_lines(state)) now = uint64_t(j.find("frame")->number);
   }
   ASSERT_GT(now, 0u);
-  const uint64_t start = now + 40;  // 1.6 s ahead at 25 fps
+  const uint64_t start = now + 100;  // 4 s ahead at 25 fps: room for a loaded machine
 
   auto started = studioctl(
       {"capture", "start", "--take", "ctl_take", "--at-frame", std::to_string(start), "--json"});
@@ -420,7 +431,7 @@ TEST_F(StudioctlTest, CaptureStartAtAFrameProducesATakeFromThatFrame) {
     if (!recording) std::this_thread::sleep_for(200ms);
   }
   ASSERT_TRUE(recording);
-  auto stopped = studioctl({"capture", "stop", "--lead", "10"});
+  auto stopped = studioctl({"capture", "stop"});
   ASSERT_EQ(stopped.code, 0) << stopped.err;
   EXPECT_NE(stopped.out.find("take ctl_take stops at frame"), std::string::npos) << stopped.out;
 
@@ -432,7 +443,19 @@ TEST_F(StudioctlTest, CaptureStartAtAFrameProducesATakeFromThatFrame) {
     std::this_thread::sleep_for(100ms);
   }
   EXPECT_NE(text.find("start_frame: " + std::to_string(start) + "\n"), std::string::npos) << text;
-  EXPECT_NE(text.find("first_frame: " + std::to_string(start) + "\n"), std::string::npos) << text;
+  // The take covers [start, stop) exactly: every frame of it is recorded or counted as a drop (a
+  // loaded machine may drop the first frames; then first_frame is later by as many drops).
+  auto value_of = [&](const std::string& key) -> int64_t {
+    const auto at = text.find("\n" + key + ": ");
+    return at == std::string::npos ? -1 : std::stoll(text.substr(at + key.size() + 3));
+  };
+  const int64_t stop = value_of("stop_frame"), first = value_of("first_frame");
+  const int64_t frames = value_of("frames"), drops = value_of("drops");
+  ASSERT_GT(stop, int64_t(start)) << text;
+  EXPECT_EQ(frames + drops, stop - int64_t(start)) << text;
+  EXPECT_GE(first, int64_t(start)) << text;
+  EXPECT_LE(first - int64_t(start), drops) << text;
+  EXPECT_GT(frames, 0) << text;
   EXPECT_NE(text.find("status: complete"), std::string::npos) << text;
   EXPECT_GT(fs::file_size(dir_ / "takes/ctl_take/cam0/frames.raw"), 0u);
 
@@ -453,6 +476,81 @@ TEST_F(StudioctlTest, CommandsWithoutAServiceFailClearly) {
   auto e = studioctl({"topic", "echo", "studio/actor/head", "--count", "1", "--timeout", "1"});
   EXPECT_EQ(e.code, 1);
   EXPECT_NE(e.err.find("timed out after 0 of 1 samples"), std::string::npos) << e.err;
+}
+
+// doctor: every check passes on the test profile (the clock may only warn); each injected fault
+// (a profile naming a missing interface, a buffer minimum above net.core.rmem_max, an unreadable
+// profile, a host without a multicast route) fails its check with the fix, and exits 1.
+TEST_F(StudioctlTest, DoctorPassesOnTheTestProfileAndNamesEachInjectedFault) {
+  auto checks_of = [&](const Run& r) {
+    std::map<std::string, Json> out;
+    for (auto& j : json_lines(r)) out[j.find("check")->string] = j;
+    return out;
+  };
+  auto ok = studioctl({"doctor", "--json"});
+  EXPECT_EQ(ok.code, 0) << ok.out << ok.err;
+  auto c = checks_of(ok);
+  for (const char* name :
+       {"profile", "interfaces", "socket_buffers", "multicast_route", "participant"})
+    EXPECT_EQ(c[name].find("status")->string, "ok") << name << ": " << ok.out;
+  EXPECT_NE(c["clock"].find("status")->string, "fail");
+  auto text = studioctl({"doctor"});
+  EXPECT_NE(text.out.find("ok   interfaces: interfaces: lo"), std::string::npos) << text.out;
+
+  const std::string loopback = slurp(fs::path(STUDIO_SOURCE_DIR) / "deploy/dds/loopback.xml");
+  auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
+    std::string x = loopback;
+    const auto at = x.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) x.replace(at, from.size(), to);
+    return write_file(name, x);
+  };
+  auto no_if = studioctl(
+      {"doctor", "--json", "--dds-config", variant("noif.xml", "name=\"lo\"", "name=\"studio9\"")});
+  EXPECT_EQ(no_if.code, 1);
+  c = checks_of(no_if);
+  EXPECT_EQ(c["interfaces"].find("status")->string, "fail");
+  EXPECT_NE(c["interfaces"].find("message")->string.find("studio9 does not exist"),
+            std::string::npos)
+      << no_if.out;
+  EXPECT_NE(c["interfaces"].find("fix")->string.find("ip link set"), std::string::npos);
+
+  auto big = studioctl({"doctor", "--json", "--dds-config",
+                        variant("big.xml", "SocketReceiveBufferSize min=\"1MB\"",
+                                "SocketReceiveBufferSize min=\"1GB\"")});
+  EXPECT_EQ(big.code, 1);
+  c = checks_of(big);
+  EXPECT_EQ(c["socket_buffers"].find("status")->string, "fail") << big.out;
+  EXPECT_NE(c["socket_buffers"].find("fix")->string.find("sysctl -w net.core.rmem_max=1000000000"),
+            std::string::npos)
+      << big.out;
+
+  auto missing =
+      studioctl({"doctor", "--json"}, "CYCLONEDDS_URI=file://" + (dir_ / "absent.xml").string());
+  EXPECT_EQ(missing.code, 1);
+  c = checks_of(missing);
+  EXPECT_EQ(c["profile"].find("status")->string, "fail");
+  EXPECT_NE(c["profile"].find("message")->string.find("absent.xml cannot be read"),
+            std::string::npos)
+      << missing.out;
+
+  // A host with only lo (a fresh network namespace) and a profile that auto-detects: no multicast
+  // route and no usable interface.
+  const std::string autodetect = write_file(
+      "auto.xml", "<CycloneDDS xmlns=\"https://cdds.io/config\"><Domain Id=\"any\"/></CycloneDDS>");
+  auto isolated = studioctl({"doctor", "--json", "--dds-config", autodetect},
+                            "unshare -n sh -c 'ip link set lo up && exec \"$0\" \"$@\"'");
+  EXPECT_EQ(isolated.code, 1) << isolated.err;
+  c = checks_of(isolated);
+  ASSERT_TRUE(c.count("multicast_route")) << isolated.out << isolated.err;
+  EXPECT_EQ(c["multicast_route"].find("status")->string, "fail") << isolated.out;
+  EXPECT_NE(c["multicast_route"].find("fix")->string.find("ip route add 224.0.0.0/4"),
+            std::string::npos);
+  EXPECT_EQ(c["interfaces"].find("status")->string, "fail") << isolated.out;
+  // Positive control of the same profile on this host (it has a routed, multicast interface).
+  auto host = studioctl({"doctor", "--json", "--dds-config", autodetect});
+  c = checks_of(host);
+  EXPECT_EQ(c["multicast_route"].find("status")->string, "ok") << host.out;
 }
 
 }  // namespace

@@ -17,7 +17,7 @@ const char kTopicHelp[] =
     "usage: studioctl topic list [--all] [--wait S] [--json]\n"
     "       studioctl topic info TOPIC [--wait S] [--json]\n"
     "       studioctl topic hz TOPIC [--window S] [--count N] [--json]\n"
-    "       studioctl topic echo TOPIC [--count N] [--timeout S] [--json]\n"
+    "       studioctl topic echo TOPIC [--count N] [--timeout S] [--key KEY] [--json]\n"
     "\n"
     "  list   topics seen on the domain (Cyclone's DCPSPublication/DCPSSubscription): name, type,\n"
     "         writer and reader counts, hosts, and the QoS of the studio table for known topics.\n"
@@ -30,8 +30,9 @@ const char kTopicHelp[] =
     "  echo   every sample of TOPIC as text (long arrays summarised), or with --json one JSON\n"
     "         object per sample per line with the IDL's member names (arrays in full, enums by\n"
     "         name). --count N: stop after N samples; --timeout S: fail (exit 1) when fewer\n"
-    "         arrived within S seconds. Malformed samples (the wire validators) are printed too,\n"
-    "         and reported on stderr.\n"
+    "         arrived within S seconds; --key KEY: only the instance whose @key members, joined\n"
+    "         by '/', are KEY (e.g. cam0, or capture/cam0 for studio/service/status). Malformed\n"
+    "         samples (the wire validators) are printed too, and reported on stderr.\n"
     "\n"
     "JSON output is one object per line. Common options: --domain N, --dds-config FILE\n"
     "(default $STUDIO_DDS_DOMAIN, $CYCLONEDDS_URI), --json, --help.\n";
@@ -76,6 +77,11 @@ int list(const Args& a) {
     for (const auto& row : wire::topic_table())
       if (!topics.contains(row.name)) topics[row.name].type = row.descriptor->m_typename;
 
+  if (topics.empty() && !a.common.json)
+    std::fprintf(
+        stderr,
+        "studioctl topic list: no topic seen within %.1f s (--all lists the studio table)\n",
+        *wait);
   if (!a.common.json)
     std::printf("%-32s %-28s %3s %3s  %-16s %s\n", "TOPIC", "TYPE", "W", "R", "HOSTS",
                 "QOS (studio table)");
@@ -203,6 +209,7 @@ int echo(const Args& a) {
   if (!count) return complain("topic echo", count.error().message, 2);
   auto timeout = seconds_flag(a, "--timeout", 0, 0.1, 1e6);
   if (!timeout) return complain("topic echo", timeout.error().message, 2);
+  const std::string* key = a.value("--key");
   std::optional<wire::Participant> p;
   auto reader = open_named(a, "topic echo", p);
   if (!reader)
@@ -221,6 +228,7 @@ int echo(const Args& a) {
     }
     auto n = reader->next(left, [&](const RawSample& s) {
       if (*count != 0 && printed >= *count) return;
+      if (key && reader->type().key(s.data) != *key) return;
       if (s.rejected)
         std::fprintf(stderr, "studioctl topic echo: sample %s is malformed (%s)\n",
                      reader->type().key(s.data).c_str(),
@@ -365,7 +373,7 @@ int topic_command(const std::vector<std::string>& argv) {
   else if (verb == "info")
     a = parse_args(rest, {"--wait"});
   else if (verb == "echo")
-    a = parse_args(rest, {"--count", "--timeout"});
+    a = parse_args(rest, {"--count", "--timeout", "--key"});
   else if (verb == "hz")
     a = parse_args(rest, {"--window", "--count"});
   else
