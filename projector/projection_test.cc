@@ -222,7 +222,7 @@ TEST(ProjectionTest, TwoPassWarpLandsWhereTheEyeRayMeetsTheScreen) {
   }
 }
 
-TEST(ProjectionTest, SinglePassAndTwoPassAgreeAndPixelNdcRoundTrips) {
+TEST(ProjectionTest, PixelNdcConventionsRoundTrip) {
   const Eigen::Matrix3d m = pixel_from_ndc(1920, 1080) * ndc_from_pixel(1920, 1080);
   EXPECT_LE((m - Eigen::Matrix3d::Identity()).norm(), 1e-12);
   // Pixel centres: the top-left pixel centre is NDC (-1 + 1/W, 1 - 1/H).

@@ -1,0 +1,27 @@
+#pragma once
+// The actor mesh as the projector's mask uses it: the hull's triangle mesh in the studio frame
+// (the wire's studio/actor/mesh, converted by the node) with the capture time of the masks that
+// built it. Vertex normals are computed here (area-weighted), never trusted from the wire.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/error.h"
+
+namespace studio::projector {
+
+struct ActorMesh {
+  std::vector<Eigen::Vector3f> vertices;  // studio frame, metres
+  std::vector<std::array<uint32_t, 3>> triangles;
+  int64_t capture_ns = 0;  // CLOCK_REALTIME of the frame whose masks built the mesh
+
+  // Non-empty, every index in range, every vertex finite. One line naming the first problem.
+  Expected<void> validate() const;
+};
+
+// Unit area-weighted vertex normals (zero for vertices of no or only degenerate triangles).
+std::vector<Eigen::Vector3f> vertex_normals(const ActorMesh& mesh);
+
+}  // namespace studio::projector

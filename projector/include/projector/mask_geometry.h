@@ -1,0 +1,33 @@
+#pragma once
+// The grown actor mask as geometry a renderer draws (TCSVT 2004 §V-D: the actor mesh rendered
+// black from the projector's viewpoint with no depth test, enlarged by the security margin).
+// Two forms, same margin:
+// - grow_mesh(): every vertex pushed out along its area-weighted normal by margin / c, where c is
+//   the smallest cosine between the vertex normal and the normals of its triangles (clamped at
+//   min_cosine), so every triangle's plane moves out by at least the margin, also at the box-like
+//   edges and corners a hull mesh has. Same triangles; draw it like the mesh (no depth test, black,
+//   both faces). Self-overlaps in concave places are harmless: the mask is a union.
+// - dilation_radius_px(): the margin as a screen-space radius in projector pixels, for a renderer
+//   that dilates the mesh's silhouette (a max filter or a wide outline): margin * f / z_min with f
+//   the projector's larger focal length and z_min the nearest mesh vertex's depth in the projector
+//   frame (conservative: the radius of the nearest part, applied everywhere).
+
+#include "core/camera.h"
+#include "core/error.h"
+#include "projector/actor_mesh.h"
+
+namespace studio::projector {
+
+struct GrowOptions {
+  double min_cosine = 0.3;  // limits the push at needle-sharp vertices to margin / 0.3
+};
+
+// Errors: invalid mesh, negative or non-finite margin.
+Expected<ActorMesh> grow_mesh(const ActorMesh& mesh, double margin_m,
+                              const GrowOptions& options = {});
+
+// Errors: invalid mesh, negative margin, no vertex in front of the projector.
+Expected<double> dilation_radius_px(const Camera& projector, const ActorMesh& mesh,
+                                    double margin_m);
+
+}  // namespace studio::projector

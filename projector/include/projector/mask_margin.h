@@ -1,0 +1,76 @@
+#pragma once
+// The actor mask's security margin (TCSVT 2004 §V-D: the mesh drawn black from the projector,
+// "enlarged by a security margin" for latency and motion), computed instead of guessed.
+//
+// Latency L: from the capture of the frame whose masks built the mesh (ActorMesh::capture_ns) to
+// the moment the projector frame is shown; measured per frame by the node, summarised here by a
+// high quantile of a sliding window (LatencyWindow), so the margin covers the slow frames too.
+//
+// margin = clamp(floor + motion_term, floor, cap), with
+//   no prediction:    motion_term = v L
+//       v = max(|head velocity|, fastest mesh region) (projector/motion.h)
+//   with prediction:  motion_term = a L (L + dt) / 2 + sigma_v L
+//       The mesh is moved forward by its regions' mean velocity over the last two captures
+//       (dt apart, the velocity at t - dt/2). For a region with constant acceleration a, the true
+//       position at t + L differs from x(t) + v_mean L by (v(t) - v_mean) L + a L^2 / 2 =
+//       a L (L + dt) / 2. a = the largest region acceleration of the estimate, sigma_v the
+//       velocity estimate's uncertainty (configured).
+//   Prediction is used only when the motion has an acceleration estimate (the third mesh on) and
+//   agrees with the head tracker (the head is not faster than the fastest region by more than
+//   head_disagreement_mps); otherwise the no-prediction term applies.
+//   floor: what motion does not explain (the hull's own error, the mesh's resolution, calibration);
+//   cap: a margin so large it would black out too much of the scene: clamped and flagged.
+
+#include <cstdint>
+#include <deque>
+
+#include "core/error.h"
+#include "projector/motion.h"
+
+namespace studio::projector {
+
+struct MarginOptions {
+  double floor_m = 0.01;
+  double cap_m = 0.20;
+  bool prediction = true;
+  double velocity_uncertainty_mps = 0.05;  // sigma_v
+  double head_disagreement_mps = 0.5;
+  Expected<void> validate() const;
+};
+
+struct Margin {
+  double margin_m = 0;  // what to grow the mask by
+  double floor_m = 0;
+  double motion_m = 0;  // the motion term before clamping
+  double latency_s = 0;
+  double speed_mps = 0;          // v (no-prediction term)
+  double acceleration_mps2 = 0;  // a (prediction term)
+  bool predicted = false;        // the mesh is to be moved forward by latency_s
+  bool capped = false;
+};
+
+// latency_s: L; head_speed_mps: |head velocity| of the actor (0 if unknown); motion: the latest
+// mesh motion (nullptr if unknown). Errors: invalid options, negative or non-finite inputs.
+Expected<Margin> security_margin(const MarginOptions& options, double latency_s,
+                                 double head_speed_mps, const MeshMotion* motion);
+
+// A sliding window of measured latencies (seconds) and its quantile.
+class LatencyWindow {
+ public:
+  explicit LatencyWindow(size_t capacity = 100, double quantile = 0.95)
+      : capacity_(capacity), quantile_(quantile) {}
+  // capture_ns: the mesh's capture time; shown_ns: when the frame using it was shown (same clock).
+  // A negative or absurd (> 10 s) latency is rejected (false) and not kept.
+  bool add(int64_t capture_ns, int64_t shown_ns);
+  bool empty() const { return samples_.empty(); }
+  size_t size() const { return samples_.size(); }
+  // The configured quantile of the window (nearest rank), 0 when empty.
+  double latency_s() const;
+
+ private:
+  size_t capacity_;
+  double quantile_;
+  std::deque<double> samples_;
+};
+
+}  // namespace studio::projector

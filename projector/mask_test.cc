@@ -1,0 +1,408 @@
+// Actor mask: margin formula, motion estimation between re-tessellated meshes, prediction and the
+// grown mask. A mesh "covers" another when every vertex and face centre of the other lies inside it
+// (winding number, computed here independently of the library).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <random>
+
+#include "projector/actor_mesh.h"
+#include "projector/mask_geometry.h"
+#include "projector/mask_margin.h"
+#include "projector/motion.h"
+
+namespace studio::projector {
+namespace {
+
+constexpr int64_t kFrameNs = 40'000'000;  // 25 fps
+
+// UV sphere, rotated by `rotation` so that two frames never share a tessellation.
+ActorMesh sphere(const Eigen::Vector3d& centre, double radius, const Eigen::Matrix3d& rotation,
+                 int rings = 24, int segments = 48) {
+  ActorMesh m;
+  m.vertices.push_back((centre + rotation * Eigen::Vector3d(0, 0, radius)).cast<float>());
+  for (int i = 1; i < rings; ++i) {
+    const double theta = M_PI * i / rings;
+    for (int j = 0; j < segments; ++j) {
+      const double phi = 2 * M_PI * j / segments;
+      const Eigen::Vector3d d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                              std::cos(theta));
+      m.vertices.push_back((centre + rotation * (radius * d)).cast<float>());
+    }
+  }
+  m.vertices.push_back((centre + rotation * Eigen::Vector3d(0, 0, -radius)).cast<float>());
+  const uint32_t south = static_cast<uint32_t>(m.vertices.size() - 1);
+  auto at = [&](int ring, int j) {
+    return static_cast<uint32_t>(1 + (ring - 1) * segments + (j % segments));
+  };
+  for (int j = 0; j < segments; ++j) m.triangles.push_back({0, at(1, j), at(1, j + 1)});
+  for (int i = 1; i + 1 < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      m.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  for (int j = 0; j < segments; ++j)
+    m.triangles.push_back({at(rings - 1, j), south, at(rings - 1, j + 1)});
+  return m;
+}
+
+// Axis-aligned box with n cells per edge, vertices shared along edges (watertight), outward faces.
+ActorMesh box(const Eigen::Vector3d& centre, const Eigen::Vector3d& half, int n) {
+  ActorMesh m;
+  std::map<std::array<long, 3>, uint32_t> index;
+  auto vertex = [&](const Eigen::Vector3d& p) {
+    const std::array<long, 3> key = {std::lround(p.x() * 1e6), std::lround(p.y() * 1e6),
+                                     std::lround(p.z() * 1e6)};
+    auto [it, inserted] = index.emplace(key, static_cast<uint32_t>(m.vertices.size()));
+    if (inserted) m.vertices.push_back(p.cast<float>());
+    return it->second;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side : {-1, 1}) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      auto point = [&](int i, int j) -> Eigen::Vector3d {
+        Eigen::Vector3d p;
+        p(axis) = side * half(axis);
+        p(u) = -half(u) + 2 * half(u) * i / n;
+        p(v) = -half(v) + 2 * half(v) * j / n;
+        return centre + p;
+      };
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          const uint32_t a = vertex(point(i, j)), b = vertex(point(i + 1, j)),
+                         c = vertex(point(i + 1, j + 1)), d = vertex(point(i, j + 1));
+          if (side > 0) {
+            m.triangles.push_back({a, b, c});
+            m.triangles.push_back({a, c, d});
+          } else {
+            m.triangles.push_back({a, c, b});
+            m.triangles.push_back({a, d, c});
+          }
+        }
+    }
+  return m;
+}
+
+ActorMesh merge(const ActorMesh& a, const ActorMesh& b) {
+  ActorMesh m = a;
+  const uint32_t offset = static_cast<uint32_t>(a.vertices.size());
+  m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (auto t : b.triangles) m.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  return m;
+}
+
+// Winding number of a closed, outward-oriented mesh around p (1 inside, 0 outside).
+double winding(const ActorMesh& m, const Eigen::Vector3d& p) {
+  double total = 0;
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3d a = m.vertices[t[0]].cast<double>() - p,
+                          b = m.vertices[t[1]].cast<double>() - p,
+                          c = m.vertices[t[2]].cast<double>() - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    total += 2 * std::atan2(a.dot(b.cross(c)),
+                            la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+  }
+  return total / (4 * M_PI);
+}
+
+// Largest distance by which `truth` sticks out of `cover` (0 when covered): the points of truth
+// (vertices and face centres) outside cover, measured to cover's nearest vertex.
+struct Coverage {
+  int outside = 0;
+  int points = 0;
+};
+Coverage coverage(const ActorMesh& cover, const ActorMesh& truth) {
+  Coverage c;
+  auto check = [&](const Eigen::Vector3d& p) {
+    ++c.points;
+    if (winding(cover, p) < 0.5) ++c.outside;
+  };
+  for (const auto& v : truth.vertices) check(v.cast<double>());
+  for (const auto& t : truth.triangles)
+    check((truth.vertices[t[0]] + truth.vertices[t[1]] + truth.vertices[t[2]]).cast<double>() / 3);
+  return c;
+}
+
+Eigen::Matrix3d random_rotation(std::mt19937& rng) {
+  std::normal_distribution<double> n(0, 1);
+  return Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().toRotationMatrix();
+}
+
+// ---- margin formula ---------------------------------------------------------------------------
+
+TEST(MaskMargin, ComponentsFollowTheFormula) {
+  MarginOptions o;  // floor 10 mm, cap 200 mm, sigma_v 0.05 m/s
+  // No motion known: floor + head speed x latency.
+  auto m = security_margin(o, 0.08, 1.0, nullptr);
+  ASSERT_TRUE(m);
+  EXPECT_NEAR(m->margin_m, 0.01 + 1.0 * 0.08, 1e-12);
+  EXPECT_FALSE(m->predicted);
+  EXPECT_FALSE(m->capped);
+  // Mesh motion faster than the head, no acceleration estimate yet: the fastest region counts.
+  MeshMotion motion;
+  motion.dt_s = 0.04;
+  motion.max_speed_mps = 1.5;
+  m = security_margin(o, 0.08, 1.0, &motion);
+  ASSERT_TRUE(m);
+  EXPECT_NEAR(m->margin_m, 0.01 + 1.5 * 0.08, 1e-12);
+  EXPECT_FALSE(m->predicted);
+  // With an acceleration estimate: floor + a L (L + dt) / 2 + sigma_v L.
+  motion.max_acceleration_mps2 = 3.75;
+  m = security_margin(o, 0.06, 1.0, &motion);
+  ASSERT_TRUE(m);
+  EXPECT_TRUE(m->predicted);
+  EXPECT_NEAR(m->motion_m, 0.5 * 3.75 * 0.06 * (0.06 + 0.04) + 0.05 * 0.06, 1e-12);
+  EXPECT_NEAR(m->margin_m, 0.01 + m->motion_m, 1e-12);
+  EXPECT_NEAR(m->margin_m, 0.02425, 1e-9);
+  // Prediction switched off: back to v L.
+  MarginOptions off = o;
+  off.prediction = false;
+  EXPECT_NEAR(security_margin(off, 0.06, 1.0, &motion)->margin_m, 0.01 + 1.5 * 0.06, 1e-12);
+  // The head tracker disagrees with the mesh motion (head much faster): no prediction.
+  m = security_margin(o, 0.06, 2.5, &motion);
+  ASSERT_TRUE(m);
+  EXPECT_FALSE(m->predicted);
+  EXPECT_NEAR(m->margin_m, 0.01 + 2.5 * 0.06, 1e-12);
+  // Cap.
+  m = security_margin(o, 0.1, 5.0, nullptr);
+  ASSERT_TRUE(m);
+  EXPECT_TRUE(m->capped);
+  EXPECT_EQ(m->margin_m, 0.2);
+  EXPECT_NEAR(m->motion_m, 0.5, 1e-12);
+  // Still actor: the floor.
+  EXPECT_EQ(security_margin(o, 0.05, 0.0, nullptr)->margin_m, 0.01);
+  // Bad input.
+  EXPECT_FALSE(security_margin(o, -0.01, 1.0, nullptr));
+  EXPECT_FALSE(security_margin(o, NAN, 1.0, nullptr));
+  EXPECT_FALSE(security_margin(o, 0.05, -1.0, nullptr));
+  MarginOptions bad = o;
+  bad.cap_m = 0.001;
+  EXPECT_FALSE(security_margin(bad, 0.05, 1.0, nullptr));
+}
+
+TEST(MaskMargin, LatencyWindowTakesAHighQuantile) {
+  LatencyWindow w(100, 0.95);
+  EXPECT_EQ(w.latency_s(), 0);
+  for (int i = 1; i <= 100; ++i) ASSERT_TRUE(w.add(1'000'000'000, 1'000'000'000 + i * 1'000'000));
+  EXPECT_NEAR(w.latency_s(), 0.095, 1e-12);
+  // Older samples leave the window.
+  for (int i = 0; i < 100; ++i) ASSERT_TRUE(w.add(0, 20'000'000));
+  EXPECT_NEAR(w.latency_s(), 0.020, 1e-12);
+  EXPECT_EQ(w.size(), 100u);
+  // Rejected: shown before captured, or absurdly late.
+  EXPECT_FALSE(w.add(100, 50));
+  EXPECT_FALSE(w.add(0, 11'000'000'000));
+  EXPECT_EQ(w.size(), 100u);
+}
+
+// ---- motion and prediction --------------------------------------------------------------------
+
+struct Outcome {
+  double needed_m = 0;  // smallest margin (1 mm steps) at which the prediction covers the truth
+  double margin_m = 0;
+  double no_prediction_margin_m = 0;
+  Coverage predicted;      // the predicted mesh grown by the margin vs the truth at display time
+  Coverage unpredicted;    // the last mesh grown by the same margin (must fail: the test can fail)
+  Coverage no_prediction;  // the last mesh grown by the no-prediction margin
+  MeshMotion motion;
+};
+
+// Feeds three consecutive meshes of `at(frame)` (re-tessellated each frame), then predicts the
+// last one to display time and compares with the truth there.
+template <class MeshAt>
+Outcome run(MeshAt at, double latency_s, const MarginOptions& margin_options = {}) {
+  MotionTracker tracker;
+  std::optional<MeshMotion> motion;
+  ActorMesh last;
+  for (int frame = 0; frame < 3; ++frame) {
+    last = at(frame * kFrameNs, frame);
+    auto m = tracker.update(last);
+    EXPECT_TRUE(m) << m.error().message;
+    if (m) motion = *m;
+  }
+  Outcome out;
+  EXPECT_TRUE(motion.has_value());
+  EXPECT_TRUE(motion->max_acceleration_mps2.has_value());
+  out.motion = *motion;
+  const auto margin = security_margin(margin_options, latency_s, 0.0, &*motion);
+  EXPECT_TRUE(margin && margin->predicted);
+  out.margin_m = margin->margin_m;
+  MarginOptions off = margin_options;
+  off.prediction = false;
+  out.no_prediction_margin_m = security_margin(off, latency_s, 0.0, &*motion)->margin_m;
+  const int64_t shown = 2 * kFrameNs + static_cast<int64_t>(latency_s * 1e9);  // after frame 2
+  const ActorMesh truth = at(shown, 99);
+  auto predicted = predict(last, *motion, latency_s);
+  EXPECT_TRUE(predicted);
+  out.predicted = coverage(*grow_mesh(*predicted, out.margin_m), truth);
+  double lo = 0, hi = 0.1;  // bisection on whole millimetres
+  while (hi - lo > 0.0011) {
+    const double mid = std::round(500 * (lo + hi)) / 1000;
+    (coverage(*grow_mesh(*predicted, mid), truth).outside == 0 ? hi : lo) = mid;
+  }
+  out.needed_m = hi;
+  out.unpredicted = coverage(*grow_mesh(last, out.margin_m), truth);
+  out.no_prediction = coverage(*grow_mesh(last, out.no_prediction_margin_m), truth);
+  return out;
+}
+
+TEST(MaskPrediction, SphereAt1_5MetresPerSecondIsCoveredWithASmallMargin) {
+  std::mt19937 rng(5);
+  const Eigen::Vector3d velocity = Eigen::Vector3d(1.2, 0.3, -0.84).normalized() * 1.5;
+  auto at = [&](int64_t t_ns, int) {
+    ActorMesh m =
+        sphere(Eigen::Vector3d(0, 1.6, 0) + velocity * (1e-9 * t_ns), 0.12, random_rotation(rng));
+    m.capture_ns = 1'000'000'000 + t_ns;
+    return m;
+  };
+  const Outcome o = run(at, 0.06);
+  std::printf(
+      "sphere: speed %.3f m/s, acceleration %.2f m/s^2, margin %.1f mm (no prediction %.1f mm), "
+      "outside: predicted %d/%d, unpredicted %d, no-prediction %d; needed with prediction %.0f "
+      "mm\n",
+      o.motion.max_speed_mps, *o.motion.max_acceleration_mps2, 1e3 * o.margin_m,
+      1e3 * o.no_prediction_margin_m, o.predicted.outside, o.predicted.points,
+      o.unpredicted.outside, o.no_prediction.outside, 1e3 * o.needed_m);
+  EXPECT_NEAR(o.motion.max_speed_mps, 1.5, 0.1);
+  EXPECT_LE(o.margin_m, 0.030);
+  EXPECT_EQ(o.predicted.outside, 0);
+  EXPECT_GT(o.unpredicted.outside, 100);  // the small margin alone does not cover a moving actor
+  EXPECT_GE(o.no_prediction_margin_m, 0.09);
+  EXPECT_EQ(o.no_prediction.outside, 0);
+}
+
+TEST(MaskPrediction, BoxAt1_5MetresPerSecondIsCoveredWithASmallMargin) {
+  const Eigen::Vector3d velocity = Eigen::Vector3d(-0.5, 0.2, 1.0).normalized() * 1.5;
+  auto at = [&](int64_t t_ns, int frame) {
+    // 10, 11, 12 ... cells per edge: never the same vertices twice.
+    ActorMesh m = box(Eigen::Vector3d(0.2, 1.2, 0.1) + velocity * (1e-9 * t_ns),
+                      Eigen::Vector3d(0.2, 0.3, 0.12), 10 + frame % 7);
+    m.capture_ns = 1'000'000'000 + t_ns;
+    return m;
+  };
+  const Outcome o = run(at, 0.06);
+  std::printf(
+      "box: speed %.3f m/s, acceleration %.2f m/s^2, margin %.1f mm (no prediction %.1f mm), "
+      "outside: predicted %d/%d, unpredicted %d, no-prediction %d; needed with prediction %.0f "
+      "mm\n",
+      o.motion.max_speed_mps, *o.motion.max_acceleration_mps2, 1e3 * o.margin_m,
+      1e3 * o.no_prediction_margin_m, o.predicted.outside, o.predicted.points,
+      o.unpredicted.outside, o.no_prediction.outside, 1e3 * o.needed_m);
+  EXPECT_LE(o.margin_m, 0.030);
+  EXPECT_EQ(o.predicted.outside, 0);
+  EXPECT_GT(o.unpredicted.outside, 100);
+  EXPECT_EQ(o.no_prediction.outside, 0);
+}
+
+TEST(MaskPrediction, SwingingHandNextToAStillTorsoIsCoveredWithASmallMargin) {
+  // A hand (sphere, 6 cm) on a 0.6 m arc at 1.5 m/s (centripetal 3.75 m/s^2) beside a still torso.
+  std::mt19937 rng(9);
+  const Eigen::Vector3d shoulder(0.25, 1.45, 0);
+  const double radius = 0.6, omega = 1.5 / radius;
+  auto at = [&](int64_t t_ns, int frame) {
+    const double angle = -1.2 + omega * 1e-9 * t_ns;
+    const Eigen::Vector3d hand =
+        shoulder +
+        radius * Eigen::Vector3d(0.3 * std::cos(angle), -std::cos(angle) * 0.95, std::sin(angle))
+                     .normalized();
+    ActorMesh m =
+        merge(box(Eigen::Vector3d(-0.05, 1.2, 0), Eigen::Vector3d(0.17, 0.3, 0.1), 12 + frame % 5),
+              sphere(hand, 0.06, random_rotation(rng), 16, 32));
+    m.capture_ns = 1'000'000'000 + t_ns;
+    return m;
+  };
+  const Outcome o = run(at, 0.06);
+  std::printf(
+      "swing: speed %.3f m/s, acceleration %.2f m/s^2, margin %.1f mm (no prediction %.1f mm), "
+      "outside: predicted %d/%d, unpredicted %d, no-prediction %d; needed with prediction %.0f "
+      "mm\n",
+      o.motion.max_speed_mps, *o.motion.max_acceleration_mps2, 1e3 * o.margin_m,
+      1e3 * o.no_prediction_margin_m, o.predicted.outside, o.predicted.points,
+      o.unpredicted.outside, o.no_prediction.outside, 1e3 * o.needed_m);
+  EXPECT_NEAR(o.motion.max_speed_mps, 1.5, 0.25);
+  EXPECT_LE(o.margin_m, 0.030);
+  EXPECT_EQ(o.predicted.outside, 0);
+  EXPECT_GT(o.unpredicted.outside, 20);
+  EXPECT_EQ(o.no_prediction.outside, 0);
+}
+
+TEST(MaskPrediction, StillActorHasNoMotion) {
+  std::mt19937 rng(2);
+  ActorMesh a = sphere({0, 1.5, 0}, 0.15, random_rotation(rng));
+  ActorMesh b = sphere({0, 1.5, 0}, 0.15, random_rotation(rng));
+  a.capture_ns = 0;
+  b.capture_ns = kFrameNs;
+  auto m = estimate_motion(a, b);
+  ASSERT_TRUE(m) << m.error().message;
+  EXPECT_LT(m->max_speed_mps, 0.05);
+}
+
+// ---- mask geometry and bad input ----------------------------------------------------------------
+
+TEST(MaskGeometry, GrownMeshClearsTheOriginalByTheMargin) {
+  // Box corners are the hard case for a normal offset: every face must move out by >= margin.
+  const ActorMesh b = box({0, 1, 0}, {0.2, 0.3, 0.1}, 6);
+  auto grown = grow_mesh(b, 0.02);
+  ASSERT_TRUE(grown);
+  // Points 19 mm outside each face centre and near the corners are inside the grown mesh.
+  for (const Eigen::Vector3d& p :
+       {Eigen::Vector3d(0.219, 1, 0), Eigen::Vector3d(0, 1.319, 0), Eigen::Vector3d(0, 1, -0.119),
+        Eigen::Vector3d(0.215, 1.315, 0.115), Eigen::Vector3d(-0.215, 0.685, -0.115)})
+    EXPECT_GT(winding(*grown, p), 0.5) << p.transpose();
+  // ... and points far outside are not.
+  EXPECT_LT(winding(*grown, {0.26, 1, 0}), 0.5);
+  // Dilation radius: margin * f / nearest depth.
+  Camera projector;
+  projector.width = 1920;
+  projector.height = 1080;
+  projector.intrinsics = {2000, 2010, 960, 540, 0};
+  projector.cam_from_world = Rigid3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, -1, 4));
+  auto r = dilation_radius_px(projector, b, 0.02);
+  ASSERT_TRUE(r);
+  EXPECT_NEAR(*r, 0.02 * 2010 / 3.9, 1e-3);
+}
+
+TEST(MaskGeometry, RefusesMalformedMeshes) {
+  ActorMesh good = box({0, 1, 0}, {0.2, 0.3, 0.1}, 2);
+  ASSERT_TRUE(good.validate());
+  ASSERT_TRUE(grow_mesh(good, 0.01));
+  ActorMesh empty;
+  EXPECT_NE(empty.validate().error().message.find("empty"), std::string::npos);
+  ActorMesh out_of_range = good;
+  out_of_range.triangles[3][1] = 100000;
+  EXPECT_NE(out_of_range.validate().error().message.find("names vertex 100000"), std::string::npos);
+  ActorMesh nan = good;
+  nan.vertices[2].x() = NAN;
+  EXPECT_FALSE(nan.validate());
+  EXPECT_FALSE(grow_mesh(nan, 0.01));
+  EXPECT_FALSE(grow_mesh(good, -0.01));
+  // The tracker rejects a bad mesh and restarts; an old mesh is refused without losing state.
+  MotionTracker tracker;
+  good.capture_ns = 0;
+  ASSERT_TRUE(tracker.update(good));
+  EXPECT_FALSE(tracker.update(out_of_range));
+  ActorMesh later = good;
+  later.capture_ns = kFrameNs;
+  auto first_after_reset = tracker.update(later);
+  ASSERT_TRUE(first_after_reset);
+  EXPECT_FALSE(first_after_reset->has_value());  // restarted: no motion yet
+  EXPECT_FALSE(tracker.update(good));            // older than the last one
+  ActorMesh next = good;
+  next.capture_ns = 2 * kFrameNs;
+  auto m = tracker.update(next);
+  ASSERT_TRUE(m);
+  EXPECT_TRUE(m->has_value());
+  // Motion from meshes too far apart or out of order.
+  EXPECT_FALSE(estimate_motion(next, good));
+  ActorMesh much_later = good;
+  much_later.capture_ns = 2'000'000'000;
+  EXPECT_FALSE(estimate_motion(good, much_later));
+  EXPECT_FALSE(predict(next, **m, -1));
+  EXPECT_FALSE(predict(box({0, 1, 0}, {0.2, 0.3, 0.1}, 3), **m, 0.05));
+}
+
+}  // namespace
+}  // namespace studio::projector
