@@ -40,8 +40,10 @@ for f in "$prefix/bin/studioctl" "$prefix/bin/studio-capture" "$prefix/bin/studi
          "$unitdir/studio-hull.service" "$unitdir/studio-tracker.service" "$unitdir/studio.target" \
          "$prefix/lib/sysusers.d/studio.conf" "$etc/studio/dds.xml" \
          "$prefix/share/studio/dds/studio.xml" "$prefix/share/studio/dds/loopback.xml" \
-         "$prefix/share/doc/studio/examples/capture-cam0.yaml" "$prefix/share/doc/studio/examples/hull.yaml" \
-         "$prefix/share/doc/studio/examples/tracker.yaml" "$prefix/share/doc/studio/examples/keyer-keyer0.yaml"; do
+         "$prefix/share/doc/studio/examples/studio/capture-cam0.yaml" \
+         "$prefix/share/doc/studio/examples/studio/hull.yaml" "$prefix/share/doc/studio/examples/studio/rig.yaml" \
+         "$prefix/share/doc/studio/examples/studio/tracker.yaml" \
+         "$prefix/share/doc/studio/examples/studio/separate-keyer/keyer-keyer0.yaml"; do
   [ -e "$stage$f" ] || bad "not installed: $f"
 done
 for b in studioctl studio-capture studio-keyer studio-hull studio-tracker; do
@@ -108,15 +110,18 @@ fi
 examples="$stage$prefix/share/doc/studio/examples"
 run="$stage/run"
 mkdir -p "$run/var/lib/studio"
-for f in capture-cam0.yaml tracker.yaml keyer-keyer0.yaml; do
-  sed "s|/var/lib/studio|$run/var/lib/studio|g" "$examples/$f" >"$run/$f"
+# The complete studio's configs (deploy/examples/studio/), as an operator copies them to
+# /etc/studio/ (capture's keyer.yaml and the keyer's ../keyer.yaml are relative to each file).
+mkdir -p "$run/separate-keyer"
+for f in capture-cam0.yaml keyer.yaml tracker.yaml separate-keyer/keyer-keyer0.yaml; do
+  sed "s|/var/lib/studio|$run/var/lib/studio|g" "$examples/studio/$f" >"$run/$f"
 done
 export CYCLONEDDS_URI="file://$source_dir/deploy/dds/loopback.xml"
 export STUDIO_DDS_DOMAIN=$((200 + RANDOM % 30))
 export STUDIO_DDS_TAG="units-test-$$-$RANDOM"
 "$stage$prefix/bin/studio-capture" --config "$run/capture-cam0.yaml" >"$run/capture.log" 2>&1 & pids+=($!)
 "$stage$prefix/bin/studio-tracker" --config "$run/tracker.yaml" >"$run/tracker.log" 2>&1 & pids+=($!)
-"$stage$prefix/bin/studio-keyer" --config "$run/keyer-keyer0.yaml" >"$run/keyer.log" 2>&1 & pids+=($!)
+"$stage$prefix/bin/studio-keyer" --config "$run/separate-keyer/keyer-keyer0.yaml" >"$run/keyer.log" 2>&1 & pids+=($!)
 ctl="$stage$prefix/bin/studioctl"
 ok=0
 for _ in $(seq 1 15); do

@@ -231,6 +231,21 @@ void fill(studio_ServiceStatus& s, int seed) {
   assign(s.counters, c);
 }
 
+void fill(studio_SceneState& s, int seed) {
+  set(s.instance, id("scene", seed));
+  stamp(s.frame, s.capture_ns, seed);
+  s.state_hash = 0x9e3779b97f4a7c15ull * uint64_t(seed + 1);
+  s.node_count = 500 + seed;
+  s.animation_count = 2;
+  s.commands_accepted = 100 + seed;
+  s.commands_rejected = seed;
+  s.commands_lost = 0;
+  set(s.last_sender, "studioctl");
+  s.last_command_id = 7 + seed;
+  s.last_accepted = seed % 2 == 0;
+  set(s.last_error, seed % 2 == 0 ? "" : "set_parent: 'a' -> 'b' would make a cycle");
+}
+
 bool same(const studio_CameraCalibration& a, const studio_CameraCalibration& b) {
   return str_same(a.camera_id, b.camera_id) && a.frame == b.frame && a.capture_ns == b.capture_ns &&
          a.width == b.width && a.height == b.height && arr_same(a.K, b.K) && a.rd3 == b.rd3 &&
@@ -306,6 +321,15 @@ bool same(const studio_ServiceStatus& a, const studio_ServiceStatus& b) {
          a.capture_ns == b.capture_ns && a.state == b.state && str_same(a.host, b.host) &&
          a.pid == b.pid && a.input_hz == b.input_hz && a.output_hz == b.output_hz &&
          a.latency_ms == b.latency_ms;
+}
+
+bool same(const studio_SceneState& a, const studio_SceneState& b) {
+  return str_same(a.instance, b.instance) && a.frame == b.frame && a.capture_ns == b.capture_ns &&
+         a.state_hash == b.state_hash && a.node_count == b.node_count &&
+         a.animation_count == b.animation_count && a.commands_accepted == b.commands_accepted &&
+         a.commands_rejected == b.commands_rejected && a.commands_lost == b.commands_lost &&
+         str_same(a.last_sender, b.last_sender) && a.last_command_id == b.last_command_id &&
+         a.last_accepted == b.last_accepted && str_same(a.last_error, b.last_error);
 }
 
 }  // namespace studio::testing
