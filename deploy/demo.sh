@@ -27,8 +27,9 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
   --take-frames N    frames of the recorded take (default 50 = 2 s)
   --keep-take        keep the take's raw frames (6 x 1.2 MB per frame) in OUT/takes
   --scheduling S     realtime (default when permitted): the services run SCHED_FIFO at the
-                     priorities of their systemd units (capture 60, keyer 58, hull 55, tracker
-                     50; the probe's receive path 45), as installed; normal: time-sharing
+                     priorities of their systemd units, in pipeline order (capture 52, keyer
+                     54, hull 56, tracker 58; the probe's receive path 45), as installed;
+                     normal: time-sharing
   --build DIR        build tree with the binaries (default build/release)
 Environment: STUDIO_DDS_DOMAIN / STUDIO_DDS_TAG choose the DDS domain (default: a random private
 domain 1..230 and a unique discovery tag, so the demo never meets another studio on this host).
@@ -156,13 +157,13 @@ PY
 say "scheduling: $scheduling$([ "$scheduling" = realtime ] && echo ' (SCHED_FIFO at the systemd units priorities)')"
 say "DDS domain $STUDIO_DDS_DOMAIN (loopback profile, tag $STUDIO_DDS_TAG); logs in $out/logs"
 say "starting tracker, hull$([ "$keyer" = separate ] && echo ', 2 keyers'), $cameras capture servers ($keyer keying)"
-start tracker 50 "$tracker_bin" --config "$cfg/tracker.yaml"
-start hull 55 "$hull_bin" --config "$cfg/hull.yaml"
+start tracker 58 "$tracker_bin" --config "$cfg/tracker.yaml"
+start hull 56 "$hull_bin" --config "$cfg/hull.yaml"
 if [ "$keyer" = separate ]; then
-  start keyer0 58 "$keyer_bin" --config "$cfg/keyer-keyer0.yaml"
-  start keyer1 58 "$keyer_bin" --config "$cfg/keyer-keyer1.yaml"
+  start keyer0 54 "$keyer_bin" --config "$cfg/keyer-keyer0.yaml"
+  start keyer1 54 "$keyer_bin" --config "$cfg/keyer-keyer1.yaml"
 fi
-for ((i = 0; i < cameras; i++)); do start "cam$i" 60 "$capture_bin" --config "$cfg/capture-cam$i.yaml"; done
+for ((i = 0; i < cameras; i++)); do start "cam$i" 52 "$capture_bin" --config "$cfg/capture-cam$i.yaml"; done
 if have $scene_bin scene.yaml; then start scene 50 "$scene_bin" --config "$cfg/scene.yaml"; fi
 for ((p = 0; p < projectors; p++)); do
   if have $projector_bin "projector-proj$p.yaml"; then

@@ -97,8 +97,8 @@ def main():
             "keying": "in each capture server" if a.keyer == "inprocess"
                       else "separate studio-keyer services",
             "configs": os.path.join(out, "config"),
-            "scheduling": a.scheduling + (" (SCHED_FIFO at the systemd units' priorities: capture 60, "
-                                          "keyer 58, hull 55, tracker 50, probe receive 45)"
+            "scheduling": a.scheduling + (" (SCHED_FIFO at the systemd units' priorities: capture 52, "
+                                          "keyer 54, hull 56, tracker 58, probe receive 45)"
                                           if a.scheduling == "realtime" else " (time-sharing)"),
             "dds": {"profile": os.environ.get("CYCLONEDDS_URI"),
                     "domain": os.environ.get("STUDIO_DDS_DOMAIN")},
