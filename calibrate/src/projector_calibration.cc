@@ -17,22 +17,8 @@
 namespace studio::calibrate {
 namespace {
 
-// The distortion of core/camera.h in one polynomial form (radial: k1 = rd3, k2 = rd5).
-struct Poly {
-  double k1 = 0, k2 = 0, k3 = 0, p1 = 0, p2 = 0;
-};
-
-Poly poly(const Distortion& d) {
-  switch (d.model) {
-    case Distortion::Model::none:
-      return {};
-    case Distortion::Model::radial:
-      return {d.rd3, d.rd5, 0, 0, 0};
-    case Distortion::Model::opencv:
-      return {d.k1, d.k2, d.k3, d.p1, d.p2};
-  }
-  return {};
-}
+using Poly = DistortionPolynomial;  // core/camera.h
+Poly poly(const Distortion& d) { return polynomial(d); }
 
 // A fixed, calibrated camera observing a free world point (triangulation refinement).
 struct PointCost {

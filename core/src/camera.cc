@@ -9,23 +9,8 @@
 namespace studio {
 namespace {
 
-// Both distortion models share one polynomial form: the paper's r = r' + rd3 r'^3 + rd5 r'^5 is
-// OpenCV's radial part with k1 = rd3, k2 = rd5 and no tangential terms.
-struct Coefficients {
-  double k1 = 0, k2 = 0, k3 = 0, p1 = 0, p2 = 0;
-};
-
-Coefficients coefficients(const Distortion& d) {
-  switch (d.model) {
-    case Distortion::Model::none:
-      return {};
-    case Distortion::Model::radial:
-      return {d.rd3, d.rd5, 0, 0, 0};
-    case Distortion::Model::opencv:
-      return {d.k1, d.k2, d.k3, d.p1, d.p2};
-  }
-  return {};
-}
+using Coefficients = DistortionPolynomial;
+Coefficients coefficients(const Distortion& d) { return polynomial(d); }
 
 // Observed normalised point and, when jacobian != nullptr, d(observed)/d(ideal).
 Eigen::Vector2d apply(const Coefficients& c, const Eigen::Vector2d& p, Eigen::Matrix2d* jacobian) {
@@ -54,6 +39,18 @@ bool finite(const Intrinsics& k, const Eigen::Matrix3d& R, const Eigen::Vector3d
 }
 
 }  // namespace
+
+DistortionPolynomial polynomial(const Distortion& d) {
+  switch (d.model) {
+    case Distortion::Model::none:
+      return {};
+    case Distortion::Model::radial:
+      return {d.rd3, d.rd5, 0, 0, 0};
+    case Distortion::Model::opencv:
+      return {d.k1, d.k2, d.k3, d.p1, d.p2};
+  }
+  return {};
+}
 
 Distortion Distortion::radial(double rd3, double rd5) {
   Distortion d;

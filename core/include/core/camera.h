@@ -33,6 +33,14 @@ struct Distortion {
   bool is_identity() const;
 };
 
+// Both models in one polynomial form (what templated solvers evaluate): the paper's
+// r = r' + rd3 r'^3 + rd5 r'^5 is OpenCV's radial part with k1 = rd3, k2 = rd5 and no tangential
+// terms; Model::none is all zeros.
+struct DistortionPolynomial {
+  double k1 = 0, k2 = 0, k3 = 0, p1 = 0, p2 = 0;
+};
+DistortionPolynomial polynomial(const Distortion& d);
+
 // Ideal normalised → observed normalised coordinates.
 Eigen::Vector2d distort(const Distortion& d, const Eigen::Vector2d& ideal);
 // Observed normalised → ideal normalised (Newton, converged to 1e-12 or 20 iterations).
