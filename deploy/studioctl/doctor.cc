@@ -18,6 +18,7 @@
 
 #include "studioctl/cli.h"
 #include "studioctl/discovery.h"
+#include "studioctl/doctor_security.h"
 #include "studioctl/printer.h"
 
 namespace studio::ctl {
@@ -39,6 +40,13 @@ const char kDoctorHelp[] =
     "                  from it on every host, DESIGN §5): a warning, not a failure\n"
     "  participant     a participant can join the domain; how many peers it discovers (--wait S,\n"
     "                  default 1)\n"
+    "  security_*      with DDS Security in the profile (doctor_security.h): the plugins and "
+    "files\n"
+    "                  it names exist and are readable; the identity certificate and the CAs are\n"
+    "                  valid now, the identity is signed by the identity CA and matches its key;\n"
+    "                  governance and permissions are signed by the permissions CA and grant the\n"
+    "                  identity (${VAR} in the profile expanded as Cyclone does); without it, a\n"
+    "                  warning that the domain is not secured\n"
     "Output: one line per check (ok / warn / FAIL, what, and the fix); --json: one object per\n"
     "check per line {check, status, message, fix}. Exit 1 when a check FAILs, else 0.\n";
 
@@ -296,6 +304,9 @@ int doctor_command(const std::vector<std::string>& argv) {
            "numbers frames from its clock"};
     checks.push_back(c);
   }
+
+  // DDS Security: the files the profile names (doctor_security.cc)
+  for (auto& s : security_checks(xml)) checks.push_back({s.name, s.status, s.message, s.fix});
 
   // participant
   {
