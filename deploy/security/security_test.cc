@@ -305,8 +305,9 @@ TEST_F(SecurityTest, ReadOnlyServiceCannotChangeTheScene) {
 }
 
 // studioctl capture start with the monitor identity (may read the camera state, may not publish
-// studio/capture/command) is refused and nothing is recorded; with the operator identity the same
-// command records a take.
+// studio/capture/command) is refused and nothing is recorded, also when the monitor's own
+// participant does not enforce its permissions (the capture service does); with the operator
+// identity the same command records a take.
 TEST_F(SecurityTest, CaptureCannotBeToldToRecordWithoutPermission) {
   make_all_pkis();
   const std::string config =
@@ -324,6 +325,37 @@ TEST_F(SecurityTest, CaptureCannotBeToldToRecordWithoutPermission) {
   EXPECT_NE(refused.code, 0) << refused.out << refused.err;
   EXPECT_NE(refused.err.find("Not Allowed By Security"), std::string::npos) << refused.err;
 
+  // The same identity with its own check switched off (a governance without write access control
+  // on studio/capture/command, signed with the studio CA's key as an insider could): its writer
+  // is created, and the capture service refuses to match it (Cyclone: "security_attributes
+  // mismatch": the studio governance requires write access control on the topic, the writer does
+  // not claim it; claiming it would make its own participant check the permissions).
+  {
+    std::string lax = slurp(dir_ / "pki/governance.xml");
+    const auto rule = lax.find("<topic_expression>studio/capture/command</topic_expression>");
+    ASSERT_NE(rule, std::string::npos);
+    const auto flag = lax.find("<enable_write_access_control>true", rule);
+    ASSERT_NE(flag, std::string::npos);
+    lax.replace(flag, 33, "<enable_write_access_control>false");
+    fs::create_directories(dir_ / "rogue");
+    write_file("rogue/governance.xml", lax);
+    fs::create_directory_symlink(dir_ / "pki/ca", dir_ / "rogue/ca");
+    fs::create_directory_symlink(dir_ / "pki/identities", dir_ / "rogue/identities");
+    const Outcome signed_lax = shell(
+        "openssl smime -sign -text -in '" + (dir_ / "rogue/governance.xml").string() + "' -out '" +
+        (dir_ / "rogue/governance.p7s").string() + "' -signer '" +
+        (dir_ / "pki/ca/ca.pem").string() + "' -inkey '" + (dir_ / "pki/ca/ca.key").string() + "'");
+    ASSERT_EQ(signed_lax.code, 0) << signed_lax.err;
+  }
+  const Outcome bypass = run(secure_env("monitor", "rogue"), "deploy/studioctl/studioctl",
+                             {"capture", "start", "--take", "bypass", "--wait", "10"});
+  EXPECT_NE(bypass.code, 0) << bypass.out << bypass.err;
+  // It authenticated and read the cameras' state (studioctl needs that first), its writer exists
+  // (no local refusal), and no capture service accepted it as a publisher.
+  EXPECT_NE(bypass.err.find("no capture service is listening on studio/capture/command"),
+            std::string::npos)
+      << bypass.err;
+
   const Outcome started = run(secure_env("operator"), "deploy/studioctl/studioctl",
                               {"capture", "start", "--take", "granted", "--wait", "20"});
   ASSERT_EQ(started.code, 0) << started.out << started.err;
@@ -339,6 +371,7 @@ TEST_F(SecurityTest, CaptureCannotBeToldToRecordWithoutPermission) {
                               {"capture", "stop", "--take", "granted", "--wait", "20"});
   EXPECT_EQ(stopped.code, 0) << stopped.out << stopped.err;
   EXPECT_FALSE(fs::exists(takes / "sneaky")) << "the refused take was recorded";
+  EXPECT_FALSE(fs::exists(takes / "bypass")) << "the remotely refused take was recorded";
 }
 
 // In a private network namespace (root), tshark on lo records a plain run and a secure run of
