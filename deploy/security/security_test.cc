@@ -21,6 +21,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -504,6 +505,65 @@ TEST_F(SecurityTest, DoctorChecksTheSecurityFiles) {
   // The control once more, for the CA's other identities (the deletion above touched only one).
   auto [again_run, again] = checks(secure_env("preview"));
   EXPECT_EQ(status(again, "security_certificates"), "ok") << again_run.out;
+}
+
+// make-pki's artefacts verify with openssl itself (certificate chain, S/MIME signatures), a
+// key is private to its owner, a role's permissions hold exactly its topics, and bad input is
+// refused with one line (exit 2) and changes nothing.
+TEST_F(SecurityTest, MakePkiWritesVerifiableDocumentsAndRefusesBadInput) {
+  make_pki("pki", "--identity hull --identity studio-pc3=tracker+monitor --days 30");
+  const std::string pki = (dir_ / "pki").string();
+  auto ok = [&](const std::string& cmd) {
+    const Outcome r = shell(cmd + " >/dev/null");
+    EXPECT_EQ(r.code, 0) << cmd << "\n" << r.err;
+  };
+  ok("openssl verify -CAfile " + pki + "/ca/ca.pem " + pki + "/identities/hull/cert.pem");
+  ok("openssl smime -verify -in " + pki + "/governance.p7s -CAfile " + pki + "/ca/ca.pem");
+  ok("openssl smime -verify -in " + pki + "/identities/hull/permissions.p7s -CAfile " + pki +
+     "/ca/ca.pem");
+  EXPECT_EQ(fs::status(dir_ / "pki/identities/hull/key.pem").permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write);
+  const std::string hull = slurp(dir_ / "pki/identities/hull/permissions.xml");
+  for (const char* t : {"studio/actor/segments", "studio/actor/mesh", "studio/service/status",
+                        "studio/camera/calibration", "studio/camera/mask"})
+    EXPECT_NE(hull.find(std::string("<topic>") + t + "</topic>"), std::string::npos) << t;
+  EXPECT_EQ(hull.find("studio/scene/"), std::string::npos) << hull;
+  EXPECT_NE(hull.find("<subject_name>CN=hull,O=Studio</subject_name>"), std::string::npos);
+  EXPECT_NE(hull.find("<default>DENY</default>"), std::string::npos);
+  const std::string pc3 = slurp(dir_ / "pki/identities/studio-pc3/permissions.xml");
+  EXPECT_NE(pc3.find("<topic>studio/actor/head</topic>"), std::string::npos) << pc3;
+  EXPECT_NE(pc3.find("<topic>studio/*</topic>"), std::string::npos) << pc3;
+  const std::string gov = slurp(dir_ / "pki/governance.xml");
+  for (const char* t :
+       {"camera/calibration", "camera/mask", "camera/image", "camera/state", "camera/control",
+        "capture/command", "actor/segments", "actor/mesh", "actor/head", "scene/node",
+        "scene/command", "scene/state", "projector/calibration", "service/status"})
+    EXPECT_NE(gov.find(std::string("<topic_expression>studio/") + t + "</topic_expression>"),
+              std::string::npos)
+        << t;
+  // 30 days of validity (2 592 000 s): valid in 2 500 000 s, expired in 2 600 000 s.
+  const Outcome end =
+      shell("openssl x509 -noout -checkend 2600000 -in " + pki + "/identities/hull/cert.pem");
+  EXPECT_NE(end.code, 0) << "valid beyond 30 days";
+  ok("openssl x509 -noout -checkend 2500000 -in " + pki + "/identities/hull/cert.pem");
+
+  const std::string make = source("deploy/security/make-pki").string() + " --out '" + pki + "' ";
+  for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+           {"--identity hull", "identity 'hull' exists"},
+           {"--identity x=director", "unknown role 'director'"},
+           {"--identity y --domains 7-300", "ids must be 0..232"},
+           {"--identity z --not-before 2030-01-01 --not-after 2029-01-01", "ends before it starts"},
+           {"--bogus", "unknown argument '--bogus'"}}) {
+    const Outcome r = shell(make + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "pki/identities/x"));
+  EXPECT_FALSE(fs::exists(dir_ / "pki/identities/y"));
+  const Outcome help = shell(source("deploy/security/make-pki").string() + " --help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_NE(help.out.find("--identity NAME[=ROLE"), std::string::npos);
 }
 
 }  // namespace
