@@ -40,6 +40,7 @@ for f in "$prefix/bin/studioctl" "$prefix/bin/studio-capture" "$prefix/bin/studi
          "$unitdir/studio-hull.service" "$unitdir/studio-tracker.service" "$unitdir/studio.target" \
          "$prefix/lib/sysusers.d/studio.conf" "$etc/studio/dds.xml" \
          "$prefix/share/studio/dds/studio.xml" "$prefix/share/studio/dds/loopback.xml" \
+         "$prefix/share/studio/dds/unicast.xml" "$prefix/share/doc/studio/README.md" \
          "$prefix/share/doc/studio/examples/studio/capture-cam0.yaml" \
          "$prefix/share/doc/studio/examples/studio/hull.yaml" "$prefix/share/doc/studio/examples/studio/rig.yaml" \
          "$prefix/share/doc/studio/examples/studio/tracker.yaml" \
