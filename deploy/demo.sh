@@ -104,6 +104,13 @@ if [ "$keyer" = separate ]; then
   sed -i 's|^keyer: \.\./keyer\.yaml|keyer: keyer.yaml|' "$cfg"/keyer-keyer*.yaml
 fi
 sed -i "s|^takes_dir: .*|takes_dir: $out/takes|" "$cfg"/capture-cam*.yaml
+# The scene server: the demo scene of this build tree (installed: /usr/share/studio/scene), its
+# persisted state under $out/scene (fresh each run: the scene starts from the file).
+if [ -f "$cfg/scene.yaml" ]; then
+  rm -rf "$out/scene"
+  sed -i -e "s|^scene: .*|scene: $build/scene/default/scene.yaml|" \
+    -e "s|^state_dir: .*|state_dir: $out/scene|" "$cfg/scene.yaml"
+fi
 cam_ids=() capture_cfgs=()
 for ((i = 0; i < cameras; i++)); do cam_ids+=("cam$i"); capture_cfgs+=("$cfg/capture-cam$i.yaml"); done
 if [ "$cameras" -lt 6 ]; then

@@ -10,6 +10,7 @@
 
 #include "studioctl/cli.h"
 #include "studioctl/printer.h"
+#include "studioctl/send.h"
 #include "wire/endpoint.h"
 
 namespace studio::ctl {
@@ -115,16 +116,7 @@ const studio_CameraFeature* find_feature(const studio_CameraState& s, std::strin
 template <class T>
 Expected<void> send(const wire::Writer<T>& writer, const T& sample, Clock::time_point deadline,
                     const char* listeners) {
-  if (!writer.wait_for_readers(
-          1, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now())))
-    return fail(std::string("no ") + listeners + " is listening on " +
-                wire::TopicTraits<T>::name());
-  if (auto w = writer.write(sample); !w) return w;
-  const auto left = std::max<int64_t>(
-      0, std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now()).count());
-  if (auto rc = dds_wait_for_acks(writer.handle(), left); rc < 0)
-    return fail(wire::dds_error("waiting for acknowledgements", rc));
-  return {};
+  return send_acked(writer, sample, deadline, listeners);
 }
 
 int capture(const std::string& verb, const Args& a) {

@@ -195,6 +195,8 @@ int doctor_command(const std::vector<std::string>& argv) {
         autodetect = true;
     }
     Check c{"interfaces", "ok", "", ""};
+    // A unicast profile (AllowMulticast false) needs interfaces that are up, nothing more.
+    const bool unicast = std::regex_search(xml, std::regex(R"(<AllowMulticast>\s*false\s*<)"));
     std::string problems, fine;
     for (const auto& [name, forced] : wanted) {
       bool exists = false;
@@ -203,7 +205,7 @@ int doctor_command(const std::vector<std::string>& argv) {
         problems += name + " does not exist; ";
       else if (!(flags & IFF_UP))
         problems += name + " is down; ";
-      else if (!(flags & IFF_MULTICAST) && !forced)
+      else if (!(flags & IFF_MULTICAST) && !forced && !unicast)
         problems += name + " cannot multicast; ";
       else
         fine += (fine.empty() ? "" : ", ") + name;
@@ -213,12 +215,13 @@ int doctor_command(const std::vector<std::string>& argv) {
       for (const auto& name : interfaces()) {
         bool exists = false;
         const unsigned flags = interface_flags(name, &exists);
-        if (name != "lo" && (flags & IFF_UP) && (flags & IFF_MULTICAST))
+        if (name != "lo" && (flags & IFF_UP) && ((flags & IFF_MULTICAST) || unicast))
           usable += (usable.empty() ? "" : ", ") + name;
       }
       if (usable.empty())
-        problems +=
-            "auto-detection finds no interface besides lo that is up and multicast-capable; ";
+        problems += unicast ? "auto-detection finds no interface besides lo that is up; "
+                            : "auto-detection finds no interface besides lo that is up and "
+                              "multicast-capable; ";
       else
         fine += (fine.empty() ? "" : ", ") + std::string("auto-detected among ") + usable;
     }

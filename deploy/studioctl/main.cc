@@ -9,6 +9,7 @@
 #include "studioctl/cli.h"
 #include "studioctl/control.h"
 #include "studioctl/doctor.h"
+#include "studioctl/scene.h"
 #include "studioctl/status.h"
 #include "studioctl/topics.h"
 
@@ -21,6 +22,8 @@ const char kHelp[] =
     "  topic list|info|hz|echo [TOPIC]              topics of the domain; samples with IDL names\n"
     "  capture start|stop [--take NAME] [--at-frame N]   frame-accurate recording on every camera\n"
     "  camera get|set CAM [FEATURE [VALUE]]        camera features, with the camera's read-back\n"
+    "  scene load|play|pause|seek|speed|hash        the scene server: commands with its verdict, "
+    "state hash\n"
     "  doctor                                       checks this host against the DDS profile, says "
     "what to fix\n"
     "\n"
@@ -63,10 +66,11 @@ int main(int argc, char** argv) {
     if (command == "topic") return topic_command(rest);
     if (command == "capture") return capture_command(rest);
     if (command == "camera") return camera_command(rest);
+    if (command == "scene") return scene_command(rest);
     if (command == "doctor") return doctor_command(rest);
   } catch (const std::exception& e) {
     return complain(command, std::string("internal error: ") + e.what());
   }
-  return complain(command, "unknown command (status, topic, capture, camera, doctor; see --help)",
-                  2);
+  return complain(command,
+                  "unknown command (status, topic, capture, camera, scene, doctor; see --help)", 2);
 }

@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "studioctl/cli.h"
+#include "studioctl/status_watch.h"
 #include "studioctl/topic_reader.h"
 #include "wire/endpoint.h"
 
@@ -12,6 +13,7 @@ namespace studio::ctl {
 
 const char kStatusHelp[] =
     "usage: studioctl status [--wait S] [--require LIST] [--json]\n"
+    "       studioctl status --watch S [--json]\n"
     "\n"
     "Collects studio/service/status for --wait S seconds (default 2.5; services publish every\n"
     "second) and lists every service heard: service, instance, state, host, pid, input and output\n"
@@ -24,6 +26,11 @@ const char kStatusHelp[] =
     "  --json           one JSON object per service per line: the ServiceStatus members (IDL "
     "names)\n"
     "                   plus last_seen_s.\n"
+    "  --watch S        instead: one line per change for S seconds (0.1..86400): a service up,\n"
+    "                   restarted (new pid; the gap without status between the two processes),\n"
+    "                   gone (liveliness lost: killed or cut off, after the 3 s lease), back, or\n"
+    "                   its state changed (running, degraded, ...); --json: one object per event\n"
+    "                   {time_ns, event, service, instance, host, pid, old_pid, state, gap_s}.\n"
     "\n"
     "Common options: --domain N, --dds-config FILE (default $STUDIO_DDS_DOMAIN, "
     "$CYCLONEDDS_URI).\n";
@@ -54,7 +61,7 @@ const char* state_name(studio_ServiceState s) {
 }  // namespace
 
 int status_command(const std::vector<std::string>& argv) {
-  auto a = parse_args(argv, {"--wait", "--require"});
+  auto a = parse_args(argv, {"--wait", "--require", "--watch"});
   if (!a) return complain("status", a.error().message, 2);
   if (a->help) {
     std::fputs(kStatusHelp, stdout);
@@ -62,6 +69,13 @@ int status_command(const std::vector<std::string>& argv) {
   }
   if (!a->positional.empty())
     return complain("status", "unexpected argument '" + a->positional[0] + "'", 2);
+  if (a->has("--watch")) {
+    auto watch = seconds_flag(*a, "--watch", 0, 0.1, 86400);
+    if (!watch) return complain("status", watch.error().message, 2);
+    if (a->has("--require") || a->has("--wait"))
+      return complain("status", "--watch does not take --require or --wait", 2);
+    return status_watch(*a, *watch);
+  }
   auto wait = seconds_flag(*a, "--wait", 2.5, 0.1, 600);
   if (!wait) return complain("status", wait.error().message, 2);
   std::vector<std::pair<std::string, std::string>> required;  // service, instance ("" = any)

@@ -309,6 +309,7 @@ class SceneServer : public runtime::Node {
     s.frame = uint64_t(std::max<int64_t>(0, scene_.frame()));
     s.capture_ns = realtime_ns();
     s.state_hash = scene_.state_hash();
+    s.nodes_hash = scene_.nodes_hash();
     s.node_count = uint32_t(scene_.nodes().size());
     s.animation_count = uint32_t(scene_.animations().size());
     s.commands_accepted = accepted_->value();

@@ -235,6 +235,7 @@ void fill(studio_SceneState& s, int seed) {
   set(s.instance, id("scene", seed));
   stamp(s.frame, s.capture_ns, seed);
   s.state_hash = 0x9e3779b97f4a7c15ull * uint64_t(seed + 1);
+  s.nodes_hash = 0xc2b2ae3d27d4eb4full * uint64_t(seed + 3);
   s.node_count = 500 + seed;
   s.animation_count = 2;
   s.commands_accepted = 100 + seed;
@@ -325,7 +326,8 @@ bool same(const studio_ServiceStatus& a, const studio_ServiceStatus& b) {
 
 bool same(const studio_SceneState& a, const studio_SceneState& b) {
   return str_same(a.instance, b.instance) && a.frame == b.frame && a.capture_ns == b.capture_ns &&
-         a.state_hash == b.state_hash && a.node_count == b.node_count &&
+         a.state_hash == b.state_hash && a.nodes_hash == b.nodes_hash &&
+         a.node_count == b.node_count &&
          a.animation_count == b.animation_count && a.commands_accepted == b.commands_accepted &&
          a.commands_rejected == b.commands_rejected && a.commands_lost == b.commands_lost &&
          str_same(a.last_sender, b.last_sender) && a.last_command_id == b.last_command_id &&
