@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
@@ -75,6 +76,9 @@ Scores score(const sim::SimulatedStudio& studio, int64_t frame, int grid, const 
 TEST(PhotoCarve, ExperimentPoses) {
   CarveOptions o;
   o.threads = 2;
+  if (const char* e = std::getenv("CARVE_T")) o.threshold = std::atof(e);
+  if (const char* e = std::getenv("CARVE_COS")) o.min_cos = std::atof(e);
+  if (const char* e = std::getenv("CARVE_DEPTH")) o.max_depth_cells = std::atoi(e);
   for (sim::Motion m : {sim::Motion::idle, sim::Motion::crouch}) {
     sim::StudioOptions so;
     so.actor.motion = m;
