@@ -87,7 +87,6 @@ if [ "$local" -eq 1 ]; then
   exit 0
 fi
 
-command -v sbatch >/dev/null || { echo "studio-hull-farm: sbatch not found (install slurm-client, or use --local)" >&2; exit 2; }
 sb=(sbatch --parsable -c "$cpus" -J studio-hull-offline)
 [ -z "$partition" ] || sb+=(-p "$partition")
 [ -z "$time_limit" ] || sb+=(-t "$time_limit")
@@ -95,6 +94,7 @@ sb=(sbatch --parsable -c "$cpus" -J studio-hull-offline)
 task_script="ranges=($(printf '%q ' "${range_list[@]}")); exec $quoted --frames \${ranges[\$SLURM_ARRAY_TASK_ID]} --json"
 array_cmd=("${sb[@]}" --array "0-$((${#range_list[@]} - 1))" -o "$log_dir/task-%A_%a.json" -e "$log_dir/task-%A_%a.err" --wrap "$task_script")
 if [ "$dry" -eq 1 ]; then printf '%q ' "${array_cmd[@]}"; echo; exit 0; fi
+command -v sbatch >/dev/null || { echo "studio-hull-farm: sbatch not found (install slurm-client, or use --local)" >&2; exit 2; }
 array_id=$("${array_cmd[@]}") || exit 1
 index_id=$("${sb[@]}" --dependency "afterok:${array_id%%;*}" -o "$log_dir/index-%j.log" --wrap "$quoted --index-only") || exit 1
 echo "array ${array_id%%;*}"
