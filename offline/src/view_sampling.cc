@@ -111,7 +111,7 @@ void DepthBuffer::triangle(const SampledView& v, const Eigen::Vector3d& a, const
 
 std::optional<Observation> observe(const SampledView& v, const DepthBuffer& depth,
                                    const Eigen::Vector3d& x, const Eigen::Vector3d& n,
-                                   double min_cos, double tolerance) {
+                                   double min_cos, double tolerance, int radius_px) {
   const Eigen::Vector3d to_cam = (v.centre - x).normalized();
   const double cos = n.dot(to_cam);
   if (cos < min_cos) return std::nullopt;
@@ -120,23 +120,32 @@ std::optional<Observation> observe(const SampledView& v, const DepthBuffer& dept
   Eigen::Vector2d p;
   if (!v.camera->project(x, &p)) return std::nullopt;
   const int W = v.camera->width, H = v.camera->height;
-  const int x0 = int(std::floor(p.x())), y0 = int(std::floor(p.y()));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= W || y0 + 1 >= H) return std::nullopt;
   const int xn = int(std::lround(p.x())), yn = int(std::lround(p.y()));
+  if (xn < 0 || yn < 0 || xn >= W || yn >= H) return std::nullopt;
   if (xc.z() > depth.at(xn, yn) + tolerance) return std::nullopt;
-  if (!v.inside(x0, y0) || !v.inside(x0 + 1, y0) || !v.inside(x0, y0 + 1) || !v.inside(x0 + 1, y0 + 1)) {
-    return std::nullopt;
-  }
-  const double fx = p.x() - x0, fy = p.y() - y0;
   Eigen::Vector3f c = Eigen::Vector3f::Zero();
-  const auto add = [&](int xx, int yy, double w) {
-    const Rgb8 px = v.image.row(yy)[xx];
-    c += float(w) * Eigen::Vector3f(px.r, px.g, px.b);
-  };
-  add(x0, y0, (1 - fx) * (1 - fy));
-  add(x0 + 1, y0, fx * (1 - fy));
-  add(x0, y0 + 1, (1 - fx) * fy);
-  add(x0 + 1, y0 + 1, fx * fy);
+  const int r = radius_px;
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
+      const double px = p.x() + dx, py = p.y() + dy;
+      const int x0 = int(std::floor(px)), y0 = int(std::floor(py));
+      if (x0 < 0 || y0 < 0 || x0 + 1 >= W || y0 + 1 >= H) return std::nullopt;
+      if (!v.inside(x0, y0) || !v.inside(x0 + 1, y0) || !v.inside(x0, y0 + 1) ||
+          !v.inside(x0 + 1, y0 + 1)) {
+        return std::nullopt;
+      }
+      const double fx = px - x0, fy = py - y0;
+      const auto add = [&](int xx, int yy, double w) {
+        const Rgb8 q = v.image.row(yy)[xx];
+        c += float(w) * Eigen::Vector3f(q.r, q.g, q.b);
+      };
+      add(x0, y0, (1 - fx) * (1 - fy));
+      add(x0 + 1, y0, fx * (1 - fy));
+      add(x0, y0 + 1, (1 - fx) * fy);
+      add(x0 + 1, y0 + 1, fx * fy);
+    }
+  }
+  c /= float((2 * r + 1) * (2 * r + 1));
   return Observation{c, float(cos * cos), float(cos)};
 }
 

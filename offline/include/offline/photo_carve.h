@@ -50,6 +50,7 @@ struct CarveOptions {
   int min_cameras = 2;           // consistency needs at least this many views of a voxel
   double min_cos = 0.3;          // views more grazing than this do not judge a voxel
   int edge_margin_px = 2;        // silhouette border pixels not used (blue spill)
+  int sample_radius_px = 0;      // colour = mean over a (2r+1)^2 pixel patch (noise)
   double depth_tolerance = 1.5;  // cells: visibility slack of the depth buffers
   int max_depth_cells = 12;      // carving stops this many cells below the hull surface
   int max_iterations = 60;

@@ -56,10 +56,11 @@ struct Observation {
 
 // The colour camera `v` sees at surface point x with outward normal n, if it sees it: in front,
 // cos(n, to camera) >= min_cos, not hidden (depth <= buffer + tolerance, metres), and the
-// bilinear footprint lies in the silhouette's interior.
+// bilinear footprint lies in the silhouette's interior. radius_px > 0: the mean of the bilinear
+// samples on a (2r+1)^2 pixel lattice around the projection (less noise; all in the interior).
 std::optional<Observation> observe(const SampledView& v, const DepthBuffer& depth,
                                    const Eigen::Vector3d& x, const Eigen::Vector3d& n,
-                                   double min_cos, double tolerance);
+                                   double min_cos, double tolerance, int radius_px = 0);
 
 // Weighted RMS distance of the observations' colours from their weighted mean, blue channel at
 // half weight (grey levels).
