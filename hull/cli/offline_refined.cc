@@ -57,7 +57,7 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
   --name NAME       file and node name stem (default actor; letters, digits, _ and -)
   --fps F           frame rate of the index's animation (default 25)
   --frames A:B      a shard: only frames A..B inclusive (the farm script gives each job one)
-  --threshold T     photo-consistency threshold, RMS grey levels (default 9)
+  --threshold T     photo-consistency threshold, RMS grey levels (default 6)
   --max-depth C     carving stops C cells below the hull (default 12)
   --plan N          print the take's frames split into N contiguous shards, one A:B per line
   --index-only      (re)write the index from the frame files in DIR (every take frame needed)
@@ -85,7 +85,7 @@ struct Args {
   int threads = int(std::max(1u, std::thread::hardware_concurrency()));
   bool refine = false, texture = false, json = false, index_only = false;
   int plan = 0;
-  double fps = 25, threshold = 9;
+  double fps = 25, threshold = 6;
   int max_depth = 12;
   std::optional<bool> progress;
 };

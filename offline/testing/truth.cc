@@ -103,6 +103,17 @@ SurfaceScore surface_distance(const hull::Mesh& mesh, const sim::ActorBody& trut
   return s;
 }
 
+std::vector<Eigen::Vector3d> far_mesh_points(const hull::Mesh& mesh, const sim::ActorBody& truth,
+                                             double distance, int samples) {
+  const std::vector<Eigen::Vector3d> on_truth = truth.surface_samples(samples, 3);
+  const PointIndex index(on_truth, 0.01);
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& x : mesh_samples(mesh, samples)) {
+    if (index.nearest(x) > distance) out.push_back(x);
+  }
+  return out;
+}
+
 std::vector<ColourView> Frame::views() const {
   std::vector<ColourView> v;
   for (std::size_t c = 0; c < cameras.size(); ++c) v.push_back({&cameras[c], images[c].view(), &masks[c]});

@@ -28,6 +28,10 @@ struct SurfaceScore {
 SurfaceScore surface_distance(const hull::Mesh& mesh, const sim::ActorBody& truth,
                               int samples = 300000);
 
+// Mesh samples farther than `distance` from the true surface (where the excess is).
+std::vector<Eigen::Vector3d> far_mesh_points(const hull::Mesh& mesh, const sim::ActorBody& truth,
+                                             double distance, int samples = 100000);
+
 // One frame of a simulated studio: colour images, keyed masks (the keyer's blue defaults) and the
 // truth.
 struct Frame {

@@ -46,9 +46,9 @@ struct ColourView {
 };
 
 struct CarveOptions {
-  double threshold = 9.0;        // carve above this weighted RGB spread (grey levels, RMS)
+  double threshold = 6.0;        // carve above this weighted RGB spread (grey levels, RMS)
   int min_cameras = 2;           // consistency needs at least this many views of a voxel
-  double min_cos = 0.3;          // views more grazing than this do not judge a voxel
+  double min_cos = 0.5;          // views more grazing than this do not judge a voxel (spill)
   int edge_margin_px = 2;        // silhouette border pixels not used (blue spill)
   int sample_radius_px = 0;      // colour = mean over a (2r+1)^2 pixel patch (noise)
   double depth_tolerance = 1.5;  // cells: visibility slack of the depth buffers
