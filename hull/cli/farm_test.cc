@@ -166,6 +166,12 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
   EXPECT_NE(r.out.find("\"computed\":0,\"skipped\":50"), std::string::npos) << r.out;
   EXPECT_EQ(files_of(whole), expected);
 
+  // Progress for people: a bar with the rate and the ETA on stderr (--progress forces it here).
+  r = run(hull() + " offline " + args(dir_ / "progress") + " --frames 0:3 --threads 1 --progress", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("4/4 frames (0 skipped)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("frames/min ETA 00:00"), std::string::npos) << r.err;
+
   // A damaged frame fails verification and is recomputed, identical.
   {
     const std::string damaged = expected.at("actor_000030.glb").substr(0, 1000);
