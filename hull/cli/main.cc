@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "frame_input.h"
+#include "offline_refined.h"
 #include "hull/crossing_refine.h"
 #include "hull/mesh_io.h"
 #include "hull/segment_mesh.h"
@@ -408,7 +409,7 @@ int main(int argc, char** argv) {
   if (verb == "-h" || verb == "--help" || verb == "help") {
     const auto service = hull_service_definition();
     std::cout
-        << kUsage << "\nService config (studio-hull --config FILE): " << service.summary << "\n"
+        << kUsage << "\n" << cli::refined_usage() << "\nService config (studio-hull --config FILE): " << service.summary << "\n"
         << service.config_help
         << "  plus the common service keys: instance, domain, dds_config, status_period, log\n";
     return 0;
@@ -419,11 +420,12 @@ int main(int argc, char** argv) {
   if (verb == "offline") {
     for (int k = 2; k < argc; ++k) {
       if (std::string(argv[k]) == "--help" || std::string(argv[k]) == "-h") {
-        std::cout << kUsage;
+        std::cout << kUsage << "\n" << cli::refined_usage();
         return 0;
       }
     }
     try {
+      if (cli::wants_refined(argc, argv)) return cli::run_refined(argc, argv);
       return run_offline(argc, argv);
     } catch (const std::exception& e) {
       std::cerr << "studio-hull: " << e.what() << "\n";

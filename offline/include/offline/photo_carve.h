@@ -1,0 +1,79 @@
+#pragma once
+// Photo-consistent refinement of the visual hull (TCSVT 2004 §IV-B names it for the offline
+// phase: "voxel colouring or shape carving"). The visual hull cannot see concavities (between
+// an arm and the body, under a crouching actor's chest); the colour images can: a point of the
+// hull that is not on the actor's surface is seen by different cameras as different surface
+// points, so their colours disagree.
+//
+// Method: generalised voxel colouring (Culbertson, Malzbender, Slabaugh, "Generalized Voxel
+// Coloring", 1999; Kutulakos & Seitz, "A Theory of Shape by Space Carving", IJCV 2000) on the
+// hull's own grid. The segment set is sampled into cubic voxels (edge = the column spacing), and
+// repeatedly:
+//   1. every camera's depth buffer of the current surface voxels gives visibility (a voxel is
+//      seen by camera c iff it is in front of c, faces it (n.v >= min_cos) and no surface voxel
+//      lies more than `depth_tolerance` cells nearer on its pixel);
+//   2. each surface voxel seen by >= min_cameras cameras gathers their colours at its
+//      projection — never from a pixel within `edge_margin_px` of that camera's silhouette
+//      boundary (the blue spill and the anti-aliased edge mix the cloth into the actor there)
+//      and with weights cos^2 (grazing views carry the most spill);
+//   3. a voxel whose weighted colour spread (RMS over cameras, blue channel half weight: the
+//      spill and the blue LED ring tint mostly blue) exceeds `threshold` is carved;
+// until nothing changes. Carving never goes deeper than `max_depth_cells` below the hull (a
+// bound on what a wrong colour can do) and never removes a voxel seen by fewer than
+// min_cameras cameras (no evidence: the hull stays).
+//
+// The result is a SegmentSet over the same grid: hull intervals without a carved voxel are
+// returned exactly (so an uncarved region's mesh is the hull's mesh), carved ends lie on voxel
+// faces.
+
+#include <cstddef>
+#include <span>
+
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/run_mask.h"
+#include "hull/segment_mesh.h"
+#include "hull/segment_set.h"
+
+namespace studio::offline {
+
+// One camera of a frame: its calibration, colour image and keyed silhouette (same size).
+struct ColourView {
+  const Camera* camera = nullptr;
+  ImageView<const Rgb8> image;
+  const RunMask* mask = nullptr;
+};
+
+struct CarveOptions {
+  double threshold = 6.0;        // carve above this weighted RGB spread (grey levels, RMS)
+  int min_cameras = 2;           // consistency needs at least this many views of a voxel
+  double min_cos = 0.5;          // views more grazing than this do not judge a voxel (spill)
+  int edge_margin_px = 2;        // silhouette border pixels not used (blue spill)
+  int sample_radius_px = 0;      // colour = mean over a (2r+1)^2 pixel patch (noise)
+  double depth_tolerance = 1.5;  // cells: visibility slack of the depth buffers
+  int max_depth_cells = 12;      // carving stops this many cells below the hull surface
+  int max_iterations = 60;
+  int threads = 1;               // surface voxels are judged in parallel
+  Expected<void> validate() const;
+};
+
+struct CarveResult {
+  hull::SegmentSet set;       // the refined shape (a subset of the hull)
+  int iterations = 0;
+  std::size_t voxels = 0;     // hull voxels sampled
+  std::size_t carved = 0;     // voxels removed
+};
+
+// Fails (one line) on invalid options, no views, or a view whose image or mask size differs
+// from its camera. The result does not depend on options.threads.
+Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const ColourView> views,
+                                  const CarveOptions& options = {});
+
+// The refined mesh: segment marching cubes of `refined`, with the exact silhouette crossings
+// (hull/crossing_refine.h) wherever the surface is still the hull's; where it was carved the
+// crossing stays at half a cell (the silhouettes say nothing there).
+Expected<hull::Mesh> refined_mesh(const hull::SegmentSet& refined, const hull::SegmentSet& hull,
+                                  std::span<const ColourView> views, int threads = 1);
+
+}  // namespace studio::offline

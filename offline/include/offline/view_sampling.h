@@ -1,0 +1,69 @@
+#pragma once
+// What the photo-consistency test and the texture blend share: a camera prepared for colour
+// sampling (its silhouette's interior, away from the blue spill on the edges), a depth buffer for
+// visibility, and the colour of a surface point in one camera.
+
+#include <Eigen/Core>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "offline/photo_carve.h"
+
+namespace studio::offline {
+
+struct SampledView {
+  const Camera* camera = nullptr;
+  Eigen::Matrix3d R;  // cam_from_world
+  Eigen::Vector3d t;
+  Eigen::Vector3d centre;  // camera centre in the world
+  ImageView<const Rgb8> image;
+  // 1 where the pixel and every pixel within edge_margin (Chebyshev) are inside the silhouette:
+  // colours are sampled there only (the silhouette border carries the cloth's blue spill).
+  std::vector<uint8_t> interior;
+  bool inside(int x, int y) const { return interior[std::size_t(y) * camera->width + x] != 0; }
+};
+
+// Fails on no views or a size mismatch between a camera and its image or mask.
+Expected<std::vector<SampledView>> prepare_views(std::span<const ColourView> views,
+                                                 int edge_margin_px);
+
+// Nearest camera-frame depth per pixel (infinity where nothing was drawn).
+class DepthBuffer {
+ public:
+  void reset(const SampledView& v);
+  // A cube of edge `size` at x, drawn as the square of its projected size around its centre.
+  void splat(const SampledView& v, const Eigen::Vector3d& x, double size);
+  // A triangle (world vertices), depth interpolated linearly in screen space (perspective error
+  // well below a cell for the small triangles of a hull mesh).
+  void triangle(const SampledView& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                const Eigen::Vector3d& c);
+  float at(int x, int y) const { return depth_[std::size_t(y) * std::size_t(width_) + x]; }
+
+ private:
+  int width_ = 0, height_ = 0;
+  std::vector<float> depth_;
+};
+
+struct Observation {
+  Eigen::Vector3f colour;  // display RGB (0..255), bilinear at the projection
+  float weight = 0;        // cos^2 of the viewing angle
+  float cos = 0;
+};
+
+// The colour camera `v` sees at surface point x with outward normal n, if it sees it: in front,
+// cos(n, to camera) >= min_cos, not hidden (depth <= buffer + tolerance, metres), and the
+// bilinear footprint lies in the silhouette's interior. radius_px > 0: the mean of the bilinear
+// samples on a (2r+1)^2 pixel lattice around the projection (less noise; all in the interior).
+std::optional<Observation> observe(const SampledView& v, const DepthBuffer& depth,
+                                   const Eigen::Vector3d& x, const Eigen::Vector3d& n,
+                                   double min_cos, double tolerance, int radius_px = 0);
+
+// Weighted RMS distance of the observations' colours from their weighted mean, blue channel at
+// half weight (grey levels).
+double colour_spread(std::span<const Observation> obs);
+
+}  // namespace studio::offline

@@ -1,0 +1,127 @@
+// The offline post-production frame (issue 21) on the simulated studio: 9 cameras (8 ring +
+// overhead) at 704x576, the actor crouching (frame 45), one core per frame (the CLI runs frames in
+// parallel, one per core). Stages after keying: hull = cut + segment marching cubes + exact
+// crossings (the baseline: `studio-hull offline` without --refine); carve = photo_carve;
+// refined_mesh; texture = vertex_colours; encode = the glb bytes. BM_Frame runs a whole frame per
+// mode at 256^2 and 512^2 columns (frames_per_min counter). BM_Quality: the refinement's quality
+// (surface distance to the true actor, counters in mm) against its cost, per threshold, with the
+// hull as the baseline in the same run.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+
+#include "hull/crossing_refine.h"
+#include "hull/segment_mesh.h"
+#include "hull/silhouette_cut.h"
+#include "offline/frame_files.h"
+#include "offline/photo_carve.h"
+#include "offline/texture.h"
+#include "sim/cameras.h"
+#include "testing/truth.h"
+
+namespace studio::offline {
+namespace {
+
+struct Scene {
+  testing::Frame frame;
+  std::vector<ColourView> views;
+  std::vector<hull::View> cut_views;
+  Scene() {
+    sim::RingOptions ring;
+    ring.count = 9;
+    sim::StudioOptions so;
+    so.actor.motion = sim::Motion::crouch;
+    auto studio = sim::SimulatedStudio::create(sim::ring_cameras(ring), so).value();
+    frame = testing::render_frame(studio, 45);
+    views = frame.views();
+    for (const auto& v : views) cut_views.push_back({v.camera, v.mask});
+  }
+  static const Scene& get() {
+    static const Scene s;
+    return s;
+  }
+};
+
+hull::Mesh hull_mesh(const Scene& s, const hull::SegmentSet& set) {
+  hull::Mesh m = hull::segment_marching_cubes(set);
+  (void)hull::refine_crossings(m, set, s.cut_views);
+  return m;
+}
+
+// range(0): grid; range(1): 0 hull only, 1 refined, 2 refined + textured.
+void BM_Frame(benchmark::State& state) {
+  const Scene& s = Scene::get();
+  const int mode = int(state.range(1));
+  double t_hull = 0, t_carve = 0, t_mesh = 0, t_texture = 0, t_encode = 0;
+  const auto ms = [](auto t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  };
+  for (auto _ : state) {
+    auto t0 = std::chrono::steady_clock::now();
+    const hull::SegmentSet set = hull::visual_hull(testing::studio_grid(int(state.range(0))), s.cut_views).value();
+    hull::Mesh mesh;
+    if (mode == 0) {
+      mesh = hull_mesh(s, set);
+      t_hull += ms(t0);
+    } else {
+      t_hull += ms(t0);
+      t0 = std::chrono::steady_clock::now();
+      const CarveResult carved = photo_carve(set, s.views).value();
+      t_carve += ms(t0);
+      t0 = std::chrono::steady_clock::now();
+      mesh = refined_mesh(carved.set, set, s.views).value();
+      t_mesh += ms(t0);
+    }
+    std::vector<Eigen::Vector3f> colours;
+    if (mode == 2) {
+      t0 = std::chrono::steady_clock::now();
+      colours = vertex_colours(mesh, s.views).value();
+      t_texture += ms(t0);
+    }
+    t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(encode_frame_glb(mesh, mode == 2 ? &colours : nullptr, "actor", 45));
+    t_encode += ms(t0);
+  }
+  const double n = double(state.iterations());
+  state.counters["hull_ms"] = t_hull / n;
+  state.counters["carve_ms"] = t_carve / n;
+  state.counters["refined_mesh_ms"] = t_mesh / n;
+  state.counters["texture_ms"] = t_texture / n;
+  state.counters["encode_ms"] = t_encode / n;
+  state.counters["frames_per_min"] =
+      benchmark::Counter(n * 60, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Frame)
+    ->ArgsProduct({{256, 512}, {0, 1, 2}})
+    ->ArgNames({"grid", "mode"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
+
+// range(0): threshold (grey levels; 0 = the hull itself, the baseline).
+void BM_Quality(benchmark::State& state) {
+  const Scene& s = Scene::get();
+  const hull::SegmentSet set = hull::visual_hull(testing::studio_grid(256), s.cut_views).value();
+  CarveOptions o;
+  o.threshold = double(state.range(0));
+  hull::Mesh mesh;
+  for (auto _ : state) {
+    if (state.range(0) == 0) {
+      mesh = hull_mesh(s, set);
+    } else {
+      const CarveResult carved = photo_carve(set, s.views, o).value();
+      mesh = refined_mesh(carved.set, set, s.views).value();
+    }
+  }
+  const auto score = testing::surface_distance(mesh, s.frame.truth.body, 100000);
+  state.counters["mean_mm"] = 1e3 * score.both.mean;
+  state.counters["p95_mm"] = 1e3 * score.both.p95;
+  state.counters["accuracy_mean_mm"] = 1e3 * score.accuracy.mean;
+  state.counters["completeness_mean_mm"] = 1e3 * score.completeness.mean;
+}
+BENCHMARK(BM_Quality)->Arg(0)->Arg(4)->Arg(6)->Arg(9)->Arg(12)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+
+}  // namespace
+}  // namespace studio::offline
+
+BENCHMARK_MAIN();

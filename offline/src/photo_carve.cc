@@ -1,0 +1,281 @@
+#include "offline/photo_carve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <thread>
+#include <vector>
+
+#include "hull/crossing_refine.h"
+#include "hull/silhouette_cut.h"
+#include "offline/view_sampling.h"
+
+namespace studio::offline {
+namespace {
+
+// The voxel lattice over the occupied part of the hull's grid: column (i, j) of the grid,
+// layer k at t = t0 + (k + 0.5) dt. Index k + nk * (ii + ni * jj), k fastest (a column is
+// contiguous).
+struct Lattice {
+  int i0 = 0, j0 = 0, ni = 0, nj = 0, nk = 0;
+  double t0 = 0, dt = 0;
+  std::size_t index(int ii, int jj, int k) const {
+    return std::size_t(k) + std::size_t(nk) * (std::size_t(ii) + std::size_t(ni) * std::size_t(jj));
+  }
+  std::size_t size() const { return std::size_t(ni) * std::size_t(nj) * std::size_t(nk); }
+};
+
+enum : uint8_t { kEmpty = 0, kFull = 1 };
+
+void parallel_for(std::size_t n, int threads, const auto& body) {
+  threads = std::max(1, std::min<int>(threads, int(n / 256) + 1));
+  if (threads == 1) {
+    body(std::size_t{0}, n);
+    return;
+  }
+  std::vector<std::jthread> pool;
+  const std::size_t chunk = (n + std::size_t(threads) - 1) / std::size_t(threads);
+  for (int w = 0; w < threads; ++w) {
+    const std::size_t a = std::min(n, w * chunk), b = std::min(n, a + chunk);
+    pool.emplace_back([&body, a, b] { body(a, b); });
+  }
+}
+
+}  // namespace
+
+Expected<void> CarveOptions::validate() const {
+  if (!(threshold > 0) || !std::isfinite(threshold)) return fail("carve: threshold must be > 0");
+  if (min_cameras < 2 || min_cameras > 64) return fail("carve: min_cameras must be 2..64");
+  if (!(min_cos >= 0 && min_cos < 1)) return fail("carve: min_cos must be in [0, 1)");
+  if (edge_margin_px < 0 || edge_margin_px > 16) return fail("carve: edge_margin_px must be 0..16");
+  if (sample_radius_px < 0 || sample_radius_px > 4) return fail("carve: sample_radius_px must be 0..4");
+  if (!(depth_tolerance > 0 && depth_tolerance < 16))
+    return fail("carve: depth_tolerance must be in (0, 16) cells");
+  if (max_depth_cells < 0 || max_depth_cells > 1000) return fail("carve: max_depth_cells must be 0..1000");
+  if (max_iterations < 0 || max_iterations > 10000) return fail("carve: max_iterations must be 0..10000");
+  if (threads < 1 || threads > 64) return fail("carve: threads must be 1..64");
+  return {};
+}
+
+Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const ColourView> views,
+                                  const CarveOptions& options) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  auto sampled = prepare_views(views, options.edge_margin_px);
+  if (!sampled) return std::unexpected(sampled.error());
+  const std::vector<SampledView>& cams = *sampled;
+  const hull::GridSpec& g = hull.grid();
+  CarveResult result;
+  result.set = hull;
+
+  // The lattice: bounding rectangle of the non-empty columns, t range of their intervals, one
+  // empty voxel of padding all round (so every surface voxel has in-range neighbours).
+  int i_lo = g.cells_u, i_hi = -1, j_lo = g.cells_v, j_hi = -1;
+  double t_lo = std::numeric_limits<double>::max(), t_hi = -t_lo;
+  for (int j = 0; j < g.cells_v; ++j) {
+    for (int i = 0; i < g.cells_u; ++i) {
+      const auto col = hull.column(i, j);
+      if (col.empty()) continue;
+      i_lo = std::min(i_lo, i), i_hi = std::max(i_hi, i);
+      j_lo = std::min(j_lo, j), j_hi = std::max(j_hi, j);
+      t_lo = std::min<double>(t_lo, col.front().lo), t_hi = std::max<double>(t_hi, col.back().hi);
+    }
+  }
+  if (i_hi < 0) return result;
+  Lattice L;
+  L.dt = 0.5 * (g.du() + g.dv());
+  L.i0 = i_lo - 1, L.j0 = j_lo - 1;
+  L.ni = i_hi - i_lo + 3, L.nj = j_hi - j_lo + 3;
+  L.t0 = t_lo - L.dt;
+  L.nk = int(std::ceil((t_hi - t_lo) / L.dt)) + 2;
+  std::vector<uint8_t> occ(L.size(), kEmpty);
+  for (int jj = 1; jj + 1 < L.nj; ++jj) {
+    for (int ii = 1; ii + 1 < L.ni; ++ii) {
+      for (const hull::Interval& iv : hull.column(L.i0 + ii, L.j0 + jj)) {
+        const int ka = std::max(1, int(std::ceil((iv.lo - L.t0) / L.dt - 0.5)));
+        const int kb = std::min(L.nk - 2, int(std::ceil((iv.hi - L.t0) / L.dt - 0.5)) - 1);
+        for (int k = ka; k <= kb; ++k) occ[L.index(ii, jj, k)] = kFull;
+      }
+    }
+  }
+  const auto centre = [&](int ii, int jj, int k) {
+    return g.point(L.i0 + ii, L.j0 + jj, L.t0 + (k + 0.5) * L.dt);
+  };
+  // Depth below the hull surface in cells (chessboard distance, capped): carving stops at
+  // max_depth_cells.
+  std::vector<uint8_t> depth(L.size(), 255);
+  {
+    std::vector<std::size_t> frontier, next;
+    for (int jj = 1; jj + 1 < L.nj; ++jj)
+      for (int ii = 1; ii + 1 < L.ni; ++ii)
+        for (int k = 1; k + 1 < L.nk; ++k) {
+          const std::size_t x = L.index(ii, jj, k);
+          if (!occ[x]) continue;
+          ++result.voxels;
+          const std::size_t sk = 1, si = std::size_t(L.nk), sj = si * std::size_t(L.ni);
+          if (!occ[x - sk] || !occ[x + sk] || !occ[x - si] || !occ[x + si] || !occ[x - sj] ||
+              !occ[x + sj]) {
+            depth[x] = 0;
+            frontier.push_back(x);
+          }
+        }
+    const int cap = std::min(options.max_depth_cells, 254);
+    const std::size_t sk = 1, si = std::size_t(L.nk), sj = si * std::size_t(L.ni);
+    for (int d = 1; d <= cap && !frontier.empty(); ++d) {
+      next.clear();
+      for (const std::size_t x : frontier) {
+        for (const std::size_t y : {x - sk, x + sk, x - si, x + si, x - sj, x + sj}) {
+          if (occ[y] && depth[y] == 255) {
+            depth[y] = uint8_t(d);
+            next.push_back(y);
+          }
+        }
+      }
+      frontier.swap(next);
+    }
+  }
+  const int max_depth = options.max_depth_cells;
+
+  const std::size_t sk = 1, si = std::size_t(L.nk), sj = si * std::size_t(L.ni);
+  struct Surface {
+    int ii, jj, k;
+    std::size_t x;
+  };
+  std::vector<Surface> surface;
+  std::vector<uint8_t> carve_flag;
+  std::vector<DepthBuffer> buffers(cams.size());
+  const double tol = options.depth_tolerance * L.dt;
+  for (int iter = 0; iter < options.max_iterations; ++iter) {
+    surface.clear();
+    for (int jj = 1; jj + 1 < L.nj; ++jj)
+      for (int ii = 1; ii + 1 < L.ni; ++ii)
+        for (int k = 1; k + 1 < L.nk; ++k) {
+          const std::size_t x = L.index(ii, jj, k);
+          if (occ[x] && (!occ[x - sk] || !occ[x + sk] || !occ[x - si] || !occ[x + si] ||
+                         !occ[x - sj] || !occ[x + sj])) {
+            surface.push_back({ii, jj, k, x});
+          }
+        }
+    // 1. Visibility: every camera's depth buffer of the surface voxels (a splat of the voxel's
+    // projected size around its centre).
+    parallel_for(cams.size(), options.threads, [&](std::size_t a, std::size_t b) {
+      for (std::size_t c = a; c < b; ++c) {
+        buffers[c].reset(cams[c]);
+        for (const Surface& s : surface) buffers[c].splat(cams[c], centre(s.ii, s.jj, s.k), L.dt);
+      }
+    });
+    // 2-3. Photo-consistency of every carvable surface voxel.
+    carve_flag.assign(surface.size(), 0);
+    parallel_for(surface.size(), options.threads, [&](std::size_t a, std::size_t b) {
+      std::vector<Observation> obs;
+      for (std::size_t n = a; n < b; ++n) {
+        const Surface& s = surface[n];
+        if (depth[s.x] > max_depth) continue;
+        // Outward normal: away from the occupied voxels of the 5x5x5 neighbourhood.
+        Eigen::Vector3d normal_l = Eigen::Vector3d::Zero();
+        for (int dj = -2; dj <= 2; ++dj)
+          for (int di = -2; di <= 2; ++di)
+            for (int dk = -2; dk <= 2; ++dk) {
+              const int ii = s.ii + di, jj = s.jj + dj, k = s.k + dk;
+              if (ii < 0 || jj < 0 || k < 0 || ii >= L.ni || jj >= L.nj || k >= L.nk ||
+                  !occ[L.index(ii, jj, k)]) {
+                normal_l += Eigen::Vector3d(di, dj, dk);
+              }
+            }
+        if (normal_l.squaredNorm() == 0) continue;
+        Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+        normal[g.u()] = normal_l.x(), normal[g.v()] = normal_l.y(), normal[g.a()] = normal_l.z();
+        normal.normalize();
+        const Eigen::Vector3d x = centre(s.ii, s.jj, s.k);
+        obs.clear();
+        for (std::size_t c = 0; c < cams.size(); ++c) {
+          if (auto o = observe(cams[c], buffers[c], x, normal, options.min_cos, tol,
+                                options.sample_radius_px)) {
+            obs.push_back(*o);
+          }
+        }
+        if (int(obs.size()) < options.min_cameras) continue;
+        if (colour_spread(obs) > options.threshold) carve_flag[n] = 1;
+      }
+    });
+    std::size_t carved = 0;
+    for (std::size_t n = 0; n < surface.size(); ++n) {
+      if (carve_flag[n]) {
+        occ[surface[n].x] = kEmpty;
+        ++carved;
+      }
+    }
+    result.iterations = iter + 1;
+    result.carved += carved;
+    if (carved == 0) break;
+  }
+
+  // Back to segments: a hull interval none of whose voxels was carved stays exact; otherwise
+  // each run of remaining voxels becomes an interval with carved ends on voxel faces and the
+  // hull's own ends where the run reaches them.
+  std::vector<std::vector<hull::Interval>> columns(g.columns());
+  for (int j = 0; j < g.cells_v; ++j) {
+    for (int i = 0; i < g.cells_u; ++i) {
+      const auto col = hull.column(i, j);
+      auto& out = columns[hull.column_index(i, j)];
+      const int ii = i - L.i0, jj = j - L.j0;
+      for (const hull::Interval& iv : col) {
+        const int ka = std::max(1, int(std::ceil((iv.lo - L.t0) / L.dt - 0.5)));
+        const int kb = std::min(L.nk - 2, int(std::ceil((iv.hi - L.t0) / L.dt - 0.5)) - 1);
+        bool any_carved = false;
+        for (int k = ka; k <= kb; ++k) any_carved |= !occ[L.index(ii, jj, k)];
+        if (!any_carved) {
+          out.push_back(iv);
+          continue;
+        }
+        for (int k = ka; k <= kb;) {
+          if (!occ[L.index(ii, jj, k)]) {
+            ++k;
+            continue;
+          }
+          int e = k;
+          while (e + 1 <= kb && occ[L.index(ii, jj, e + 1)]) ++e;
+          const float lo = k == ka ? iv.lo : float(L.t0 + k * L.dt);
+          const float hi = e == kb ? iv.hi : float(L.t0 + (e + 1) * L.dt);
+          if (lo < hi) out.push_back({lo, hi});
+          k = e + 1;
+        }
+      }
+    }
+  }
+  result.set = hull::SegmentSet::from_columns(g, columns);
+  return result;
+}
+
+Expected<hull::Mesh> refined_mesh(const hull::SegmentSet& refined, const hull::SegmentSet& hull,
+                                  std::span<const ColourView> views, int threads) {
+  hull::Mesh mesh = hull::segment_marching_cubes(refined);
+  hull::Mesh exact = mesh;
+  std::vector<hull::View> cut_views;
+  for (const ColourView& v : views) cut_views.push_back({v.camera, v.mask});
+  hull::CutOptions cut;
+  cut.threads = threads;
+  if (auto ok = hull::refine_crossings(exact, refined, cut_views, cut); !ok) {
+    return std::unexpected(ok.error());
+  }
+  // A vertex between an inside and an outside column of `refined`: keep the exact crossing only
+  // where the outside column is outside the hull too (a silhouette made that surface).
+  const hull::GridSpec& g = refined.grid();
+  for (std::size_t n = 0; n < mesh.vertices.size(); ++n) {
+    const Eigen::Vector3f p = mesh.vertices[n];
+    if (p == exact.vertices[n]) continue;
+    const double fi = (p[g.u()] - g.box_min[g.u()]) / g.du() - 0.5;
+    const double fj = (p[g.v()] - g.box_min[g.v()]) / g.dv() - 0.5;
+    const double t = p[g.a()];
+    // The two columns of the vertex's grid edge; the outside one in `refined`.
+    const int ia = int(std::floor(fi + 1e-6)), ja = int(std::floor(fj + 1e-6));
+    const bool along_u = std::abs(fi - std::round(fi)) > 0.25;
+    const int ib = along_u ? ia + 1 : ia, jb = along_u ? ja : ja + 1;
+    const Eigen::Vector3d pa = g.point(ia, ja, t), pb = g.point(ib, jb, t);
+    const Eigen::Vector3d outside = refined.contains(pa) ? pb : pa;
+    if (!hull.contains(outside)) mesh.vertices[n] = exact.vertices[n];
+  }
+  hull::compute_normals(mesh);
+  return mesh;
+}
+
+}  // namespace studio::offline

@@ -1,0 +1,104 @@
+#include "offline/texture.h"
+
+#include <cmath>
+#include <thread>
+
+#include "offline/view_sampling.h"
+
+namespace studio::offline {
+
+Expected<void> TextureOptions::validate() const {
+  if (!(min_cos >= 0 && min_cos < 1)) return fail("texture: min_cos must be in [0, 1)");
+  if (edge_margin_px < 0 || edge_margin_px > 16) return fail("texture: edge_margin_px must be 0..16");
+  if (!(depth_tolerance > 0 && depth_tolerance < 1)) return fail("texture: depth_tolerance must be in (0, 1) m");
+  if (!(sharpness >= 0 && sharpness <= 32)) return fail("texture: sharpness must be 0..32");
+  if (threads < 1 || threads > 64) return fail("texture: threads must be 1..64");
+  return {};
+}
+
+Expected<std::vector<Eigen::Vector3f>> vertex_colours(const hull::Mesh& mesh,
+                                                      std::span<const ColourView> views,
+                                                      const TextureOptions& options) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  auto sampled = prepare_views(views, options.edge_margin_px);
+  if (!sampled) return std::unexpected(sampled.error());
+  const std::vector<SampledView>& cams = *sampled;
+  const std::size_t nv = mesh.vertices.size();
+  std::vector<Eigen::Vector3d> sum(nv, Eigen::Vector3d::Zero());
+  std::vector<double> weight(nv, 0);
+  std::vector<DepthBuffer> buffers(cams.size());
+  {
+    std::vector<std::jthread> pool;
+    const int workers = std::max(1, std::min<int>(options.threads, int(cams.size())));
+    for (int w = 0; w < workers; ++w) {
+      pool.emplace_back([&, w] {
+        for (std::size_t c = std::size_t(w); c < cams.size(); c += std::size_t(workers)) {
+          buffers[c].reset(cams[c]);
+          for (const auto& t : mesh.triangles) {
+            buffers[c].triangle(cams[c], mesh.vertices[t[0]].cast<double>(),
+                                mesh.vertices[t[1]].cast<double>(), mesh.vertices[t[2]].cast<double>());
+          }
+        }
+      });
+    }
+  }
+  // Vertices in parallel; each sums its cameras in camera order (deterministic).
+  {
+    std::vector<std::jthread> pool;
+    const int workers = std::max(1, options.threads);
+    const std::size_t chunk = (nv + std::size_t(workers) - 1) / std::size_t(workers);
+    for (int w = 0; w < workers; ++w) {
+      pool.emplace_back([&, w] {
+        const std::size_t a = std::min(nv, std::size_t(w) * chunk), b = std::min(nv, a + chunk);
+        for (std::size_t n = a; n < b; ++n) {
+          const Eigen::Vector3d x = mesh.vertices[n].cast<double>();
+          const Eigen::Vector3d normal = mesh.normals[n].cast<double>();
+          if (normal.squaredNorm() < 0.5) continue;
+          for (std::size_t c = 0; c < cams.size(); ++c) {
+            auto o = observe(cams[c], buffers[c], x, normal, options.min_cos, options.depth_tolerance);
+            if (!o) continue;
+            const double w8 = std::pow(double(o->cos), options.sharpness);
+            sum[n] += w8 * o->colour.cast<double>();
+            weight[n] += w8;
+          }
+        }
+      });
+    }
+  }
+  std::vector<Eigen::Vector3f> colour(nv, Eigen::Vector3f::Zero());
+  std::vector<uint8_t> known(nv, 0);
+  for (std::size_t n = 0; n < nv; ++n) {
+    if (weight[n] > 0) {
+      colour[n] = (sum[n] / weight[n]).cast<float>();
+      known[n] = 1;
+    }
+  }
+  // Fill the unseen vertices from their neighbours, ring by ring (Jacobi steps: deterministic).
+  std::vector<std::vector<uint32_t>> adjacent(nv);
+  for (const auto& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      adjacent[t[k]].push_back(t[(k + 1) % 3]);
+      adjacent[t[k]].push_back(t[(k + 2) % 3]);
+    }
+  }
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::vector<std::pair<uint32_t, Eigen::Vector3f>> fill;
+    for (std::size_t n = 0; n < nv; ++n) {
+      if (known[n]) continue;
+      Eigen::Vector3f s = Eigen::Vector3f::Zero();
+      int count = 0;
+      for (uint32_t m : adjacent[n]) {
+        if (known[m]) s += colour[m], ++count;
+      }
+      if (count) fill.emplace_back(uint32_t(n), s / float(count));
+    }
+    for (const auto& [n, c] : fill) colour[n] = c, known[n] = 1, changed = true;
+  }
+  for (std::size_t n = 0; n < nv; ++n) {
+    if (!known[n]) colour[n] = Eigen::Vector3f(128, 128, 128);
+  }
+  return colour;
+}
+
+}  // namespace studio::offline

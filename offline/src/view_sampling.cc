@@ -1,0 +1,169 @@
+#include "offline/view_sampling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace studio::offline {
+
+Expected<std::vector<SampledView>> prepare_views(std::span<const ColourView> views,
+                                                 int edge_margin_px) {
+  if (views.empty()) return fail("no camera views");
+  std::vector<SampledView> out;
+  out.reserve(views.size());
+  for (const ColourView& cv : views) {
+    const Camera& cam = *cv.camera;
+    if (cv.image.width() != cam.width || cv.image.height() != cam.height) {
+      return fail("camera " + cam.id + ": image is " + std::to_string(cv.image.width()) + "x" +
+                  std::to_string(cv.image.height()) + ", camera is " + std::to_string(cam.width) +
+                  "x" + std::to_string(cam.height));
+    }
+    if (!cv.mask || cv.mask->width() != cam.width || cv.mask->height() != cam.height) {
+      return fail("camera " + cam.id + ": mask size differs from the camera's");
+    }
+    SampledView v;
+    v.camera = &cam;
+    v.R = cam.cam_from_world.R();
+    v.t = cam.cam_from_world.translation;
+    v.centre = cam.centre_in_world();
+    v.image = cv.image;
+    const int W = cam.width, H = cam.height, m = edge_margin_px;
+    std::vector<uint8_t> in(std::size_t(W) * H, 0), tmp(std::size_t(W) * H, 0);
+    for (int y = 0; y < H; ++y)
+      for (const Run& r : cv.mask->row(y))
+        std::fill(in.begin() + std::size_t(y) * W + r.begin, in.begin() + std::size_t(y) * W + r.end, 1);
+    // Erosion by a (2m+1)^2 square, separable: rows, then columns.
+    for (int y = 0; y < H; ++y) {
+      const uint8_t* row = &in[std::size_t(y) * W];
+      int run = 0;  // inside pixels ending at x
+      std::vector<int> left(W);
+      for (int x = 0; x < W; ++x) left[x] = run = row[x] ? run + 1 : 0;
+      int right = 0;
+      for (int x = W - 1; x >= 0; --x) {
+        right = row[x] ? right + 1 : 0;
+        tmp[std::size_t(y) * W + x] = left[x] > m && right > m;
+      }
+    }
+    v.interior.assign(std::size_t(W) * H, 0);
+    for (int x = 0; x < W; ++x) {
+      int run = 0;
+      std::vector<int> up(H);
+      for (int y = 0; y < H; ++y) up[y] = run = tmp[std::size_t(y) * W + x] ? run + 1 : 0;
+      int down = 0;
+      for (int y = H - 1; y >= 0; --y) {
+        down = tmp[std::size_t(y) * W + x] ? down + 1 : 0;
+        v.interior[std::size_t(y) * W + x] = up[y] > m && down > m;
+      }
+    }
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+void DepthBuffer::reset(const SampledView& v) {
+  width_ = v.camera->width, height_ = v.camera->height;
+  depth_.assign(std::size_t(width_) * height_, std::numeric_limits<float>::infinity());
+}
+
+void DepthBuffer::splat(const SampledView& v, const Eigen::Vector3d& x, double size) {
+  const Eigen::Vector3d xc = v.R * x + v.t;
+  if (!(xc.z() > 0)) return;
+  Eigen::Vector2d p;
+  if (!v.camera->project(x, &p)) return;
+  const double r = 0.5 * size * std::max(v.camera->intrinsics.fx, v.camera->intrinsics.fy) / xc.z();
+  const int x0 = std::max(0, int(std::ceil(p.x() - r))), x1 = std::min(width_ - 1, int(std::floor(p.x() + r)));
+  const int y0 = std::max(0, int(std::ceil(p.y() - r))), y1 = std::min(height_ - 1, int(std::floor(p.y() + r)));
+  const float z = float(xc.z());
+  for (int y = y0; y <= y1; ++y) {
+    float* row = &depth_[std::size_t(y) * width_];
+    for (int xx = x0; xx <= x1; ++xx) row[xx] = std::min(row[xx], z);
+  }
+}
+
+void DepthBuffer::triangle(const SampledView& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                           const Eigen::Vector3d& c) {
+  Eigen::Vector2d p[3];
+  double z[3];
+  const Eigen::Vector3d* w[3] = {&a, &b, &c};
+  for (int k = 0; k < 3; ++k) {
+    z[k] = (v.R * *w[k] + v.t).z();
+    if (!(z[k] > 0) || !v.camera->project(*w[k], &p[k])) return;
+  }
+  const double area = (p[1] - p[0]).x() * (p[2] - p[0]).y() - (p[1] - p[0]).y() * (p[2] - p[0]).x();
+  if (std::abs(area) < 1e-12) return;
+  const int x0 = std::max(0, int(std::ceil(std::min({p[0].x(), p[1].x(), p[2].x()}))));
+  const int x1 = std::min(width_ - 1, int(std::floor(std::max({p[0].x(), p[1].x(), p[2].x()}))));
+  const int y0 = std::max(0, int(std::ceil(std::min({p[0].y(), p[1].y(), p[2].y()}))));
+  const int y1 = std::min(height_ - 1, int(std::floor(std::max({p[0].y(), p[1].y(), p[2].y()}))));
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const Eigen::Vector2d q(x, y);
+      const auto edge = [&](int i, int j) {
+        return ((p[j] - p[i]).x() * (q - p[i]).y() - (p[j] - p[i]).y() * (q - p[i]).x()) / area;
+      };
+      const double l0 = edge(1, 2), l1 = edge(2, 0), l2 = edge(0, 1);
+      if (l0 < 0 || l1 < 0 || l2 < 0) continue;
+      float& d = depth_[std::size_t(y) * width_ + x];
+      d = std::min(d, float(l0 * z[0] + l1 * z[1] + l2 * z[2]));
+    }
+  }
+}
+
+std::optional<Observation> observe(const SampledView& v, const DepthBuffer& depth,
+                                   const Eigen::Vector3d& x, const Eigen::Vector3d& n,
+                                   double min_cos, double tolerance, int radius_px) {
+  const Eigen::Vector3d to_cam = (v.centre - x).normalized();
+  const double cos = n.dot(to_cam);
+  if (cos < min_cos) return std::nullopt;
+  const Eigen::Vector3d xc = v.R * x + v.t;
+  if (!(xc.z() > 0)) return std::nullopt;
+  Eigen::Vector2d p;
+  if (!v.camera->project(x, &p)) return std::nullopt;
+  const int W = v.camera->width, H = v.camera->height;
+  const int xn = int(std::lround(p.x())), yn = int(std::lround(p.y()));
+  if (xn < 0 || yn < 0 || xn >= W || yn >= H) return std::nullopt;
+  if (xc.z() > depth.at(xn, yn) + tolerance) return std::nullopt;
+  Eigen::Vector3f c = Eigen::Vector3f::Zero();
+  const int r = radius_px;
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
+      const double px = p.x() + dx, py = p.y() + dy;
+      const int x0 = int(std::floor(px)), y0 = int(std::floor(py));
+      if (x0 < 0 || y0 < 0 || x0 + 1 >= W || y0 + 1 >= H) return std::nullopt;
+      if (!v.inside(x0, y0) || !v.inside(x0 + 1, y0) || !v.inside(x0, y0 + 1) ||
+          !v.inside(x0 + 1, y0 + 1)) {
+        return std::nullopt;
+      }
+      const double fx = px - x0, fy = py - y0;
+      const auto add = [&](int xx, int yy, double w) {
+        const Rgb8 q = v.image.row(yy)[xx];
+        c += float(w) * Eigen::Vector3f(q.r, q.g, q.b);
+      };
+      add(x0, y0, (1 - fx) * (1 - fy));
+      add(x0 + 1, y0, fx * (1 - fy));
+      add(x0, y0 + 1, (1 - fx) * fy);
+      add(x0 + 1, y0 + 1, fx * fy);
+    }
+  }
+  c /= float((2 * r + 1) * (2 * r + 1));
+  return Observation{c, float(cos * cos), float(cos)};
+}
+
+double colour_spread(std::span<const Observation> obs) {
+  double sw = 0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Observation& o : obs) {
+    sw += o.weight;
+    mean += o.weight * o.colour.cast<double>();
+  }
+  if (sw <= 0) return 0;
+  mean /= sw;
+  double var = 0;
+  for (const Observation& o : obs) {
+    const Eigen::Vector3d d = o.colour.cast<double>() - mean;
+    var += o.weight * (d.x() * d.x() + d.y() * d.y() + 0.25 * d.z() * d.z());
+  }
+  return std::sqrt(var / sw / 2.25);
+}
+
+}  // namespace studio::offline

@@ -1,0 +1,219 @@
+#include "testing/truth.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <unordered_map>
+
+#include "keyer/keyer.h"
+
+namespace studio::offline::testing {
+namespace {
+
+// Nearest-neighbour distances through a hash grid of cell h.
+class PointIndex {
+ public:
+  PointIndex(const std::vector<Eigen::Vector3d>& pts, double h) : pts_(pts), h_(h) {
+    for (std::size_t n = 0; n < pts.size(); ++n) cells_[key(cell(pts[n]))].push_back(uint32_t(n));
+  }
+  double nearest(const Eigen::Vector3d& x) const {
+    const Eigen::Vector3i c = cell(x);
+    double best2 = std::numeric_limits<double>::max();
+    for (int r = 0; r < 64; ++r) {
+      for (int dz = -r; dz <= r; ++dz)
+        for (int dy = -r; dy <= r; ++dy)
+          for (int dx = -r; dx <= r; ++dx) {
+            if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != r) continue;
+            auto it = cells_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
+            if (it == cells_.end()) continue;
+            for (uint32_t n : it->second) best2 = std::min(best2, (pts_[n] - x).squaredNorm());
+          }
+      // Cells of shell r + 1 and beyond are at least r cells away.
+      if (best2 != std::numeric_limits<double>::max() && std::sqrt(best2) <= r * h_) break;
+    }
+    return std::sqrt(best2);
+  }
+
+ private:
+  Eigen::Vector3i cell(const Eigen::Vector3d& x) const {
+    return Eigen::Vector3i(int(std::floor(x.x() / h_)), int(std::floor(x.y() / h_)),
+                           int(std::floor(x.z() / h_)));
+  }
+  static uint64_t key(const Eigen::Vector3i& c) {
+    return (uint64_t(uint32_t(c.x() + (1 << 20))) << 42) ^ (uint64_t(uint32_t(c.y() + (1 << 20))) << 21) ^
+           uint64_t(uint32_t(c.z() + (1 << 20)));
+  }
+  const std::vector<Eigen::Vector3d>& pts_;
+  double h_;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
+};
+
+std::vector<Eigen::Vector3d> mesh_samples(const hull::Mesh& mesh, int n) {
+  std::vector<double> cum;
+  double total = 0;
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>(), b = mesh.vertices[t[1]].cast<double>(),
+                          c = mesh.vertices[t[2]].cast<double>();
+    total += 0.5 * (b - a).cross(c - a).norm();
+    cum.push_back(total);
+  }
+  std::vector<Eigen::Vector3d> out;
+  if (cum.empty()) return out;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int k = 0; k < n; ++k) {
+    const std::size_t f = std::min(cum.size() - 1, std::size_t(std::lower_bound(cum.begin(), cum.end(), u(rng) * total) - cum.begin()));
+    const auto& t = mesh.triangles[f];
+    double r1 = u(rng), r2 = u(rng);
+    if (r1 + r2 > 1) r1 = 1 - r1, r2 = 1 - r2;
+    out.push_back(mesh.vertices[t[0]].cast<double>() +
+                  r1 * (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cast<double>() +
+                  r2 * (mesh.vertices[t[2]] - mesh.vertices[t[0]]).cast<double>());
+  }
+  return out;
+}
+
+Distances stats(std::vector<double> d) {
+  Distances s;
+  if (d.empty()) return s;
+  double sum = 0;
+  for (double x : d) sum += x;
+  s.mean = sum / double(d.size());
+  const std::size_t k = std::min(d.size() - 1, std::size_t(0.95 * double(d.size())));
+  std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(k), d.end());
+  s.p95 = d[k];
+  return s;
+}
+
+}  // namespace
+
+SurfaceScore surface_distance(const hull::Mesh& mesh, const sim::ActorBody& truth, int samples) {
+  const std::vector<Eigen::Vector3d> on_truth = truth.surface_samples(samples, 3);
+  const std::vector<Eigen::Vector3d> on_mesh = mesh_samples(mesh, samples);
+  const PointIndex truth_index(on_truth, 0.01), mesh_index(on_mesh, 0.01);
+  std::vector<double> acc, comp;
+  for (const auto& x : on_mesh) acc.push_back(truth_index.nearest(x));
+  for (const auto& x : on_truth) comp.push_back(mesh_index.nearest(x));
+  SurfaceScore s;
+  s.accuracy = stats(acc);
+  s.completeness = stats(comp);
+  std::vector<double> both = acc;
+  both.insert(both.end(), comp.begin(), comp.end());
+  s.both = stats(std::move(both));
+  return s;
+}
+
+std::vector<Eigen::Vector3d> far_mesh_points(const hull::Mesh& mesh, const sim::ActorBody& truth,
+                                             double distance, int samples) {
+  const std::vector<Eigen::Vector3d> on_truth = truth.surface_samples(samples, 3);
+  const PointIndex index(on_truth, 0.01);
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& x : mesh_samples(mesh, samples)) {
+    if (index.nearest(x) > distance) out.push_back(x);
+  }
+  return out;
+}
+
+std::vector<ColourView> Frame::views() const {
+  std::vector<ColourView> v;
+  for (std::size_t c = 0; c < cameras.size(); ++c) v.push_back({&cameras[c], images[c].view(), &masks[c]});
+  return v;
+}
+
+Frame render_frame(const sim::SimulatedStudio& studio, int64_t frame) {
+  Frame f;
+  f.cameras = studio.cameras();
+  f.truth = studio.render_all(frame, &f.images, nullptr);
+  auto keyer = keyer::Keyer::create({}).value();
+  f.masks.resize(f.cameras.size());
+  for (std::size_t c = 0; c < f.cameras.size(); ++c) (void)keyer.key(f.images[c].view(), f.masks[c]);
+  return f;
+}
+
+Image<Rgb8> render_coloured(const hull::Mesh& mesh, const std::vector<Eigen::Vector3f>& colours,
+                            const Camera& camera, Rgb8 background) {
+  const int W = camera.width, H = camera.height;
+  Image<Rgb8> out(W, H);
+  std::vector<float> zbuf(std::size_t(W) * H, std::numeric_limits<float>::infinity());
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) out.view().row(y)[x] = background;
+  std::vector<Eigen::Vector2d> p(mesh.vertices.size());
+  std::vector<double> z(mesh.vertices.size());
+  std::vector<uint8_t> ok(mesh.vertices.size());
+  for (std::size_t n = 0; n < mesh.vertices.size(); ++n) {
+    const Eigen::Vector3d x = mesh.vertices[n].cast<double>();
+    z[n] = (camera.cam_from_world * x).z();
+    ok[n] = camera.project(x, &p[n]);
+  }
+  for (const auto& t : mesh.triangles) {
+    if (!ok[t[0]] || !ok[t[1]] || !ok[t[2]]) continue;
+    const Eigen::Vector2d a = p[t[0]], b = p[t[1]], c = p[t[2]];
+    const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    if (std::abs(area) < 1e-12) continue;
+    const int x0 = std::max(0, int(std::ceil(std::min({a.x(), b.x(), c.x()}))));
+    const int x1 = std::min(W - 1, int(std::floor(std::max({a.x(), b.x(), c.x()}))));
+    const int y0 = std::max(0, int(std::ceil(std::min({a.y(), b.y(), c.y()}))));
+    const int y1 = std::min(H - 1, int(std::floor(std::max({a.y(), b.y(), c.y()}))));
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        const Eigen::Vector2d q(x, y);
+        const double l0 = ((c - b).x() * (q - b).y() - (c - b).y() * (q - b).x()) / area;
+        const double l1 = ((a - c).x() * (q - c).y() - (a - c).y() * (q - c).x()) / area;
+        const double l2 = 1 - l0 - l1;
+        if (l0 < 0 || l1 < 0 || l2 < 0) continue;
+        // Perspective-correct interpolation (1/z).
+        const double w0 = l0 / z[t[0]], w1 = l1 / z[t[1]], w2 = l2 / z[t[2]], ws = w0 + w1 + w2;
+        const float depth = float(1 / ws);
+        float& zb = zbuf[std::size_t(y) * W + x];
+        if (depth >= zb) continue;
+        zb = depth;
+        const Eigen::Vector3f col =
+            (float(w0) * colours[t[0]] + float(w1) * colours[t[1]] + float(w2) * colours[t[2]]) / float(ws);
+        auto q8 = [](float v) { return uint8_t(std::clamp(v + 0.5f, 0.0f, 255.0f)); };
+        out.view().row(y)[x] = Rgb8{q8(col.x()), q8(col.y()), q8(col.z())};
+      }
+  }
+  return out;
+}
+
+double psnr(const Image<Rgb8>& image, const Image<Rgb8>& truth, const Mask& region) {
+  double se = 0;
+  std::size_t n = 0;
+  for (int y = 0; y < truth.height(); ++y)
+    for (int x = 0; x < truth.width(); ++x) {
+      if (!region.view().row(y)[x]) continue;
+      const Rgb8 a = image.view().row(y)[x], b = truth.view().row(y)[x];
+      se += double(a.r - b.r) * (a.r - b.r) + double(a.g - b.g) * (a.g - b.g) + double(a.b - b.b) * (a.b - b.b);
+      n += 3;
+    }
+  if (n == 0) return 0;
+  const double mse = se / double(n);
+  return mse <= 0 ? 99 : 10 * std::log10(255.0 * 255.0 / mse);
+}
+
+Mask erode(const Mask& mask, int r) {
+  Mask out(mask.width(), mask.height());
+  for (int y = 0; y < mask.height(); ++y)
+    for (int x = 0; x < mask.width(); ++x) {
+      bool all = true;
+      for (int dy = -r; dy <= r && all; ++dy)
+        for (int dx = -r; dx <= r && all; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          all = xx >= 0 && yy >= 0 && xx < mask.width() && yy < mask.height() &&
+                mask.view().row(yy)[xx] != 0;
+        }
+      out.view().row(y)[x] = all ? 255 : 0;
+    }
+  return out;
+}
+
+hull::GridSpec studio_grid(int n) {
+  hull::GridSpec g;
+  g.box_min = {-1.5, 0, -1.5};
+  g.box_max = {1.5, 2.4, 1.5};
+  g.axis = hull::Axis::y;
+  g.cells_u = g.cells_v = n;
+  return g;
+}
+
+}  // namespace studio::offline::testing
