@@ -19,7 +19,27 @@ function(studio_test)
   gtest_discover_tests(${T_NAME}
     PROPERTIES LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT}
     DISCOVERY_TIMEOUT 60)
+  foreach(label ${T_LABELS})
+    set_property(GLOBAL APPEND PROPERTY STUDIO_TESTS_${label} ${T_NAME})
+  endforeach()
 endfunction()
+
+# studio_tests_<label> (unit, integration, gl, dataset): builds every gtest binary of that label,
+# so `./studio test --asan -L unit` (CI's sanitizer run) builds only what it runs. Created once,
+# at the end of the top-level CMakeLists.txt, when every studio_test() is known.
+function(studio_label_targets)
+  foreach(label unit integration gl dataset)
+    get_property(targets GLOBAL PROPERTY STUDIO_TESTS_${label})
+    if(targets)
+      add_custom_target(studio_tests_${label} DEPENDS ${targets})
+    endif()
+  endforeach()
+endfunction()
+get_property(studio_label_targets_deferred GLOBAL PROPERTY STUDIO_LABEL_TARGETS_DEFERRED)
+if(NOT studio_label_targets_deferred)
+  set_property(GLOBAL PROPERTY STUDIO_LABEL_TARGETS_DEFERRED ON)
+  cmake_language(DEFER DIRECTORY ${CMAKE_SOURCE_DIR} CALL studio_label_targets)
+endif()
 
 # studio_bench(NAME name SOURCES a.cc LIBS lib...): a Google Benchmark binary, run by ./studio bench.
 function(studio_bench)
