@@ -2,18 +2,19 @@
 // reason, the bytes depend only on the content, and a DCC importer (assimp, the one scene/ uses)
 // loads both a frame (positions, normals, vertex colours) and the index (one mesh per frame, the
 // flip-book animation).
+#include "offline/frame_files.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <assimp/Importer.hpp>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 #include <filesystem>
 #include <fstream>
 
 #include "hull/segment_mesh.h"
 #include "hull/segment_set.h"
-#include "offline/frame_files.h"
 
 namespace fs = std::filesystem;
 
@@ -33,7 +34,8 @@ hull::Mesh box_mesh(float size) {
 
 std::vector<Eigen::Vector3f> colours_of(const hull::Mesh& m) {
   std::vector<Eigen::Vector3f> c;
-  for (std::size_t n = 0; n < m.vertices.size(); ++n) c.emplace_back(float(n % 256), 128, 255 - float(n % 256));
+  for (std::size_t n = 0; n < m.vertices.size(); ++n)
+    c.emplace_back(float(n % 256), 128, 255 - float(n % 256));
   return c;
 }
 
@@ -71,7 +73,8 @@ TEST(FrameFiles, FrameVerifiesAndDamageIsRefused) {
 }
 
 TEST(FrameFiles, ImporterLoadsFramesAndIndex) {
-  const fs::path dir = fs::temp_directory_path() / ("offline_frame_files_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("offline_frame_files_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::vector<FrameFileInfo> infos;
   std::vector<std::size_t> vertices;

@@ -11,8 +11,8 @@
 // - the result does not depend on the thread count; bad input is refused by reason.
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <algorithm>
+#include <cstdio>
 #include <map>
 
 #include "hull/crossing_refine.h"
@@ -86,10 +86,11 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
               sim::motion_name(motion), (long long)frame, kGrid, carved.carved, carved.voxels,
               carved.iterations);
   const auto row = [](const char* what, const testing::SurfaceScore& s, double psnr) {
-    std::printf("  %-8s surface distance mean / p95 (mm): both %.2f / %.2f, mesh->truth %.2f / %.2f, "
-                "truth->mesh %.2f / %.2f; held-out PSNR %.2f dB\n",
-                what, 1e3 * s.both.mean, 1e3 * s.both.p95, 1e3 * s.accuracy.mean, 1e3 * s.accuracy.p95,
-                1e3 * s.completeness.mean, 1e3 * s.completeness.p95, psnr);
+    std::printf(
+        "  %-8s surface distance mean / p95 (mm): both %.2f / %.2f, mesh->truth %.2f / %.2f, "
+        "truth->mesh %.2f / %.2f; held-out PSNR %.2f dB\n",
+        what, 1e3 * s.both.mean, 1e3 * s.both.p95, 1e3 * s.accuracy.mean, 1e3 * s.accuracy.p95,
+        1e3 * s.completeness.mean, 1e3 * s.completeness.p95, psnr);
   };
   row("hull", c.hull, c.psnr_hull);
   row("refined", c.refined, c.psnr_refined);
@@ -118,8 +119,8 @@ TEST(PhotoCarve, RefinedSurfaceIsCloserToTheTruthThanTheHull) {
     mean += c.refined.both.mean, p95 += c.refined.both.p95;
   }
   const double mean_gain = 1 - mean / hull_mean, p95_gain = 1 - p95 / hull_p95;
-  std::printf("over the poses: mean %.1f %% lower, p95 %.1f %% lower than the hull\n", 100 * mean_gain,
-              100 * p95_gain);
+  std::printf("over the poses: mean %.1f %% lower, p95 %.1f %% lower than the hull\n",
+              100 * mean_gain, 100 * p95_gain);
   // Measured 11 % / 17 % (docs/offline.md); the 30 % is not reached.
   EXPECT_GE(mean_gain, 0.08);
   EXPECT_GE(p95_gain, 0.10);

@@ -42,14 +42,16 @@ struct Result {
 };
 
 Result run(const std::string& cmd, const fs::path& dir) {
-  const std::string full = cmd + " >" + (dir / "out.txt").string() + " 2>" + (dir / "err.txt").string();
+  const std::string full =
+      cmd + " >" + (dir / "out.txt").string() + " 2>" + (dir / "err.txt").string();
   const int status = std::system(full.c_str());
   return {WEXITSTATUS(status), slurp(dir / "out.txt"), slurp(dir / "err.txt")};
 }
 
 std::map<std::string, std::string> files_of(const fs::path& dir) {
   std::map<std::string, std::string> out;
-  for (const auto& e : fs::directory_iterator(dir)) out[e.path().filename().string()] = slurp(e.path());
+  for (const auto& e : fs::directory_iterator(dir))
+    out[e.path().filename().string()] = slurp(e.path());
   return out;
 }
 
@@ -77,7 +79,8 @@ class HullFarm : public ::testing::Test {
       info.period_ns = 40'000'000;
       info.start_frame = kFirst;
       info.calibration_yaml = yaml::format_camera(cam, 2);
-      auto rec = capture::Recorder::start({.dir = (dir_ / "take" / cam.id).string(), .queue_frames = 64}, info);
+      auto rec = capture::Recorder::start(
+          {.dir = (dir_ / "take" / cam.id).string(), .queue_frames = 64}, info);
       ASSERT_TRUE(rec) << rec.error().message;
       for (uint64_t f = kFirst; f <= kLast; ++f) {
         Image<Rgb8> image;
@@ -104,14 +107,18 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
   const fs::path whole = dir_ / "whole";
   auto r = run(hull() + " offline " + args(whole) + " --threads 2 --json", dir_);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("\"event\":\"summary\",\"frames\":50,\"computed\":50,\"skipped\":0,\"index_written\":true"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"event\":\"summary\",\"frames\":50,\"computed\":50,\"skipped\":0,\"index_"
+                       "written\":true"),
+            std::string::npos)
+      << r.out;
   const auto expected = files_of(whole);
   ASSERT_EQ(expected.size(), 51u);  // 50 frames + the index
   ASSERT_TRUE(expected.contains("actor_000000.glb") && expected.contains("actor_000049.glb") &&
               expected.contains("actor.gltf"));
   for (const auto& [name, bytes] : expected) {
     if (name.ends_with(".glb")) {
-      auto info = offline::verify_frame_glb(std::span(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
+      auto info = offline::verify_frame_glb(
+          std::span(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
       ASSERT_TRUE(info) << name << ": " << info.error().message;
       EXPECT_TRUE(info->coloured);
       EXPECT_GT(info->triangles, 100u);
@@ -128,7 +135,8 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
   fs::create_directories(sharded);
   const pid_t pid = ::fork();
   if (pid == 0) {
-    const std::string cmd = "exec " + hull() + " offline " + args(sharded) + " --frames 12:24 --threads 1 --quiet";
+    const std::string cmd =
+        "exec " + hull() + " offline " + args(sharded) + " --frames 12:24 --threads 1 --quiet";
     ::execl("/bin/sh", "sh", "-c", cmd.c_str(), nullptr);
     ::_exit(127);
   }
@@ -152,8 +160,8 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
 
   // The whole take through the farm script (local mode): the killed shard resumes.
   const fs::path logs = dir_ / "logs";
-  r = run(std::string(STUDIO_HULL_FARM) + " --local --shards 4 --parallel 2 --log-dir " + logs.string() +
-              " --hull " + hull() + " -- " + args(sharded) + " --threads 1",
+  r = run(std::string(STUDIO_HULL_FARM) + " --local --shards 4 --parallel 2 --log-dir " +
+              logs.string() + " --hull " + hull() + " -- " + args(sharded) + " --threads 1",
           dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string resumed = slurp(logs / "shard-12-24.json");
@@ -167,7 +175,8 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
   EXPECT_EQ(files_of(whole), expected);
 
   // Progress for people: a bar with the rate and the ETA on stderr (--progress forces it here).
-  r = run(hull() + " offline " + args(dir_ / "progress") + " --frames 0:3 --threads 1 --progress", dir_);
+  r = run(hull() + " offline " + args(dir_ / "progress") + " --frames 0:3 --threads 1 --progress",
+          dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("4/4 frames (0 skipped)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("frames/min ETA 00:00"), std::string::npos) << r.err;
@@ -187,9 +196,12 @@ TEST_F(HullFarm, BadInputIsOneLine) {
   const fs::path out = dir_ / "bad";
   for (const std::string& a :
        {std::string("--refine --box 0,0,0,1,1,1 --grid 8 --out ") + out.string(),  // no take
-        "--take " + (dir_ / "nothing").string() + " --refine --box 0,0,0,1,1,1 --grid 8 --out " + out.string(),
-        "--take " + (dir_ / "take").string() + " --box 0,0,0,1,1,1 --grid 8 --out " + out.string() + " --refine --threshold -1",
-        "--take " + (dir_ / "take").string() + " --refine --box 0,0,0,1,1,1 --grid 8 --out " + out.string() + " --name a/b"}) {
+        "--take " + (dir_ / "nothing").string() + " --refine --box 0,0,0,1,1,1 --grid 8 --out " +
+            out.string(),
+        "--take " + (dir_ / "take").string() + " --box 0,0,0,1,1,1 --grid 8 --out " + out.string() +
+            " --refine --threshold -1",
+        "--take " + (dir_ / "take").string() + " --refine --box 0,0,0,1,1,1 --grid 8 --out " +
+            out.string() + " --name a/b"}) {
     auto r = run(hull() + " offline " + a, dir_);
     EXPECT_EQ(r.code, 2) << a;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -209,12 +221,16 @@ TEST_F(HullFarm, BadInputIsOneLine) {
 // The Slurm submission itself (no Slurm needed): one job array over the plan's shards, each task
 // running the same command as the local mode with its range, and a dependent index job.
 TEST_F(HullFarm, SlurmSubmission) {
-  auto r = run(std::string(STUDIO_HULL_FARM) + " --dry-run --shards 4 --cpus 2 --partition render --hull " +
-                   hull() + " -- " + args(dir_ / "slurm"),
+  auto r = run(std::string(STUDIO_HULL_FARM) +
+                   " --dry-run --shards 4 --cpus 2 --partition render --hull " + hull() + " -- " +
+                   args(dir_ / "slurm"),
                dir_);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("sbatch --parsable -c 2 -J studio-hull-offline -p render --array 0-3"), std::string::npos) << r.out;
-  for (const char* range : {"0:11", "12:24", "25:36", "37:49"}) EXPECT_NE(r.out.find(range), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("sbatch --parsable -c 2 -J studio-hull-offline -p render --array 0-3"),
+            std::string::npos)
+      << r.out;
+  for (const char* range : {"0:11", "12:24", "25:36", "37:49"})
+    EXPECT_NE(r.out.find(range), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("SLURM_ARRAY_TASK_ID"), std::string::npos) << r.out;
 }
 
@@ -224,17 +240,20 @@ TEST_F(HullFarm, SlurmSubmission) {
 // above runs the same shard commands.
 TEST_F(HullFarm, SlurmJobArray) {
   if (std::system("command -v sbatch >/dev/null 2>&1 && sinfo -h >/dev/null 2>&1") != 0) {
-    GTEST_SKIP() << "Slurm cannot start here (slurm-wlm not installed, no controller answers sinfo)";
+    GTEST_SKIP()
+        << "Slurm cannot start here (slurm-wlm not installed, no controller answers sinfo)";
   }
   const fs::path whole = dir_ / "slurm_whole", farm = dir_ / "slurm_farm";
   auto r = run(hull() + " offline " + args(whole) + " --threads 2", dir_);
   ASSERT_EQ(r.code, 0) << r.err;
-  r = run(std::string(STUDIO_HULL_FARM) + " --shards 4 --log-dir " + (dir_ / "slurm_logs").string() +
-              " --hull " + hull() + " -- " + args(farm) + " --threads 2",
+  r = run(std::string(STUDIO_HULL_FARM) + " --shards 4 --log-dir " +
+              (dir_ / "slurm_logs").string() + " --hull " + hull() + " -- " + args(farm) +
+              " --threads 2",
           dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   const auto t0 = std::chrono::steady_clock::now();
-  while (!fs::exists(farm / "actor.gltf") && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(900)) {
+  while (!fs::exists(farm / "actor.gltf") &&
+         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(900)) {
     std::this_thread::sleep_for(std::chrono::seconds(1));
   }
   EXPECT_EQ(files_of(farm), files_of(whole));

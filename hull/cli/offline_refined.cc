@@ -3,12 +3,11 @@
 #include <signal.h>
 #include <unistd.h>
 
-#include <cerrno>
-#include <cmath>
-
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -21,8 +20,8 @@
 #include <vector>
 
 #include "frame_input.h"
-#include "hull/segment_mesh.h"
 #include "hull/crossing_refine.h"
+#include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
 #include "keyer/config/keyer_yaml.h"
 #include "offline/frame_files.h"
@@ -105,21 +104,42 @@ Expected<Args> parse(int argc, char** argv) {
   Args a;
   for (int k = 2; k < argc; ++k) {
     const std::string opt = argv[k];
-    if (opt == "--refine") { a.refine = true; continue; }
-    if (opt == "--texture") { a.texture = true; continue; }
-    if (opt == "--json") { a.json = true; continue; }
-    if (opt == "--index-only") { a.index_only = true; continue; }
-    if (opt == "--progress" || opt == "--quiet") { a.progress = opt == "--progress"; continue; }
+    if (opt == "--refine") {
+      a.refine = true;
+      continue;
+    }
+    if (opt == "--texture") {
+      a.texture = true;
+      continue;
+    }
+    if (opt == "--json") {
+      a.json = true;
+      continue;
+    }
+    if (opt == "--index-only") {
+      a.index_only = true;
+      continue;
+    }
+    if (opt == "--progress" || opt == "--quiet") {
+      a.progress = opt == "--progress";
+      continue;
+    }
     if (k + 1 >= argc) return fail(opt + ": missing value (see --help)");
     const std::string v = argv[++k];
-    if (opt == "--rig") a.rig = v;
-    else if (opt == "--take") a.take = v;
-    else if (opt == "--keyer") a.keyer_file = v;
-    else if (opt == "--out") a.out = v;
-    else if (opt == "--name") a.name = v;
+    if (opt == "--rig")
+      a.rig = v;
+    else if (opt == "--take")
+      a.take = v;
+    else if (opt == "--keyer")
+      a.keyer_file = v;
+    else if (opt == "--out")
+      a.out = v;
+    else if (opt == "--name")
+      a.name = v;
     else if (opt == "--key") {
       auto m = keyer::parse_key_mode(v);
-      if (!m || *m == keyer::KeyMode::kDifference) return fail("--key: '" + v + "': expected blue or green");
+      if (!m || *m == keyer::KeyMode::kDifference)
+        return fail("--key: '" + v + "': expected blue or green");
       a.key = *m;
     } else if (opt == "--box") {
       std::vector<double> n;
@@ -135,7 +155,10 @@ Expected<Args> parse(int argc, char** argv) {
     } else if (opt == "--grid" || opt == "--threads" || opt == "--plan" || opt == "--max-depth") {
       auto d = number(opt, v);
       if (!d || *d != std::floor(*d)) return fail(opt + ": '" + v + "' is not an integer");
-      (opt == "--grid" ? a.grid : opt == "--threads" ? a.threads : opt == "--plan" ? a.plan : a.max_depth) = int(*d);
+      (opt == "--grid"      ? a.grid
+       : opt == "--threads" ? a.threads
+       : opt == "--plan"    ? a.plan
+                            : a.max_depth) = int(*d);
     } else if (opt == "--fps" || opt == "--threshold") {
       auto d = number(opt, v);
       if (!d || !(*d > 0)) return fail(opt + ": '" + v + "': expected a number > 0");
@@ -153,17 +176,20 @@ Expected<Args> parse(int argc, char** argv) {
       }
       a.frames = FrameRange{lo, hi};
     } else if (opt == "--min-views") {
-      if (v == "all") a.min_views = kAllViews;
+      if (v == "all")
+        a.min_views = kAllViews;
       else {
         auto d = number(opt, v);
-        if (!d || *d < 0 || *d > 64 || *d != std::floor(*d)) return fail("--min-views: '" + v + "': expected 0..64 or all");
+        if (!d || *d < 0 || *d > 64 || *d != std::floor(*d))
+          return fail("--min-views: '" + v + "': expected 0..64 or all");
         a.min_views = int(*d);
       }
     } else {
       return fail("unknown option " + opt + " (see --help)");
     }
   }
-  if (a.take.empty()) return fail("--take DIR is required (the colour images come from a recorded take)");
+  if (a.take.empty())
+    return fail("--take DIR is required (the colour images come from a recorded take)");
   if (!a.keyer_file.empty() && a.key) return fail("give --keyer FILE or --key, not both");
   if (a.name.empty() || !std::all_of(a.name.begin(), a.name.end(), [](char c) {
         return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
@@ -204,7 +230,8 @@ void remove_stale_temporaries(const std::string& dir) {
 Expected<bool> write_index_if_complete(const Args& a, const std::vector<uint64_t>& all) {
   std::vector<offline::FrameFileInfo> infos;
   for (uint64_t f : all) {
-    const std::string path = (fs::path(a.out) / offline::frame_file_name(a.name, int64_t(f))).string();
+    const std::string path =
+        (fs::path(a.out) / offline::frame_file_name(a.name, int64_t(f))).string();
     if (!fs::exists(path)) return false;
     auto info = offline::verify_frame_file(path);
     if (!info) return false;
@@ -212,7 +239,9 @@ Expected<bool> write_index_if_complete(const Args& a, const std::vector<uint64_t
   }
   const std::string json = offline::encode_index_gltf(a.name, a.fps, infos);
   const std::string path = (fs::path(a.out) / offline::index_file_name(a.name)).string();
-  if (auto ok = offline::write_file_atomic(path, std::span(reinterpret_cast<const uint8_t*>(json.data()), json.size())); !ok) {
+  if (auto ok = offline::write_file_atomic(
+          path, std::span(reinterpret_cast<const uint8_t*>(json.data()), json.size()));
+      !ok) {
     return std::unexpected(ok.error());
   }
   return true;
@@ -293,7 +322,10 @@ int run_refined(int argc, char** argv) {
   if (a.index_only) {
     auto done = write_index_if_complete(a, all);
     if (!done || !*done) {
-      std::cerr << "studio-hull: " << (done ? "the take's frames are not all written and verified in " + a.out : done.error().message) << "\n";
+      std::cerr << "studio-hull: "
+                << (done ? "the take's frames are not all written and verified in " + a.out
+                         : done.error().message)
+                << "\n";
       return 1;
     }
     return 0;
@@ -314,7 +346,8 @@ int run_refined(int argc, char** argv) {
   }
   std::vector<uint64_t> selected;
   for (uint64_t f : all) {
-    if (!a.frames || (long(f) >= a.frames->first && long(f) <= a.frames->last)) selected.push_back(f);
+    if (!a.frames || (long(f) >= a.frames->first && long(f) <= a.frames->last))
+      selected.push_back(f);
   }
   if (selected.empty()) {
     std::cerr << "studio-hull: take " << a.take << ": no frames in --frames\n";
@@ -335,14 +368,19 @@ int run_refined(int argc, char** argv) {
   } total;
   const auto report = [&](uint64_t f, bool skip, double ms) {  // under lock
     ++done;
-    if (skip) ++skipped; else ++computed, computed_ms += ms;
+    if (skip)
+      ++skipped;
+    else
+      ++computed, computed_ms += ms;
     const std::size_t left = selected.size() - done;
     // ETA: frames left at the measured rate of computed frames, frames in parallel.
     const double per_frame = computed ? computed_ms / double(computed) / workers : 0;
     const double eta_s = per_frame * double(left) / 1000;
     if (a.json) {
-      std::printf("{\"event\":\"frame\",\"frame\":%llu,\"skipped\":%s,\"ms\":%.1f,\"done\":%zu,\"total\":%zu,\"eta_s\":%.1f}\n",
-                  (unsigned long long)f, skip ? "true" : "false", ms, done, selected.size(), eta_s);
+      std::printf(
+          "{\"event\":\"frame\",\"frame\":%llu,\"skipped\":%s,\"ms\":%.1f,\"done\":%zu,\"total\":%"
+          "zu,\"eta_s\":%.1f}\n",
+          (unsigned long long)f, skip ? "true" : "false", ms, done, selected.size(), eta_s);
       std::fflush(stdout);
     }
     if (bar) {
@@ -364,17 +402,20 @@ int run_refined(int argc, char** argv) {
       const std::size_t k = next++;
       if (k >= selected.size()) return;
       const uint64_t f = selected[k];
-      const std::string path = (fs::path(a.out) / offline::frame_file_name(a.name, int64_t(f))).string();
+      const std::string path =
+          (fs::path(a.out) / offline::frame_file_name(a.name, int64_t(f))).string();
       const auto t_frame = std::chrono::steady_clock::now();
       if (fs::exists(path)) {
-        if (auto ok = offline::verify_frame_file(path); ok && ok->frame == int64_t(f) && ok->coloured == a.texture) {
+        if (auto ok = offline::verify_frame_file(path);
+            ok && ok->frame == int64_t(f) && ok->coloured == a.texture) {
           std::lock_guard g(lock);
           report(f, true, ms_since(t_frame));
           continue;
         }
       }
       Stages s;
-      if (auto ok = (*take)->load(f, slot, frame, s.read, s.key); !ok) return give_up(ok.error().message);
+      if (auto ok = (*take)->load(f, slot, frame, s.read, s.key); !ok)
+        return give_up(ok.error().message);
       std::vector<offline::ColourView> views;
       std::vector<View> cut_views;
       for (std::size_t c = 0; c < cameras.size(); ++c) {
@@ -399,7 +440,8 @@ int run_refined(int argc, char** argv) {
         mesh = std::move(*refined);
       } else {
         mesh = segment_marching_cubes(*hull);
-        if (auto ok = refine_crossings(mesh, *hull, cut_views, cut); !ok) return give_up(ok.error().message);
+        if (auto ok = refine_crossings(mesh, *hull, cut_views, cut); !ok)
+          return give_up(ok.error().message);
       }
       s.mesh = ms_since(t0);
       t0 = std::chrono::steady_clock::now();
@@ -411,8 +453,10 @@ int run_refined(int argc, char** argv) {
       }
       s.texture = ms_since(t0);
       t0 = std::chrono::steady_clock::now();
-      const auto bytes = offline::encode_frame_glb(mesh, colours ? &*colours : nullptr, a.name, int64_t(f));
-      if (auto ok = offline::write_file_atomic(path, bytes); !ok) return give_up(ok.error().message);
+      const auto bytes =
+          offline::encode_frame_glb(mesh, colours ? &*colours : nullptr, a.name, int64_t(f));
+      if (auto ok = offline::write_file_atomic(path, bytes); !ok)
+        return give_up(ok.error().message);
       s.write = ms_since(t0);
       std::lock_guard g(lock);
       total.read += s.read, total.key += s.key, total.cut += s.cut, total.carve += s.carve;
@@ -437,13 +481,17 @@ int run_refined(int argc, char** argv) {
   }
   if (a.json) {
     const double n = std::max<double>(1, double(computed));
-    std::printf("{\"event\":\"summary\",\"frames\":%zu,\"computed\":%zu,\"skipped\":%zu,\"index_written\":%s,"
-                "\"grid\":%d,\"cameras\":%zu,\"refine\":%s,\"texture\":%s,\"unit\":\"ms per computed frame\","
-                "\"read\":%.2f,\"key\":%.2f,\"cut\":%.2f,\"carve\":%.2f,\"mesh\":%.2f,\"texture_ms\":%.2f,"
-                "\"write\":%.2f,\"wall_ms\":%.1f}\n",
-                selected.size(), computed, skipped, *indexed ? "true" : "false", a.grid, cameras.size(),
-                a.refine ? "true" : "false", a.texture ? "true" : "false", total.read / n, total.key / n,
-                total.cut / n, total.carve / n, total.mesh / n, total.texture / n, total.write / n, ms_since(wall0));
+    std::printf(
+        "{\"event\":\"summary\",\"frames\":%zu,\"computed\":%zu,\"skipped\":%zu,\"index_written\":%"
+        "s,"
+        "\"grid\":%d,\"cameras\":%zu,\"refine\":%s,\"texture\":%s,\"unit\":\"ms per computed "
+        "frame\","
+        "\"read\":%.2f,\"key\":%.2f,\"cut\":%.2f,\"carve\":%.2f,\"mesh\":%.2f,\"texture_ms\":%.2f,"
+        "\"write\":%.2f,\"wall_ms\":%.1f}\n",
+        selected.size(), computed, skipped, *indexed ? "true" : "false", a.grid, cameras.size(),
+        a.refine ? "true" : "false", a.texture ? "true" : "false", total.read / n, total.key / n,
+        total.cut / n, total.carve / n, total.mesh / n, total.texture / n, total.write / n,
+        ms_since(wall0));
   }
   return 0;
 }

@@ -96,12 +96,15 @@ Expected<void> ColourTake::load(uint64_t f, int slot, ColourFrame& out, double& 
     }
     out.images[c] = Image<Rgb8>(cam.width, cam.height);
     std::memcpy(out.images[c].data(), pixels.data(), std::size_t(cam.width) * cam.height * 3);
-    read_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    read_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     t0 = std::chrono::steady_clock::now();
-    if (auto ok = impl_->keyers[std::size_t(slot)][c].key(out.images[c].view(), out.masks[c]); !ok) {
+    if (auto ok = impl_->keyers[std::size_t(slot)][c].key(out.images[c].view(), out.masks[c]);
+        !ok) {
       return fail(where + ": " + ok.error().message);
     }
-    key_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    key_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   return {};
 }

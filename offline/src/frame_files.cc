@@ -21,7 +21,8 @@ void put_u32(std::vector<uint8_t>& out, uint32_t v) {
   for (int k = 0; k < 4; ++k) out.push_back(uint8_t(v >> (8 * k)));
 }
 uint32_t get_u32(std::span<const uint8_t> b, std::size_t at) {
-  return uint32_t(b[at]) | uint32_t(b[at + 1]) << 8 | uint32_t(b[at + 2]) << 16 | uint32_t(b[at + 3]) << 24;
+  return uint32_t(b[at]) | uint32_t(b[at + 1]) << 8 | uint32_t(b[at + 2]) << 16 |
+         uint32_t(b[at + 3]) << 24;
 }
 template <class T>
 void append(std::vector<uint8_t>& bin, const T* data, std::size_t count) {
@@ -33,7 +34,9 @@ std::string num(double v) {
   std::snprintf(buf, sizeof buf, "%.9g", v);
   return buf;
 }
-std::string vec3(const Eigen::Vector3f& v) { return "[" + num(v.x()) + "," + num(v.y()) + "," + num(v.z()) + "]"; }
+std::string vec3(const Eigen::Vector3f& v) {
+  return "[" + num(v.x()) + "," + num(v.y()) + "," + num(v.z()) + "]";
+}
 
 // The byte offsets of the sections in the BIN chunk (see the header).
 struct Sections {
@@ -58,24 +61,28 @@ std::string mesh_json(int buffer, std::size_t base, const FrameFileInfo& f, std:
   const auto add = [&](std::size_t offset, std::size_t length, int target, int component,
                        std::size_t count, const char* type, const std::string& extra) {
     if (!views.empty()) views += ",";
-    views += "{\"buffer\":" + std::to_string(buffer) + ",\"byteOffset\":" + std::to_string(base + offset) +
-             ",\"byteLength\":" + std::to_string(length) + ",\"target\":" + std::to_string(target) + "}";
+    views += "{\"buffer\":" + std::to_string(buffer) +
+             ",\"byteOffset\":" + std::to_string(base + offset) +
+             ",\"byteLength\":" + std::to_string(length) + ",\"target\":" + std::to_string(target) +
+             "}";
     if (!accessors.empty()) accessors += ",";
-    accessors += "{\"bufferView\":" + std::to_string(view_count++) + ",\"componentType\":" +
-                 std::to_string(component) + ",\"count\":" + std::to_string(count) + ",\"type\":\"" +
-                 type + "\"" + extra + "}";
+    accessors += "{\"bufferView\":" + std::to_string(view_count++) +
+                 ",\"componentType\":" + std::to_string(component) +
+                 ",\"count\":" + std::to_string(count) + ",\"type\":\"" + type + "\"" + extra + "}";
     return accessor_count++;
   };
   const int pos = add(s.positions, 12 * f.vertices, 34962, 5126, f.vertices, "VEC3",
                       ",\"min\":" + vec3(f.min) + ",\"max\":" + vec3(f.max));
   const int nrm = add(s.normals, 12 * f.vertices, 34962, 5126, f.vertices, "VEC3", "");
-  std::string attributes = "\"POSITION\":" + std::to_string(pos) + ",\"NORMAL\":" + std::to_string(nrm);
+  std::string attributes =
+      "\"POSITION\":" + std::to_string(pos) + ",\"NORMAL\":" + std::to_string(nrm);
   if (f.coloured) {
     const int col = add(s.colours, 12 * f.vertices, 34962, 5126, f.vertices, "VEC3", "");
     attributes += ",\"COLOR_0\":" + std::to_string(col);
   }
   const int idx = add(s.indices, 12 * f.triangles, 34963, 5125, 3 * f.triangles, "SCALAR", "");
-  return "{\"attributes\":{" + attributes + "},\"indices\":" + std::to_string(idx) + ",\"material\":0}";
+  return "{\"attributes\":{" + attributes + "},\"indices\":" + std::to_string(idx) +
+         ",\"material\":0}";
 }
 
 const char* kMaterial =
@@ -119,7 +126,8 @@ std::string frame_file_name(const std::string& name, int64_t frame) {
 }
 std::string index_file_name(const std::string& name) { return name + ".gltf"; }
 
-std::vector<uint8_t> encode_frame_glb(const hull::Mesh& mesh, const std::vector<Eigen::Vector3f>* colours,
+std::vector<uint8_t> encode_frame_glb(const hull::Mesh& mesh,
+                                      const std::vector<Eigen::Vector3f>* colours,
                                       const std::string& name, int64_t frame) {
   FrameFileInfo f;
   f.frame = frame;
@@ -138,7 +146,8 @@ std::vector<uint8_t> encode_frame_glb(const hull::Mesh& mesh, const std::vector<
   if (colours) {
     std::vector<Eigen::Vector3f> lin(mesh.vertices.size(), Eigen::Vector3f::Constant(0.5f));
     for (std::size_t n = 0; n < lin.size() && n < colours->size(); ++n) {
-      lin[n] = Eigen::Vector3f(linear((*colours)[n].x()), linear((*colours)[n].y()), linear((*colours)[n].z()));
+      lin[n] = Eigen::Vector3f(linear((*colours)[n].x()), linear((*colours)[n].y()),
+                               linear((*colours)[n].z()));
     }
     append(bin, lin.data(), lin.size());
   }
@@ -150,13 +159,18 @@ std::vector<uint8_t> encode_frame_glb(const hull::Mesh& mesh, const std::vector<
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a64(bin)));
   std::string json =
       "{\"asset\":{\"version\":\"2.0\",\"generator\":\"studio-hull offline\"},\"scene\":0,"
-      "\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"name\":\"" + name + "\",\"mesh\":0}],"
-      "\"meshes\":[{\"name\":\"" + name + "\",\"primitives\":[" + primitive + "]}]," + kMaterial +
-      ",\"buffers\":[{\"byteLength\":" + std::to_string(bin.size()) + "}],\"bufferViews\":[" + views +
-      "],\"accessors\":[" + accessors + "],\"extras\":{\"studio_frame\":" + std::to_string(frame) +
-      ",\"studio_vertices\":" + std::to_string(f.vertices) + ",\"studio_triangles\":" +
-      std::to_string(f.triangles) + ",\"studio_coloured\":" + (f.coloured ? "1" : "0") +
-      ",\"studio_bin_fnv1a64\":\"" + hash + "\"}}";
+      "\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"name\":\"" +
+      name +
+      "\",\"mesh\":0}],"
+      "\"meshes\":[{\"name\":\"" +
+      name + "\",\"primitives\":[" + primitive + "]}]," + kMaterial +
+      ",\"buffers\":[{\"byteLength\":" + std::to_string(bin.size()) + "}],\"bufferViews\":[" +
+      views + "],\"accessors\":[" + accessors +
+      "],\"extras\":{\"studio_frame\":" + std::to_string(frame) +
+      ",\"studio_vertices\":" + std::to_string(f.vertices) +
+      ",\"studio_triangles\":" + std::to_string(f.triangles) +
+      ",\"studio_coloured\":" + (f.coloured ? "1" : "0") + ",\"studio_bin_fnv1a64\":\"" + hash +
+      "\"}}";
   while (json.size() % 4) json += ' ';
   while (bin.size() % 4) bin.push_back(0);
   std::vector<uint8_t> out;
@@ -173,19 +187,28 @@ std::vector<uint8_t> encode_frame_glb(const hull::Mesh& mesh, const std::vector<
 }
 
 Expected<FrameFileInfo> verify_frame_glb(std::span<const uint8_t> b) {
-  if (b.size() < 28 || get_u32(b, 0) != 0x46546C67 || get_u32(b, 4) != 2) return fail("not a glTF 2.0 binary");
-  if (get_u32(b, 8) != b.size()) return fail("length " + std::to_string(get_u32(b, 8)) + " in the header, file has " + std::to_string(b.size()) + " bytes (truncated?)");
+  if (b.size() < 28 || get_u32(b, 0) != 0x46546C67 || get_u32(b, 4) != 2)
+    return fail("not a glTF 2.0 binary");
+  if (get_u32(b, 8) != b.size())
+    return fail("length " + std::to_string(get_u32(b, 8)) + " in the header, file has " +
+                std::to_string(b.size()) + " bytes (truncated?)");
   const std::size_t json_len = get_u32(b, 12);
-  if (get_u32(b, 16) != 0x4E4F534A || 20 + json_len + 8 > b.size()) return fail("malformed JSON chunk");
+  if (get_u32(b, 16) != 0x4E4F534A || 20 + json_len + 8 > b.size())
+    return fail("malformed JSON chunk");
   const std::string json(reinterpret_cast<const char*>(b.data() + 20), json_len);
   const std::size_t bin_at = 20 + json_len;
   const std::size_t bin_len = get_u32(b, bin_at);
-  if (get_u32(b, bin_at + 4) != 0x004E4942 || bin_at + 8 + bin_len != b.size()) return fail("malformed BIN chunk");
+  if (get_u32(b, bin_at + 4) != 0x004E4942 || bin_at + 8 + bin_len != b.size())
+    return fail("malformed BIN chunk");
   FrameFileInfo f;
-  const long long frame = json_integer(json, "studio_frame"), nv = json_integer(json, "studio_vertices"),
-                  nt = json_integer(json, "studio_triangles"), col = json_integer(json, "studio_coloured");
-  if (frame < 0 || nv < 0 || nt < 0 || col < 0) return fail("not a studio-hull offline frame file (no extras)");
-  f.frame = frame, f.vertices = std::size_t(nv), f.triangles = std::size_t(nt), f.coloured = col == 1;
+  const long long frame = json_integer(json, "studio_frame"),
+                  nv = json_integer(json, "studio_vertices"),
+                  nt = json_integer(json, "studio_triangles"),
+                  col = json_integer(json, "studio_coloured");
+  if (frame < 0 || nv < 0 || nt < 0 || col < 0)
+    return fail("not a studio-hull offline frame file (no extras)");
+  f.frame = frame, f.vertices = std::size_t(nv), f.triangles = std::size_t(nt),
+  f.coloured = col == 1;
   f.file_size = b.size();
   f.bin_offset = bin_at + 8;
   const Sections s = sections(f.vertices, f.triangles, f.coloured);
@@ -195,7 +218,8 @@ Expected<FrameFileInfo> verify_frame_glb(std::span<const uint8_t> b) {
   if (at == std::string::npos) return fail("no hash in the extras");
   char hash[20];
   std::snprintf(hash, sizeof hash, "%016llx",
-                static_cast<unsigned long long>(fnv1a64(b.subspan(f.bin_offset, s.total + (bin_len - s.total)))));
+                static_cast<unsigned long long>(
+                    fnv1a64(b.subspan(f.bin_offset, s.total + (bin_len - s.total)))));
   if (json.compare(at + key.size(), 16, hash) != 0) return fail("hash mismatch (damaged file)");
   for (std::size_t n = 0; n < f.vertices; ++n) {
     Eigen::Vector3f v;
@@ -209,7 +233,8 @@ Expected<FrameFileInfo> verify_frame_glb(std::span<const uint8_t> b) {
 Expected<FrameFileInfo> verify_frame_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(path + ": cannot open");
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
   auto f = verify_frame_glb(bytes);
   if (!f) return fail(path + ": " + f.error().message);
   return f;
@@ -234,7 +259,8 @@ Expected<void> write_file_atomic(const std::string& path, std::span<const uint8_
   return {};
 }
 
-std::string encode_index_gltf(const std::string& name, double fps, const std::vector<FrameFileInfo>& frames) {
+std::string encode_index_gltf(const std::string& name, double fps,
+                              const std::vector<FrameFileInfo>& frames) {
   std::string buffers, views, accessors, meshes, nodes, node_list, channels, samplers;
   int nview = 0, nacc = 0;
   // Key data (embedded buffer 0): per frame k, times and scales of its STEP keys.
@@ -250,7 +276,8 @@ std::string encode_index_gltf(const std::string& name, double fps, const std::ve
     const double t = double(k) * period;
     if (k > 0) times.push_back(0), scales.insert(scales.end(), {0, 0, 0});
     times.push_back(float(t)), scales.insert(scales.end(), {1, 1, 1});
-    if (k + 1 < frames.size()) times.push_back(float(t + period)), scales.insert(scales.end(), {0, 0, 0});
+    if (k + 1 < frames.size())
+      times.push_back(float(t + period)), scales.insert(scales.end(), {0, 0, 0});
     Keys kk{keys.size(), 0, int(times.size())};
     append(keys, times.data(), times.size());
     kk.scale_at = keys.size();
@@ -263,36 +290,50 @@ std::string encode_index_gltf(const std::string& name, double fps, const std::ve
     const FrameFileInfo& f = frames[k];
     const std::string file = frame_file_name(name, f.frame);
     buffers += ",{\"byteLength\":" + std::to_string(f.file_size) + ",\"uri\":\"" + file + "\"}";
-    const std::string primitive = mesh_json(int(k) + 1, f.bin_offset, f, views, accessors, nview, nacc);
+    const std::string primitive =
+        mesh_json(int(k) + 1, f.bin_offset, f, views, accessors, nview, nacc);
     const std::string stem = file.substr(0, file.size() - 4);
     if (k) meshes += ",", nodes += ",", node_list += ",", channels += ",", samplers += ",";
     meshes += "{\"name\":\"" + stem + "\",\"primitives\":[" + primitive + "]}";
-    nodes += "{\"name\":\"" + stem + "\",\"mesh\":" + std::to_string(k) + ",\"scale\":" +
-             (k == 0 ? "[1,1,1]" : "[0,0,0]") + "}";
+    nodes += "{\"name\":\"" + stem + "\",\"mesh\":" + std::to_string(k) +
+             ",\"scale\":" + (k == 0 ? "[1,1,1]" : "[0,0,0]") + "}";
     node_list += std::to_string(k);
     // The key accessors (buffer 0).
     const Keys& kk = per_frame[k];
-    views += ",{\"buffer\":0,\"byteOffset\":" + std::to_string(kk.time_at) + ",\"byteLength\":" + std::to_string(4 * kk.count) + "}";
-    float tmin = k > 0 ? 0.0f : 0.0f, tmax = float(double(std::min(k + 1, frames.size() - 1)) * period);
+    views += ",{\"buffer\":0,\"byteOffset\":" + std::to_string(kk.time_at) +
+             ",\"byteLength\":" + std::to_string(4 * kk.count) + "}";
+    float tmin = k > 0 ? 0.0f : 0.0f,
+          tmax = float(double(std::min(k + 1, frames.size() - 1)) * period);
     if (k + 1 >= frames.size()) tmax = float(double(k) * period);
-    accessors += ",{\"bufferView\":" + std::to_string(nview++) + ",\"componentType\":5126,\"count\":" +
-                 std::to_string(kk.count) + ",\"type\":\"SCALAR\",\"min\":[" + num(tmin) + "],\"max\":[" + num(tmax) + "]}";
+    accessors += ",{\"bufferView\":" + std::to_string(nview++) +
+                 ",\"componentType\":5126,\"count\":" + std::to_string(kk.count) +
+                 ",\"type\":\"SCALAR\",\"min\":[" + num(tmin) + "],\"max\":[" + num(tmax) + "]}";
     const int time_acc = nacc++;
-    views += ",{\"buffer\":0,\"byteOffset\":" + std::to_string(kk.scale_at) + ",\"byteLength\":" + std::to_string(12 * kk.count) + "}";
-    accessors += ",{\"bufferView\":" + std::to_string(nview++) + ",\"componentType\":5126,\"count\":" +
-                 std::to_string(kk.count) + ",\"type\":\"VEC3\"}";
+    views += ",{\"buffer\":0,\"byteOffset\":" + std::to_string(kk.scale_at) +
+             ",\"byteLength\":" + std::to_string(12 * kk.count) + "}";
+    accessors += ",{\"bufferView\":" + std::to_string(nview++) +
+                 ",\"componentType\":5126,\"count\":" + std::to_string(kk.count) +
+                 ",\"type\":\"VEC3\"}";
     const int scale_acc = nacc++;
-    samplers += "{\"input\":" + std::to_string(time_acc) + ",\"output\":" + std::to_string(scale_acc) + ",\"interpolation\":\"STEP\"}";
-    channels += "{\"sampler\":" + std::to_string(k) + ",\"target\":{\"node\":" + std::to_string(k) + ",\"path\":\"scale\"}}";
+    samplers += "{\"input\":" + std::to_string(time_acc) +
+                ",\"output\":" + std::to_string(scale_acc) + ",\"interpolation\":\"STEP\"}";
+    channels += "{\"sampler\":" + std::to_string(k) + ",\"target\":{\"node\":" + std::to_string(k) +
+                ",\"path\":\"scale\"}}";
   }
-  std::string json = "{\"asset\":{\"version\":\"2.0\",\"generator\":\"studio-hull offline (index)\"},"
-                     "\"scene\":0,\"scenes\":[{\"name\":\"" + name + "\",\"nodes\":[" + node_list + "]}],"
-                     "\"nodes\":[" + nodes + "],\"meshes\":[" + meshes + "]," + kMaterial +
-                     ",\"buffers\":[" + buffers + "],\"bufferViews\":[" + views + "],\"accessors\":[" + accessors + "]";
+  std::string json =
+      "{\"asset\":{\"version\":\"2.0\",\"generator\":\"studio-hull offline (index)\"},"
+      "\"scene\":0,\"scenes\":[{\"name\":\"" +
+      name + "\",\"nodes\":[" + node_list +
+      "]}],"
+      "\"nodes\":[" +
+      nodes + "],\"meshes\":[" + meshes + "]," + kMaterial + ",\"buffers\":[" + buffers +
+      "],\"bufferViews\":[" + views + "],\"accessors\":[" + accessors + "]";
   if (!frames.empty()) {
-    json += ",\"animations\":[{\"name\":\"" + name + "\",\"channels\":[" + channels + "],\"samplers\":[" + samplers + "]}]";
+    json += ",\"animations\":[{\"name\":\"" + name + "\",\"channels\":[" + channels +
+            "],\"samplers\":[" + samplers + "]}]";
   }
-  json += ",\"extras\":{\"studio_fps\":" + num(fps) + ",\"studio_frames\":" + std::to_string(frames.size()) + "}}\n";
+  json += ",\"extras\":{\"studio_fps\":" + num(fps) +
+          ",\"studio_frames\":" + std::to_string(frames.size()) + "}}\n";
   return json;
 }
 

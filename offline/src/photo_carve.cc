@@ -48,11 +48,14 @@ Expected<void> CarveOptions::validate() const {
   if (min_cameras < 2 || min_cameras > 64) return fail("carve: min_cameras must be 2..64");
   if (!(min_cos >= 0 && min_cos < 1)) return fail("carve: min_cos must be in [0, 1)");
   if (edge_margin_px < 0 || edge_margin_px > 16) return fail("carve: edge_margin_px must be 0..16");
-  if (sample_radius_px < 0 || sample_radius_px > 4) return fail("carve: sample_radius_px must be 0..4");
+  if (sample_radius_px < 0 || sample_radius_px > 4)
+    return fail("carve: sample_radius_px must be 0..4");
   if (!(depth_tolerance > 0 && depth_tolerance < 16))
     return fail("carve: depth_tolerance must be in (0, 16) cells");
-  if (max_depth_cells < 0 || max_depth_cells > 1000) return fail("carve: max_depth_cells must be 0..1000");
-  if (max_iterations < 0 || max_iterations > 10000) return fail("carve: max_iterations must be 0..10000");
+  if (max_depth_cells < 0 || max_depth_cells > 1000)
+    return fail("carve: max_depth_cells must be 0..1000");
+  if (max_iterations < 0 || max_iterations > 10000)
+    return fail("carve: max_iterations must be 0..10000");
   if (threads < 1 || threads > 64) return fail("carve: threads must be 1..64");
   return {};
 }
@@ -189,7 +192,7 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         obs.clear();
         for (std::size_t c = 0; c < cams.size(); ++c) {
           if (auto o = observe(cams[c], buffers[c], x, normal, options.min_cos, tol,
-                                options.sample_radius_px)) {
+                               options.sample_radius_px)) {
             obs.push_back(*o);
           }
         }

@@ -6,11 +6,26 @@
 #include "offline/view_sampling.h"
 
 namespace studio::offline {
+namespace {
+
+// One worker runs on the caller's thread (no thread for a single-threaded call).
+template <class F>
+void run_on(std::vector<std::jthread>& pool, int workers, F&& f) {
+  if (workers == 1) {
+    f();
+  } else {
+    pool.emplace_back(std::forward<F>(f));
+  }
+}
+
+}  // namespace
 
 Expected<void> TextureOptions::validate() const {
   if (!(min_cos >= 0 && min_cos < 1)) return fail("texture: min_cos must be in [0, 1)");
-  if (edge_margin_px < 0 || edge_margin_px > 16) return fail("texture: edge_margin_px must be 0..16");
-  if (!(depth_tolerance > 0 && depth_tolerance < 1)) return fail("texture: depth_tolerance must be in (0, 1) m");
+  if (edge_margin_px < 0 || edge_margin_px > 16)
+    return fail("texture: edge_margin_px must be 0..16");
+  if (!(depth_tolerance > 0 && depth_tolerance < 1))
+    return fail("texture: depth_tolerance must be in (0, 1) m");
   if (!(sharpness >= 0 && sharpness <= 32)) return fail("texture: sharpness must be 0..32");
   if (threads < 1 || threads > 64) return fail("texture: threads must be 1..64");
   return {};
@@ -31,12 +46,13 @@ Expected<std::vector<Eigen::Vector3f>> vertex_colours(const hull::Mesh& mesh,
     std::vector<std::jthread> pool;
     const int workers = std::max(1, std::min<int>(options.threads, int(cams.size())));
     for (int w = 0; w < workers; ++w) {
-      pool.emplace_back([&, w] {
+      run_on(pool, workers, [&, w] {
         for (std::size_t c = std::size_t(w); c < cams.size(); c += std::size_t(workers)) {
           buffers[c].reset(cams[c]);
           for (const auto& t : mesh.triangles) {
             buffers[c].triangle(cams[c], mesh.vertices[t[0]].cast<double>(),
-                                mesh.vertices[t[1]].cast<double>(), mesh.vertices[t[2]].cast<double>());
+                                mesh.vertices[t[1]].cast<double>(),
+                                mesh.vertices[t[2]].cast<double>());
           }
         }
       });
@@ -48,14 +64,15 @@ Expected<std::vector<Eigen::Vector3f>> vertex_colours(const hull::Mesh& mesh,
     const int workers = std::max(1, options.threads);
     const std::size_t chunk = (nv + std::size_t(workers) - 1) / std::size_t(workers);
     for (int w = 0; w < workers; ++w) {
-      pool.emplace_back([&, w] {
+      run_on(pool, workers, [&, w] {
         const std::size_t a = std::min(nv, std::size_t(w) * chunk), b = std::min(nv, a + chunk);
         for (std::size_t n = a; n < b; ++n) {
           const Eigen::Vector3d x = mesh.vertices[n].cast<double>();
           const Eigen::Vector3d normal = mesh.normals[n].cast<double>();
           if (normal.squaredNorm() < 0.5) continue;
           for (std::size_t c = 0; c < cams.size(); ++c) {
-            auto o = observe(cams[c], buffers[c], x, normal, options.min_cos, options.depth_tolerance);
+            auto o =
+                observe(cams[c], buffers[c], x, normal, options.min_cos, options.depth_tolerance);
             if (!o) continue;
             const double w8 = std::pow(double(o->cos), options.sharpness);
             sum[n] += w8 * o->colour.cast<double>();

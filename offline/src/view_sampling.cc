@@ -31,7 +31,8 @@ Expected<std::vector<SampledView>> prepare_views(std::span<const ColourView> vie
     std::vector<uint8_t> in(std::size_t(W) * H, 0), tmp(std::size_t(W) * H, 0);
     for (int y = 0; y < H; ++y)
       for (const Run& r : cv.mask->row(y))
-        std::fill(in.begin() + std::size_t(y) * W + r.begin, in.begin() + std::size_t(y) * W + r.end, 1);
+        std::fill(in.begin() + std::size_t(y) * W + r.begin,
+                  in.begin() + std::size_t(y) * W + r.end, 1);
     // Erosion by a (2m+1)^2 square, separable: rows, then columns.
     for (int y = 0; y < H; ++y) {
       const uint8_t* row = &in[std::size_t(y) * W];
@@ -71,8 +72,10 @@ void DepthBuffer::splat(const SampledView& v, const Eigen::Vector3d& x, double s
   Eigen::Vector2d p;
   if (!v.camera->project(x, &p)) return;
   const double r = 0.5 * size * std::max(v.camera->intrinsics.fx, v.camera->intrinsics.fy) / xc.z();
-  const int x0 = std::max(0, int(std::ceil(p.x() - r))), x1 = std::min(width_ - 1, int(std::floor(p.x() + r)));
-  const int y0 = std::max(0, int(std::ceil(p.y() - r))), y1 = std::min(height_ - 1, int(std::floor(p.y() + r)));
+  const int x0 = std::max(0, int(std::ceil(p.x() - r))),
+            x1 = std::min(width_ - 1, int(std::floor(p.x() + r)));
+  const int y0 = std::max(0, int(std::ceil(p.y() - r))),
+            y1 = std::min(height_ - 1, int(std::floor(p.y() + r)));
   const float z = float(xc.z());
   for (int y = y0; y <= y1; ++y) {
     float* row = &depth_[std::size_t(y) * width_];

@@ -40,8 +40,8 @@ class PointIndex {
                            int(std::floor(x.z() / h_)));
   }
   static uint64_t key(const Eigen::Vector3i& c) {
-    return (uint64_t(uint32_t(c.x() + (1 << 20))) << 42) ^ (uint64_t(uint32_t(c.y() + (1 << 20))) << 21) ^
-           uint64_t(uint32_t(c.z() + (1 << 20)));
+    return (uint64_t(uint32_t(c.x() + (1 << 20))) << 42) ^
+           (uint64_t(uint32_t(c.y() + (1 << 20))) << 21) ^ uint64_t(uint32_t(c.z() + (1 << 20)));
   }
   const std::vector<Eigen::Vector3d>& pts_;
   double h_;
@@ -52,7 +52,8 @@ std::vector<Eigen::Vector3d> mesh_samples(const hull::Mesh& mesh, int n) {
   std::vector<double> cum;
   double total = 0;
   for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>(), b = mesh.vertices[t[1]].cast<double>(),
+    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>(),
+                          b = mesh.vertices[t[1]].cast<double>(),
                           c = mesh.vertices[t[2]].cast<double>();
     total += 0.5 * (b - a).cross(c - a).norm();
     cum.push_back(total);
@@ -62,7 +63,9 @@ std::vector<Eigen::Vector3d> mesh_samples(const hull::Mesh& mesh, int n) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0, 1);
   for (int k = 0; k < n; ++k) {
-    const std::size_t f = std::min(cum.size() - 1, std::size_t(std::lower_bound(cum.begin(), cum.end(), u(rng) * total) - cum.begin()));
+    const std::size_t f = std::min(
+        cum.size() - 1,
+        std::size_t(std::lower_bound(cum.begin(), cum.end(), u(rng) * total) - cum.begin()));
     const auto& t = mesh.triangles[f];
     double r1 = u(rng), r2 = u(rng);
     if (r1 + r2 > 1) r1 = 1 - r1, r2 = 1 - r2;
@@ -116,7 +119,8 @@ std::vector<Eigen::Vector3d> far_mesh_points(const hull::Mesh& mesh, const sim::
 
 std::vector<ColourView> Frame::views() const {
   std::vector<ColourView> v;
-  for (std::size_t c = 0; c < cameras.size(); ++c) v.push_back({&cameras[c], images[c].view(), &masks[c]});
+  for (std::size_t c = 0; c < cameras.size(); ++c)
+    v.push_back({&cameras[c], images[c].view(), &masks[c]});
   return v;
 }
 
@@ -126,7 +130,8 @@ Frame render_frame(const sim::SimulatedStudio& studio, int64_t frame) {
   f.truth = studio.render_all(frame, &f.images, nullptr);
   auto keyer = keyer::Keyer::create({}).value();
   f.masks.resize(f.cameras.size());
-  for (std::size_t c = 0; c < f.cameras.size(); ++c) (void)keyer.key(f.images[c].view(), f.masks[c]);
+  for (std::size_t c = 0; c < f.cameras.size(); ++c)
+    (void)keyer.key(f.images[c].view(), f.masks[c]);
   return f;
 }
 
@@ -168,7 +173,8 @@ Image<Rgb8> render_coloured(const hull::Mesh& mesh, const std::vector<Eigen::Vec
         if (depth >= zb) continue;
         zb = depth;
         const Eigen::Vector3f col =
-            (float(w0) * colours[t[0]] + float(w1) * colours[t[1]] + float(w2) * colours[t[2]]) / float(ws);
+            (float(w0) * colours[t[0]] + float(w1) * colours[t[1]] + float(w2) * colours[t[2]]) /
+            float(ws);
         auto q8 = [](float v) { return uint8_t(std::clamp(v + 0.5f, 0.0f, 255.0f)); };
         out.view().row(y)[x] = Rgb8{q8(col.x()), q8(col.y()), q8(col.z())};
       }
@@ -183,7 +189,8 @@ double psnr(const Image<Rgb8>& image, const Image<Rgb8>& truth, const Mask& regi
     for (int x = 0; x < truth.width(); ++x) {
       if (!region.view().row(y)[x]) continue;
       const Rgb8 a = image.view().row(y)[x], b = truth.view().row(y)[x];
-      se += double(a.r - b.r) * (a.r - b.r) + double(a.g - b.g) * (a.g - b.g) + double(a.b - b.b) * (a.b - b.b);
+      se += double(a.r - b.r) * (a.r - b.r) + double(a.g - b.g) * (a.g - b.g) +
+            double(a.b - b.b) * (a.b - b.b);
       n += 3;
     }
   if (n == 0) return 0;

@@ -54,15 +54,15 @@ struct CarveOptions {
   double depth_tolerance = 1.5;  // cells: visibility slack of the depth buffers
   int max_depth_cells = 12;      // carving stops this many cells below the hull surface
   int max_iterations = 60;
-  int threads = 1;               // surface voxels are judged in parallel
+  int threads = 1;  // surface voxels are judged in parallel
   Expected<void> validate() const;
 };
 
 struct CarveResult {
-  hull::SegmentSet set;       // the refined shape (a subset of the hull)
+  hull::SegmentSet set;  // the refined shape (a subset of the hull)
   int iterations = 0;
-  std::size_t voxels = 0;     // hull voxels sampled
-  std::size_t carved = 0;     // voxels removed
+  std::size_t voxels = 0;  // hull voxels sampled
+  std::size_t carved = 0;  // voxels removed
 };
 
 // Fails (one line) on invalid options, no views, or a view whose image or mask size differs
