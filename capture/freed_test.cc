@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "capture/freed_listener.h"
+#include "core/clock.h"
 
 namespace studio::capture {
 namespace {
@@ -315,10 +316,6 @@ TEST(FreeDListener, CountsRejectionsAndKeepsTheNewestPerCamera) {
   EXPECT_EQ(cam3->packet.pan_deg, 19.0);
   EXPECT_GT(cam3->arrival_ns, 1'600'000'000'000'000'000);  // CLOCK_REALTIME, after 2020
   EXPECT_FALSE((*listener)->latest(1));
-  // Only the last 8 packets of camera 3 are kept: the oldest reachable is pan 12.
-  auto oldest = (*listener)->nearest(3, 0, INT64_MAX);
-  ASSERT_TRUE(oldest);
-  EXPECT_EQ(oldest->packet.pan_deg, 12.0);
 }
 
 TEST(FreeDListener, ReportsAPortInUse) {
@@ -354,45 +351,61 @@ class ScriptedSource : public FrameSource {
   int w_, h_;
 };
 
-TEST(TrackedSource, AttachesTheCalibrationNearestInTime) {
-  auto created = FreeDListener::create({"127.0.0.1", 0, 64});
+TEST(TrackedSource, AttachesThePacketOfItsFrameByArrivalTimeAndCountsTheRest) {
+  FreeDListenerOptions lo{"127.0.0.1", 0, 64};
+  lo.clock.period_ns = 40'000'000;
+  auto created = FreeDListener::create(lo);
   ASSERT_TRUE(created);
   std::shared_ptr<FreeDListener> listener = std::move(*created);
-  // Tracker packets every 20 ms (50 Hz) for camera 3, pan = packet index; arrival = t + 5 ms.
-  FreeDPacket p;
-  p.camera_id = 3;
-  for (int i = 0; i < 10; ++i) {
-    p.pan_deg = i;
-    const auto bytes = encode_freed(p);
-    listener->handle_datagram(bytes, int64_t(i) * 20'000'000 + 5'000'000);
-  }
   TrackedSourceOptions options;
   options.camera = camera_options();
-  options.latency_ns = 5'000'000;
-  options.max_skew_ns = 8'000'000;
+  options.clock = lo.clock;
+  options.delay_frames = 1;
   ASSERT_TRUE(options.validate());
-  // Frames at 40 ms (→ packet 2), 61 ms (→ packet 3, 1 ms off), 130 ms (10 ms off both 6 and 7:
-  // beyond max skew) and 1 s (no packet near).
-  TrackedSource source(std::make_unique<ScriptedSource>(
-                           std::deque<int64_t>{40'000'000, 61'000'000, 130'000'000, 1'000'000'000}),
+  // Frames 2, 3, 5 and 6 (the scripted source numbers frames by 40 ms).
+  TrackedSource source(std::make_unique<ScriptedSource>(std::deque<int64_t>{
+                           80'000'000, 121'000'000, 205'000'000, 250'000'000}),
                        listener, options);
   ASSERT_TRUE(source.start());
+  // The tracker lags one frame: the packet of frame i (pan = i) arrives 5 ms into frame i + 1.
+  FreeDPacket p;
+  p.camera_id = 3;
+  auto send = [&](double pan, int64_t arrival) {
+    p.pan_deg = pan;
+    listener->handle_datagram(encode_freed(p), arrival);
+  };
+  for (int i : {2, 3, 6}) send(i, int64_t(i + 1) * 40'000'000 + 5'000'000);
+  send(99, 3 * 40'000'000 + 30'000'000);  // a second packet for frame 2: the first counts
+  p.camera_id = 4;
+  send(50, 3 * 40'000'000 + 31'000'000);  // no camera takes id 4
+  p.camera_id = 3;
   std::vector<std::optional<Camera>> calibrations;
   for (int i = 0; i < 4; ++i) {
     auto f = source.next(std::chrono::milliseconds(10));
     ASSERT_TRUE(f && *f);
     calibrations.push_back((*f)->calibration);
+    if (i == 1) send(77, 4 * 40'000'000 + 1'000'000);  // for frame 3, after it was delivered
   }
+  auto axis = [](double deg) {
+    return Eigen::Vector3d(std::sin(deg * M_PI / 180), 0, -std::cos(deg * M_PI / 180));
+  };
   ASSERT_TRUE(calibrations[0]);
   EXPECT_EQ(calibrations[0]->id, "tracked0");
-  EXPECT_TRUE(calibrations[0]->axis_in_world().isApprox(
-      Eigen::Vector3d(std::sin(2 * M_PI / 180), 0, -std::cos(2 * M_PI / 180)), 1e-9));
+  EXPECT_TRUE(calibrations[0]->axis_in_world().isApprox(axis(2), 1e-9));
   ASSERT_TRUE(calibrations[1]);
-  EXPECT_TRUE(calibrations[1]->axis_in_world().isApprox(
-      Eigen::Vector3d(std::sin(3 * M_PI / 180), 0, -std::cos(3 * M_PI / 180)), 1e-9));
-  EXPECT_FALSE(calibrations[2]);
-  EXPECT_FALSE(calibrations[3]);
-  EXPECT_EQ(source.untracked(), 2u);
+  EXPECT_TRUE(calibrations[1]->axis_in_world().isApprox(axis(3), 1e-9));
+  EXPECT_FALSE(calibrations[2]);  // frame 5: no packet
+  ASSERT_TRUE(calibrations[3]);
+  EXPECT_TRUE(calibrations[3]->axis_in_world().isApprox(axis(6), 1e-9));
+  EXPECT_EQ(source.untracked(), 1u);
+  const FreeDListenerStats s = listener->stats();
+  EXPECT_EQ(s.accepted, 3u);
+  EXPECT_EQ(s.rejected[size_t(FreeDReject::duplicate)], 1u);
+  EXPECT_EQ(s.rejected[size_t(FreeDReject::unknown_id)], 1u);
+  EXPECT_EQ(s.rejected[size_t(FreeDReject::too_late)], 1u);
+  // Silence: the last packet arrived at 285 ms (1970): long silent now; fresh just after it.
+  EXPECT_TRUE(source.status(realtime_ns()).silent);
+  EXPECT_FALSE(source.status(7 * 40'000'000 + 5'000'000 + 100'000'000).silent);
 
   // A frame of another size than the lens table's is refused with one line.
   TrackedSource wrong(std::make_unique<ScriptedSource>(std::deque<int64_t>{40'000'000}, 640, 480),
@@ -400,6 +413,50 @@ TEST(TrackedSource, AttachesTheCalibrationNearestInTime) {
   auto f = wrong.next(std::chrono::milliseconds(10));
   ASSERT_FALSE(f);
   EXPECT_NE(f.error().message.find("640x480"), std::string::npos);
+}
+
+TEST(FreeDListener, SharedPortGivesEveryListenerEachBroadcast) {
+  FreeDListenerOptions lo{"0.0.0.0", 0, 8};
+  lo.shared = true;
+  auto a = FreeDListener::create(lo);
+  ASSERT_TRUE(a) << a.error().message;
+  lo.port = (*a)->port();
+  auto b = FreeDListener::create(lo);
+  ASSERT_TRUE(b) << b.error().message;
+  (*a)->track(1, 0);
+  (*b)->track(2, 0);
+  // Unshared, the same port is refused (positive control of the sharing).
+  FreeDListenerOptions unshared{"0.0.0.0", lo.port, 8};
+  EXPECT_FALSE(FreeDListener::create(unshared));
+
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  const int one = 1;
+  ASSERT_EQ(setsockopt(fd, SOL_SOCKET, SO_BROADCAST, &one, sizeof one), 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(lo.port);
+  inet_pton(AF_INET, "127.255.255.255", &to.sin_addr);
+  for (uint8_t id : {1, 2}) {
+    FreeDPacket p;
+    p.camera_id = id;
+    p.pan_deg = id;
+    const auto bytes = encode_freed(p);
+    ASSERT_EQ(sendto(fd, bytes.data(), bytes.size(), 0, reinterpret_cast<sockaddr*>(&to),
+                     sizeof to),
+              ssize_t(bytes.size()));
+  }
+  close(fd);
+  ASSERT_TRUE((*a)->wait_for_datagrams(2, std::chrono::seconds(10)));
+  ASSERT_TRUE((*b)->wait_for_datagrams(2, std::chrono::seconds(10)));
+  for (auto* l : {a->get(), b->get()}) {
+    const auto s = l->stats();
+    EXPECT_EQ(s.accepted, 1u);
+    EXPECT_EQ(s.rejected[size_t(FreeDReject::unknown_id)], 1u);
+  }
+  ASSERT_TRUE((*a)->latest(1));
+  EXPECT_FALSE((*a)->latest(2));
+  ASSERT_TRUE((*b)->latest(2));
+  EXPECT_FALSE((*b)->latest(1));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "camera_worker.h"
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <thread>
@@ -22,8 +23,18 @@ CameraWorker::CameraWorker(CameraSetup setup, const CaptureIo& io)
       id_(std::move(setup.id)),
       source_(std::move(setup.source)),
       calibration_(std::move(setup.calibration)),
+      tracked_(setup.tracked),
+      report_tracker_(setup.report_tracker),
+      lens_table_(std::move(setup.lens_table)),
       image_rate_(io.options.image_rate),
-      image_raw_(io.options.image_raw) {}
+      image_raw_(io.options.image_raw) {
+  if (report_tracker_) {
+    freed_counters_.push_back(&io_.loop.counter("freed_accepted"));
+    for (std::size_t r = 0; r < kFreeDRejectCount; ++r)
+      freed_counters_.push_back(
+          &io_.loop.counter(std::string("freed_rejected_") + to_string(FreeDReject(r))));
+  }
+}
 
 Expected<void> CameraWorker::start() {
   auto k = keyer::Keyer::create(io_.options.keyer);
@@ -32,6 +43,15 @@ Expected<void> CameraWorker::start() {
   // A plate captured on command before a restart. Unreadable: the camera waits for a new one.
   io_.kept_plates.restore(id_, keyer_->keyer(), kLog);
   if (auto s = source_->start(); !s) return fail("camera " + id_ + ": " + s.error().message);
+  if (!tracked_) {  // the lens as calibrated: the Zoom/Focus values now
+    double zoom = NAN, focus = NAN;
+    for (const Feature& f : source_->features()) {
+      if (f.name == "Zoom") zoom = f.value;
+      if (f.name == "Focus") focus = f.value;
+    }
+    std::lock_guard lock(mutex_);
+    lens_.emplace(calibration_, lens_table_, zoom, focus);
+  }
   return {};
 }
 
@@ -44,6 +64,7 @@ void CameraWorker::run() {
     }
     const auto now = Clock::now();
     if (*next) on_frame(**next, now);
+    if (tracked_) check_tracking();
     if (state_due(now)) publish_state();
   }
 }
@@ -76,6 +97,7 @@ void CameraWorker::on_frame(Frame& frame, Clock::time_point now) {
     record(frame);
     send = image_due(now, raw);
   }
+  if (frame.calibration) publish_tracked_calibration(frame);
   // Key → mask codec → AlphaMask (unless keying runs elsewhere: masks: false).
   if (io_.options.publish_masks) key(frame);
   if (send) send_image(frame, raw);
@@ -177,6 +199,7 @@ std::string CameraWorker::control(const CameraControlCore& c) {
   } else {
     STUDIO_LOG(info, kLog) << id_ << ": " << c.feature << " = " << *v << " (asked " << c.value
                            << ")";
+    if (c.feature == "Zoom" || c.feature == "Focus") lens_moved(c.feature, *v);
   }
   {
     std::lock_guard lock(mutex_);
@@ -239,6 +262,11 @@ void CameraWorker::publish_state() {
               : s.recording                 ? Run::kRecording
                                             : Run::kStreaming;
     s.error = error_;
+    if (const std::string p = calibration_problem(); !p.empty()) {
+      s.calibration_valid = false;
+      if (s.error.empty()) s.error = p;
+    }
+    s.time_source = source_->time_source();
     dirty_ = false;
   }
   wire::Owned<studio_CameraState> sample;

@@ -40,6 +40,7 @@ struct CaptureIo {
   runtime::Output<studio_AlphaMask>& masks;
   runtime::Output<studio_CameraImage>& images;
   runtime::Output<studio_CameraState>& states;
+  runtime::Output<studio_CameraCalibration>& calibrations;  // at start; per frame when tracked
   runtime::Counter& frames_captured;
   runtime::Counter& frames_recorded;
   runtime::Counter& frames_dropped;
@@ -70,6 +71,8 @@ class CameraWorker {
   // CaptureCommand (take name already checked); the problem, or "" when scheduled.
   std::string command(const CaptureCommandCore& c);
   void publish_state();
+  // The calibration to publish at start (fixed cameras), as a sample; false with the error.
+  Expected<void> publish_fixed_calibration();
 
   struct Health {
     bool error = false;
@@ -91,12 +94,27 @@ class CameraWorker {
   void send_image(const Frame& frame, bool raw);
   // Every state_period: the fps over the window; true when a state should go out.
   bool state_due(std::chrono::steady_clock::time_point now);
+  // Tracked cameras (camera_tracking.cc): the frame's CameraCalibration (tracked: true); the
+  // tracker's silence into the state; the listener's counters into the node's.
+  void publish_tracked_calibration(const Frame& frame);
+  void check_tracking();
+  // After a Zoom/Focus change (control()): new intrinsics published, or the calibration marked
+  // invalid.
+  void lens_moved(const std::string& feature, double value);
+  // Under mutex_: what the state says about the calibration ("" = valid).
+  std::string calibration_problem() const;
 
   const CaptureIo& io_;
   std::string id_;
   std::unique_ptr<FrameSource> source_;
   std::optional<studio::Camera> calibration_;
+  TrackedSource* tracked_ = nullptr;
+  bool report_tracker_ = false;
+  std::optional<LensTableOptions> lens_table_;
   // Grab thread only.
+  wire::Owned<studio_CameraCalibration> calibration_sample_;
+  FreeDListenerStats reported_{};
+  std::vector<runtime::Counter*> freed_counters_;  // accepted, then rejected by reason
   std::optional<keyer::PlateKeyer> keyer_;
   RunMask mask_;
   std::vector<uint8_t> mask_bytes_, image_bytes_;
@@ -122,6 +140,9 @@ class CameraWorker {
   std::chrono::steady_clock::time_point window_start_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point last_image_ = std::chrono::steady_clock::time_point::min();
   bool dirty_ = true;
+  std::optional<LensCalibration> lens_;  // fixed cameras: zoom/focus vs the calibration
+  bool tracker_silent_ = false;
+  double tracker_silent_s_ = -1;
 };
 
 }  // namespace studio::capture::node

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <optional>
+#include <set>
 
 #include "capture/aravis_source.h"
 #include "capture/file_source.h"
 #include "capture/sim_source.h"
 #include "keyer/config/keyer_yaml.h"
 #include "sim/cameras.h"
+#include "tracking_config.h"
 #include "yaml_io/options.h"
 #include "yaml_io/rig_yaml.h"
 
@@ -34,7 +36,8 @@ const char kConfigHelp[] =
     "      source: {type: files, path: DIR, fps: 25, loop: false, paced: true}\n"
     "      source: {type: aravis, device: ID, pixel_format: BayerRG8, width: W, height: H,\n"
     "               fps: 25, trigger: free_run|software|line, line: Line0, buffers: 8,\n"
-    "               interfaces: [GigEVision, USB3Vision]}\n";
+    "               interfaces: [GigEVision, USB3Vision], clock_trigger: true,\n"
+    "               camera_time: true}\n";
 
 namespace {
 
@@ -78,6 +81,8 @@ struct CameraKeys {
   SimKeys sim;
   FileSourceOptions files;
   AravisOptions aravis;
+  std::optional<TrackingKeys> tracking;
+  std::optional<LensTableFile> lens_table;  // a fixed camera's zoom/focus -> intrinsics
 };
 struct CaptureKeys {
   ClockKeys clock;
@@ -127,6 +132,8 @@ const yaml::Schema<AravisOptions> kAravis{
                       {"software", TriggerMode::software},
                       {"line", TriggerMode::line}}),
     yaml::field("line", &AravisOptions::trigger_line),
+    yaml::field("clock_trigger", &AravisOptions::clock_trigger),
+    yaml::field("camera_time", &AravisOptions::camera_time),
     yaml::field("buffers", &AravisOptions::buffers).range(2, 256),
     yaml::field("interfaces", &AravisOptions::interfaces),
 };
@@ -169,6 +176,19 @@ Expected<std::vector<CameraKeys>> read_cameras(const yaml::Node& n) {
     auto source = m->required("source");
     if (!source) return std::unexpected(source.error());
     if (auto r = read_source(*source, *c); !r) return std::unexpected(r.error());
+    if (auto tracking = m->optional("tracking")) {
+      auto t = read_tracking(*tracking);
+      if (!t) return std::unexpected(t.error());
+      c->tracking = std::move(*t);
+    }
+    if (auto lens = m->optional("lens_table")) {
+      auto path = lens->as_string();
+      if (!path) return std::unexpected(path.error());
+      auto table = read_lens_table(yaml::resolve_path(*lens, *path));
+      if (!table) return lens->fail("lens_table: " + table.error().message);
+      if (c->tracking) return lens->fail("lens_table: a tracked camera's goes under tracking:");
+      c->lens_table = std::move(*table);
+    }
     if (auto r = m->finish(); !r) return std::unexpected(r.error());
     for (const auto& other : cameras)
       if (other.id == c->id) return e.fail("duplicate camera id " + c->id);
@@ -178,7 +198,8 @@ Expected<std::vector<CameraKeys>> read_cameras(const yaml::Node& n) {
 }
 
 // The camera's source, opened with the studio clock; errors name the source mapping.
-Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock) {
+Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
+                                  Listeners& listeners) {
   CameraSetup setup;
   setup.id = c.id;
   const yaml::Node& at = *c.source;
@@ -204,12 +225,27 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock) 
     src = FileSource::create(fo);
   } else {
     AravisOptions ao = c.aravis;
+    if (ao.trigger == TriggerMode::software && !ao.clock_trigger)
+      return at.fail("trigger: software with clock_trigger: false: nothing in the capture "
+                     "service would fire the trigger (use clock_trigger: true, or line)");
     ao.camera_id = c.id;
     ao.clock = clock;
     src = AravisSource::open(ao);
   }
   if (!src) return at.fail(src.error().message);
   setup.source = std::move(*src);
+  if (c.tracking) {
+    // A tracked camera's calibration is per frame; a simulated one renders from it.
+    const int w = c.type == "sim" ? c.sim.width : c.type == "aravis" ? c.aravis.width : 0;
+    const int h = c.type == "sim" ? c.sim.height : c.type == "aravis" ? c.aravis.height : 0;
+    auto tracked = make_tracked_source(std::move(setup.source), *c.tracking, c.id, w, h,
+                                       setup.calibration, clock, listeners);
+    if (!tracked) return at.fail(tracked.error().message);
+    setup.tracked = tracked->get();
+    setup.source = std::move(*tracked);
+    setup.calibration.reset();
+  }
+  if (c.lens_table) setup.lens_table = LensTableOptions{c.lens_table->table, c.lens_table->feature_scale};
   return setup;
 }
 
@@ -260,16 +296,20 @@ Expected<CaptureNodeOptions> read_capture_config(yaml::MapReader& config) {
   o.publish_masks = keys->masks;
   o.plate_dir = keys->plate_dir;
   o.state_period = keys->state_period;
+  Listeners listeners;
+  std::set<const FreeDListener*> reported;
   for (const CameraKeys& c : keys->cameras) {
-    auto setup = open_camera(c, o.clock);
+    auto setup = open_camera(c, o.clock, listeners);
     if (!setup) return std::unexpected(setup.error());
+    // One camera per listener reports its counters.
+    if (setup->tracked) setup->report_tracker = reported.insert(&setup->tracked->listener()).second;
     o.cameras.push_back(std::move(*setup));
   }
   if (!keys->rig.empty()) {
     auto rig = yaml::read_rig(keys->rig);
     if (!rig) return std::unexpected(rig.error());
     for (auto& c : o.cameras)
-      if (const Camera* rc = rig->find_camera(c.id)) c.calibration = *rc;
+      if (const Camera* rc = rig->find_camera(c.id); rc && !c.tracked) c.calibration = *rc;
   }
   return o;
 }
@@ -280,7 +320,7 @@ runtime::ServiceDefinition capture_service_definition() {
   d.summary =
       "Capture server: per camera publishes alpha masks, images and state, applies camera "
       "control and records takes on command. Also: studio-capture verify-take DIR.";
-  d.config_help = kConfigHelp;
+  d.config_help = std::string(kConfigHelp) + kTrackingHelp;
   d.create = [](yaml::MapReader& config,
                 runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto options = read_capture_config(config);

@@ -32,14 +32,14 @@ class CaptureNode : public runtime::Node {
                 {.counter = "images_published", .rate = !options_.publish_masks}),
             .states =
                 loop_.output<studio_CameraState>({.counter = "states_published", .rate = false}),
+            .calibrations = loop_.output<studio_CameraCalibration>(
+                {.counter = "calibrations_published", .rate = false}),
             .frames_captured = loop_.counter("frames_captured"),
             .frames_recorded = loop_.counter("frames_recorded"),
             .frames_dropped = loop_.counter("frames_dropped"),
             .frames_unkeyed = loop_.counter("frames_unkeyed"),
             .plates_captured = loop_.counter("plates_captured"),
             .plate_saves_failed = loop_.counter("plate_saves_failed")} {
-    calibrations_ = &loop_.output<studio_CameraCalibration>(
-        {.counter = "calibrations_published", .rate = false});
     loop_.count_as_input(io_.frames_captured);
     loop_.input<studio_CameraControl>(
         {.received = "controls_in",
@@ -70,16 +70,7 @@ class CaptureNode : public runtime::Node {
       if (auto r = w->start(); !r) return r;
     if (auto r = loop_.start(); !r) return r;
     for (auto& w : workers_) {
-      if (w->calibration()) {
-        wire::Owned<studio_CameraCalibration> c;
-        // The wire carries the paper's model: OpenCV distortion is fitted or refused here.
-        auto fit = from_core(*w->calibration(), 0, realtime_ns(), false, c);
-        if (!fit) return std::unexpected(Error{w->id() + ": " + fit.error().message});
-        if (fit->fitted)
-          STUDIO_LOG(info, kLog) << w->id() << ": OpenCV distortion fitted to the paper's model, residual max "
-                                 << fit->max_residual_px << " px, RMS " << fit->rms_residual_px << " px";
-        if (auto r = calibrations_->write(*c); !r) return r;
-      }
+      if (auto r = w->publish_fixed_calibration(); !r) return r;
       w->publish_state();
     }
     return {};
@@ -132,7 +123,6 @@ class CaptureNode : public runtime::Node {
   CaptureNodeOptions options_;
   const keyer::KeptPlates kept_plates_;
   std::vector<std::unique_ptr<CameraWorker>> workers_;
-  runtime::Output<studio_CameraCalibration>* calibrations_ = nullptr;
   runtime::Input<studio_CaptureCommand>* commands_ = nullptr;
   runtime::ServiceLoop loop_;  // stopped (destroyed) before the workers: declared after them
   CaptureIo io_;

@@ -29,6 +29,8 @@
 
 #include "capture/frame_clock.h"
 #include "capture/frame_source.h"
+#include "capture/freed_listener.h"
+#include "capture/lens_calibration.h"
 #include "core/camera.h"
 #include "core/mask_codec.h"
 #include "keyer/keyer_options.h"
@@ -40,6 +42,9 @@ struct CameraSetup {
   std::string id;
   std::unique_ptr<FrameSource> source;
   std::optional<Camera> calibration;
+  TrackedSource* tracked = nullptr;  // `source` itself when the camera is Free-D tracked
+  bool report_tracker = false;       // this camera counts its listener's packets
+  std::optional<LensTableOptions> lens_table;  // a fixed camera's zoom/focus -> intrinsics
 };
 
 struct CaptureNodeOptions {

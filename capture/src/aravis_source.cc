@@ -1,5 +1,6 @@
 #include "core/clock.h"
 #include "capture/aravis_source.h"
+#include "capture/camera_time.h"
 
 #include <arv.h>
 
@@ -9,6 +10,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <deque>
 #include <mutex>
 #include <thread>
 #include <utility>
@@ -127,7 +129,17 @@ struct AravisSource::Impl {
 
   std::vector<std::thread> reapers;  // finalising lost devices
 
+  // Camera time (next()'s thread) and the clock trigger thread.
+  CameraTimeLatch latch;
+  std::atomic<TimeSource> time_source{TimeSource::host_arrival};
+  std::thread trigger_thread;
+  std::atomic<bool> trigger_run{false};
+  std::atomic<uint64_t> triggers{0};
+  std::mutex trigger_mutex;
+  std::deque<uint64_t> triggered;  // studio frames triggered, not yet delivered
+
   ~Impl() {
+    stop_trigger();
     disconnect(/*device_alive=*/!control_lost);
     for (std::thread& t : reapers) t.join();
   }
@@ -289,6 +301,7 @@ struct AravisSource::Impl {
 
   Expected<void> start_acquisition() {
     std::lock_guard lock(device_mutex);
+    latch_camera_time();  // (re)connected: the camera's clock may have restarted
     GError* error = nullptr;
     arv_camera_start_acquisition(camera, &error);
     if (error) return fail("aravis camera '" + id + "': AcquisitionStart: " + take_error(error));
@@ -374,6 +387,105 @@ struct AravisSource::Impl {
     return false;
   }
 
+  Expected<void> trigger_locked() {
+    if (!camera) return fail("camera " + id + ": software trigger: camera is disconnected");
+    GError* error = nullptr;
+    arv_camera_software_trigger(camera, &error);
+    if (error) return fail("camera " + id + ": software trigger: " + take_error(error));
+    ++triggers;
+    return {};
+  }
+
+  // Fires the software trigger at every studio frame, half a period in (genlock instant).
+  void start_trigger() {
+    if (options.trigger != TriggerMode::software || !options.clock_trigger || trigger_run) return;
+    if (trigger_thread.joinable()) trigger_thread.join();  // ended by stop()
+    trigger_run = true;
+    trigger_thread = std::thread([this] {
+      const FrameClock& clock = options.clock;
+      uint64_t f = clock.frame_at(realtime_ns()) + 1;
+      while (trigger_run) {
+        const int64_t due = clock.time_of(f) + clock.period_ns / 2;
+        // Absolute sleeps on CLOCK_REALTIME in slices of at most 50 ms (stop stays prompt).
+        for (int64_t now = realtime_ns(); trigger_run && now < due; now = realtime_ns()) {
+          const int64_t until = std::min(due, now + 50'000'000);
+          timespec ts{time_t(until / 1'000'000'000), long(until % 1'000'000'000)};
+          clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &ts, nullptr);
+        }
+        if (!trigger_run) break;
+        {
+          std::lock_guard lock(device_mutex);
+          if (camera && acquiring && trigger_locked()) {
+            std::lock_guard t(trigger_mutex);
+            triggered.push_back(f);
+            while (triggered.size() > 64) triggered.pop_front();
+          }
+        }
+        // A late wake-up (a loaded host) skips to the next frame not yet due: one trigger per
+        // frame, never a burst.
+        f = std::max(f + 1, clock.frame_at(realtime_ns() - clock.period_ns / 2) + 1);
+      }
+    });
+  }
+
+  // Clock-triggered frames carry the number of the studio frame whose trigger made them (the
+  // oldest trigger not yet answered; triggers whose answer never came, passed by a frame taken
+  // after the next trigger, count as drops). A frame nobody triggered is not delivered.
+  bool frame_of_trigger(Frame& frame) {
+    if (options.trigger != TriggerMode::software || !options.clock_trigger) return true;
+    std::lock_guard lock(trigger_mutex);
+    const FrameClock& c = options.clock;
+    while (triggered.size() > 1 &&
+           c.time_of(triggered[1]) + c.period_ns / 2 <= frame.capture_ns) {
+      triggered.pop_front();
+      ++own_drops;
+    }
+    if (triggered.empty() || c.time_of(triggered.front()) + c.period_ns / 2 > frame.capture_ns)
+      return false;
+    frame.frame = triggered.front();
+    triggered.pop_front();
+    return true;
+  }
+
+  void stop_trigger() {
+    trigger_run = false;
+    if (trigger_thread.joinable()) trigger_thread.join();
+  }
+
+  // Seeds the camera-time latch from a GenICam timestamp latch, when the camera has one.
+  void latch_camera_time() {
+    latch.reset();
+    if (!options.camera_time || !camera) return;
+    ArvDevice* device = arv_camera_get_device(camera);
+    struct Names {
+      const char *latch, *value;
+      bool ticks;
+    };
+    for (const Names n : {Names{"TimestampLatch", "TimestampLatchValue", false},
+                          Names{"GevTimestampControlLatch", "GevTimestampValue", true}}) {
+      if (!arv_device_is_feature_available(device, n.latch, nullptr) ||
+          !arv_device_is_feature_available(device, n.value, nullptr))
+        continue;
+      GError* error = nullptr;
+      const int64_t before = realtime_ns();
+      arv_device_execute_command(device, n.latch, &error);
+      const gint64 value = error ? 0 : arv_device_get_integer_feature_value(device, n.value, &error);
+      const int64_t after = realtime_ns();
+      double ns_per_tick = 1;
+      if (!error && n.ticks) {
+        const gint64 hz =
+            arv_device_get_integer_feature_value(device, "GevTimestampTickFrequency", &error);
+        if (!error && hz > 0) ns_per_tick = 1e9 / double(hz);
+      }
+      if (error) {
+        g_clear_error(&error);
+        continue;
+      }
+      latch.latch(int64_t(double(value) * ns_per_tick), before, after);
+      return;
+    }
+  }
+
   // Sleeps until `until` in short slices, returning early on stop().
   void nap(Clock::time_point until) {
     while (!stopping && Clock::now() < until) {
@@ -403,12 +515,19 @@ Expected<void> AravisSource::start() {
   Impl& d = *impl_;
   d.stopping = false;
   d.want_acquisition = true;
+  d.start_trigger();
   if (!d.camera) return {};  // lost: next() reconnects and starts
   if (d.acquiring) return {};
   return d.start_acquisition();
 }
 
-void AravisSource::stop() { impl_->stopping = true; }
+void AravisSource::stop() {
+  impl_->stopping = true;
+  impl_->trigger_run = false;  // the thread ends within 50 ms; joined by the next start/destructor
+}
+
+TimeSource AravisSource::time_source() const { return impl_->time_source; }
+uint64_t AravisSource::triggers() const { return impl_->triggers; }
 
 Expected<std::optional<Frame>> AravisSource::next(std::chrono::milliseconds timeout) {
   Impl& d = *impl_;
@@ -459,6 +578,7 @@ Expected<std::optional<Frame>> AravisSource::next(std::chrono::milliseconds time
     }
     d.last_activity = Clock::now();
     std::optional<Frame> frame;
+    bool unsolicited = false;  // a frame no clock trigger asked for: ignored, not a drop
     if (arv_buffer_get_status(buffer) == ARV_BUFFER_STATUS_SUCCESS) {
       size_t size = 0;
       const void* data = arv_buffer_get_image_data(buffer, &size);
@@ -471,9 +591,18 @@ Expected<std::optional<Frame>> AravisSource::next(std::chrono::milliseconds time
       if (image) {
         frame.emplace();
         const guint64 system_ns = arv_buffer_get_system_timestamp(buffer);
-        frame->capture_ns = system_ns ? int64_t(system_ns) : realtime_ns();
+        const int64_t arrival = system_ns ? int64_t(system_ns) : realtime_ns();
+        std::optional<int64_t> camera_ns;
+        if (d.options.camera_time)
+          camera_ns = d.latch.frame(int64_t(arv_buffer_get_timestamp(buffer)), arrival);
+        frame->capture_ns = camera_ns ? *camera_ns : arrival;
+        d.time_source = camera_ns ? TimeSource::camera : TimeSource::host_arrival;
         frame->frame = d.options.clock.frame_at(frame->capture_ns);
         frame->image = std::move(*image);
+        if (!d.frame_of_trigger(*frame)) {
+          frame.reset();
+          unsolicited = true;
+        }
       }
     }
     arv_stream_push_buffer(d.stream, buffer);
@@ -481,7 +610,7 @@ Expected<std::optional<Frame>> AravisSource::next(std::chrono::milliseconds time
       std::lock_guard lock(d.stats_mutex);
       if (frame) {
         ++d.stats.frames;
-      } else {
+      } else if (!unsolicited) {
         ++d.own_drops;
       }
     }
@@ -605,10 +734,7 @@ Expected<void> AravisSource::software_trigger() {
     return fail("camera " + d.id +
                 ": software trigger: the camera is not in software trigger mode");
   }
-  GError* error = nullptr;
-  arv_camera_software_trigger(d.camera, &error);
-  if (error) return fail("camera " + d.id + ": software trigger: " + take_error(error));
-  return {};
+  return d.trigger_locked();
 }
 
 AravisSource::Config AravisSource::config() const {

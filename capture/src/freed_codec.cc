@@ -44,6 +44,12 @@ const char* to_string(FreeDReject reason) {
       return "unknown_type";
     case FreeDReject::bad_checksum:
       return "bad_checksum";
+    case FreeDReject::unknown_id:
+      return "unknown_id";
+    case FreeDReject::too_late:
+      return "too_late";
+    case FreeDReject::duplicate:
+      return "duplicate";
   }
   return "unknown";
 }

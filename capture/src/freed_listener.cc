@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <condition_variable>
 #include <cstring>
@@ -29,6 +30,12 @@ Expected<void> FreeDListenerOptions::validate() const {
   if (inet_pton(AF_INET, bind_address.c_str(), &addr) != 1) {
     return fail("free-d listener: bind_address '" + bind_address + "' is not an IPv4 address");
   }
+  if (!group.empty()) {
+    in_addr g{};
+    if (inet_pton(AF_INET, group.c_str(), &g) != 1 || !IN_MULTICAST(ntohl(g.s_addr)))
+      return fail("free-d listener: group '" + group + "' is not an IPv4 multicast address");
+  }
+  if (!clock.valid()) return fail("free-d listener: clock period must be > 0");
   if (history == 0 || history > 100000) {
     return fail("free-d listener: history must be in 1..100000, got " + std::to_string(history));
   }
@@ -46,6 +53,11 @@ struct FreeDListener::State {
   mutable std::condition_variable changed;
   FreeDListenerStats stats;
   std::map<uint8_t, std::deque<FreeDSample>> kept;  // per camera id, oldest first
+  struct Tracked {
+    int delay_frames = 0;
+    std::optional<uint64_t> delivered;  // newest frame delivered
+  };
+  std::map<uint8_t, Tracked> tracked;
 
   ~State() {
     if (socket_fd >= 0) close(socket_fd);
@@ -64,8 +76,14 @@ Expected<std::unique_ptr<FreeDListener>> FreeDListener::create(
   state->options = options;
   state->socket_fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (state->socket_fd < 0) return fail("free-d listener: socket: " + errno_text());
-  // No SO_REUSEADDR: on Linux it lets two UDP sockets share a port and split the datagrams
-  // silently; a second listener on the same port must fail instead (UDP has no TIME_WAIT).
+  // SO_REUSEADDR only when sharing is asked for: on Linux it lets UDP sockets share a port, each
+  // getting a copy of broadcast/multicast datagrams but unicast ones going to one socket only; a
+  // second unshared listener on the same port must fail instead (UDP has no TIME_WAIT).
+  if (options.shared || !options.group.empty()) {
+    const int one = 1;
+    if (setsockopt(state->socket_fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) != 0)
+      return fail("free-d listener: SO_REUSEADDR: " + errno_text());
+  }
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_port = htons(options.port);
@@ -73,6 +91,13 @@ Expected<std::unique_ptr<FreeDListener>> FreeDListener::create(
   if (bind(state->socket_fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
     return fail("free-d listener: bind " + options.bind_address + ":" +
                 std::to_string(options.port) + ": " + errno_text());
+  }
+  if (!options.group.empty()) {
+    ip_mreq mreq{};
+    inet_pton(AF_INET, options.group.c_str(), &mreq.imr_multiaddr);
+    mreq.imr_interface.s_addr = htonl(INADDR_ANY);
+    if (setsockopt(state->socket_fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mreq, sizeof mreq) != 0)
+      return fail("free-d listener: join " + options.group + ": " + errno_text());
   }
   socklen_t len = sizeof addr;
   getsockname(state->socket_fd, reinterpret_cast<sockaddr*>(&addr), &len);
@@ -116,23 +141,57 @@ FreeDListener::~FreeDListener() {
 }
 
 uint16_t FreeDListener::port() const { return state_->port; }
+const FreeDListenerOptions& FreeDListener::options() const { return state_->options; }
+
+void FreeDListener::track(uint8_t freed_id, int delay_frames) {
+  std::lock_guard lock(state_->mutex);
+  state_->tracked[freed_id].delay_frames = std::max(delay_frames, 0);
+}
 
 void FreeDListener::handle_datagram(std::span<const uint8_t> bytes, int64_t arrival_ns) {
   FreeDReject reason{};
   auto packet = decode_freed(bytes, &reason);
   {
     std::lock_guard lock(state_->mutex);
-    ++state_->stats.datagrams;
+    State& s = *state_;
+    ++s.stats.datagrams;
+    std::optional<FreeDReject> rejected;
+    uint64_t frame = 0;
     if (!packet) {
-      ++state_->stats.rejected[std::size_t(reason)];
+      rejected = reason;
     } else {
-      ++state_->stats.accepted;
-      auto& history = state_->kept[packet->camera_id];
-      history.push_back(FreeDSample{*packet, arrival_ns});
-      while (history.size() > state_->options.history) history.pop_front();
+      const auto t = s.tracked.find(packet->camera_id);
+      const int delay = t == s.tracked.end() ? 0 : t->second.delay_frames;
+      const uint64_t arrival_frame = s.options.clock.frame_at(arrival_ns);
+      auto& history = s.kept[packet->camera_id];
+      if (!s.tracked.empty() && t == s.tracked.end()) {
+        rejected = FreeDReject::unknown_id;
+      } else if (arrival_frame < uint64_t(delay) ||
+                 (t != s.tracked.end() && t->second.delivered &&
+                  arrival_frame - uint64_t(delay) <= *t->second.delivered)) {
+        rejected = FreeDReject::too_late;
+      } else if (frame = arrival_frame - uint64_t(delay);
+                 !s.tracked.empty() &&
+                 std::any_of(history.begin(), history.end(),
+                             [&](const FreeDSample& k) { return k.frame == frame; })) {
+        rejected = FreeDReject::duplicate;  // the first packet of a frame counts
+      } else {
+        history.push_back(FreeDSample{*packet, arrival_ns, frame});
+        while (history.size() > s.options.history) history.pop_front();
+      }
+      if (history.empty()) s.kept.erase(packet->camera_id);
     }
+    if (rejected)
+      ++s.stats.rejected[std::size_t(*rejected)];
+    else
+      ++s.stats.accepted;
   }
   state_->changed.notify_all();
+}
+
+bool FreeDListener::tracks(uint8_t freed_id) const {
+  std::lock_guard lock(state_->mutex);
+  return state_->tracked.count(freed_id) > 0;
 }
 
 std::optional<FreeDSample> FreeDListener::latest(uint8_t freed_id) const {
@@ -142,22 +201,24 @@ std::optional<FreeDSample> FreeDListener::latest(uint8_t freed_id) const {
   return it->second.back();
 }
 
-std::optional<FreeDSample> FreeDListener::nearest(uint8_t freed_id, int64_t time_ns,
-                                                  int64_t max_skew_ns) const {
-  std::lock_guard lock(state_->mutex);
-  auto it = state_->kept.find(freed_id);
-  if (it == state_->kept.end()) return std::nullopt;
-  const FreeDSample* best = nullptr;
-  int64_t best_skew = 0;
-  for (const FreeDSample& s : it->second) {
-    const int64_t skew = s.arrival_ns > time_ns ? s.arrival_ns - time_ns : time_ns - s.arrival_ns;
-    if (!best || skew < best_skew) {
-      best = &s;
-      best_skew = skew;
+std::optional<FreeDSample> FreeDListener::wait_frame(uint8_t freed_id, uint64_t frame,
+                                                     int64_t until_ns) const {
+  std::unique_lock lock(state_->mutex);
+  for (;;) {
+    if (auto it = state_->kept.find(freed_id); it != state_->kept.end()) {
+      for (const FreeDSample& s : it->second)
+        if (s.frame == frame) return s;
     }
+    const int64_t now = realtime_ns();
+    if (now >= until_ns) return std::nullopt;
+    state_->changed.wait_for(lock, std::chrono::nanoseconds(until_ns - now));
   }
-  if (!best || best_skew > max_skew_ns) return std::nullopt;
-  return *best;
+}
+
+void FreeDListener::delivered(uint8_t freed_id, uint64_t frame) {
+  std::lock_guard lock(state_->mutex);
+  auto& t = state_->tracked[freed_id];
+  if (!t.delivered || frame > *t.delivered) t.delivered = frame;
 }
 
 FreeDListenerStats FreeDListener::stats() const {
@@ -174,14 +235,32 @@ bool FreeDListener::wait_for_datagrams(uint64_t count, std::chrono::milliseconds
 
 Expected<void> TrackedSourceOptions::validate() const {
   if (auto ok = camera.validate(); !ok) return ok;
-  if (max_skew_ns < 0) return fail("tracked source: max_skew_ns must not be negative");
+  if (!clock.valid()) return fail("tracked source: clock period must be > 0");
+  if (delay_frames < 0 || delay_frames > 50)
+    return fail("tracked source: delay_frames must be in 0..50");
+  if (silent_ns <= 0) return fail("tracked source: silent_ns must be > 0");
   return {};
 }
 
 TrackedSource::TrackedSource(std::unique_ptr<FrameSource> inner,
-                             std::shared_ptr<const FreeDListener> listener,
-                             TrackedSourceOptions options)
-    : inner_(std::move(inner)), listener_(std::move(listener)), options_(std::move(options)) {}
+                             std::shared_ptr<FreeDListener> listener, TrackedSourceOptions options)
+    : inner_(std::move(inner)), listener_(std::move(listener)), options_(std::move(options)) {
+  if (options_.grace_ns < 0) options_.grace_ns = options_.clock.period_ns / 4;
+  listener_->track(options_.camera.freed_id, options_.delay_frames);
+  following_ = inner_->follow_pose([this](uint64_t frame) { return resolve(frame); });
+}
+
+std::optional<Camera> TrackedSource::resolve(uint64_t frame) {
+  if (resolved_ && resolved_->first == frame) return resolved_->second;
+  const int64_t until = options_.clock.time_of(frame + uint64_t(options_.delay_frames) + 1) +
+                        options_.grace_ns;
+  std::optional<Camera> camera;
+  if (auto sample = listener_->wait_frame(options_.camera.freed_id, frame, until))
+    camera = freed_to_camera(sample->packet, options_.camera);
+  listener_->delivered(options_.camera.freed_id, frame);
+  resolved_.emplace(frame, camera);
+  return camera;
+}
 
 Expected<std::optional<Frame>> TrackedSource::next(std::chrono::milliseconds timeout) {
   auto frame = inner_->next(timeout);
@@ -193,15 +272,19 @@ Expected<std::optional<Frame>> TrackedSource::next(std::chrono::milliseconds tim
                 std::to_string(options_.camera.width) + "x" +
                 std::to_string(options_.camera.height));
   }
-  auto sample = listener_->nearest(options_.camera.freed_id, f.capture_ns + options_.latency_ns,
-                                   options_.max_skew_ns);
-  if (sample) {
-    f.calibration = freed_to_camera(sample->packet, options_.camera);
-  } else {
-    f.calibration.reset();
-    ++untracked_;
-  }
+  f.calibration = resolve(f.frame);
+  if (!f.calibration) ++untracked_;
   return frame;
+}
+
+TrackingStatus TrackedSource::status(int64_t now_ns) const {
+  TrackingStatus s;
+  s.untracked = untracked_.load();
+  if (auto last = listener_->latest(options_.camera.freed_id)) {
+    s.since_s = double(now_ns - last->arrival_ns) * 1e-9;
+    s.silent = now_ns - last->arrival_ns > options_.silent_ns;
+  }
+  return s;
 }
 
 }  // namespace studio::capture

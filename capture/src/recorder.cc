@@ -9,6 +9,8 @@
 #include <cstring>
 #include <filesystem>
 
+#include "capture/take_calibration.h"
+
 namespace studio::capture {
 namespace {
 
@@ -22,6 +24,9 @@ Expected<void> RecorderOptions::validate() const {
   if (dir.empty()) return fail("recorder: dir is empty");
   if (queue_frames < 1 || queue_frames > 10000)
     return fail("recorder: queue_frames must be in 1..10000, got " + std::to_string(queue_frames));
+  if (sync_interval_ms < 1 || sync_interval_ms > 60000)
+    return fail("recorder: sync_interval_ms must be in 1..60000, got " +
+                std::to_string(sync_interval_ms));
   return {};
 }
 
@@ -55,7 +60,14 @@ Expected<std::unique_ptr<Recorder>> Recorder::start(const RecorderOptions& optio
     ::close(frames_fd);
     return fail(errno_text("recorder: cannot open " + index_path, err));
   }
+  // The new files' names are durable before the first frame is.
+  if (auto synced = sync_directory(options.dir); !synced) {
+    ::close(frames_fd);
+    ::close(index_fd);
+    return fail("recorder: " + synced.error().message);
+  }
   auto r = std::unique_ptr<Recorder>(new Recorder(options, std::move(info), frames_fd, index_fd));
+  r->last_sync_ = std::chrono::steady_clock::now();
   r->writer_ = std::thread([p = r.get()] { p->writer_loop(); });
   return r;
 }
@@ -71,7 +83,8 @@ Recorder::~Recorder() {
   (void)wait();
 }
 
-bool Recorder::push(uint64_t frame, int64_t capture_ns, ImageView<const Rgb8> image) {
+bool Recorder::push(uint64_t frame, int64_t capture_ns, ImageView<const Rgb8> image,
+                    const std::optional<Camera>& calibration) {
   if (image.width() != int(info_.width) || image.height() != int(info_.height)) return false;
   const std::size_t row_bytes = std::size_t(image.width()) * sizeof(Rgb8);
   std::vector<uint8_t> buffer;
@@ -94,7 +107,7 @@ bool Recorder::push(uint64_t frame, int64_t capture_ns, ImageView<const Rgb8> im
   {
     std::lock_guard lock(mutex_);
     if (state_ != RecorderState::kRecording) return false;
-    queue_.push_back(Slot{frame, capture_ns, std::move(buffer)});
+    queue_.push_back(Slot{frame, capture_ns, std::move(buffer), calibration});
     stats_.max_queue_depth = std::max(stats_.max_queue_depth, queue_.size());
   }
   wake_.notify_one();
@@ -151,7 +164,11 @@ void Recorder::writer_loop() {
       queue_.pop_front();
     }
     const auto t0 = std::chrono::steady_clock::now();
-    const bool ok = write_frame(slot.pixels, slot.frame, slot.capture_ns);
+    bool ok = write_frame(slot.pixels, slot.frame, slot.capture_ns);
+    if (ok && slot.calibration) ok = write_calibration(slot.frame, *slot.calibration);
+    if (ok && std::chrono::steady_clock::now() - last_sync_ >=
+                  std::chrono::milliseconds(options_.sync_interval_ms))
+      ok = sync_files();
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::lock_guard lock(mutex_);
@@ -236,12 +253,48 @@ bool Recorder::write_frame(const std::vector<uint8_t>& pixels, uint64_t frame, i
   return false;
 }
 
+bool Recorder::write_calibration(uint64_t frame, const Camera& camera) {
+  if (calibration_fd_ < 0) {
+    const std::string path = options_.dir + "/" + kCalibrationFile;
+    calibration_fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    if (calibration_fd_ < 0 || !sync_directory(options_.dir)) {
+      std::lock_guard lock(mutex_);
+      error_ = errno_text("recorder: cannot create " + path, errno);
+      return false;
+    }
+  }
+  const std::string line = format_calibration_line(frame, camera);
+  const ssize_t w = ::write(calibration_fd_, line.data(), line.size());
+  if (w == ssize_t(line.size())) return true;
+  std::lock_guard lock(mutex_);
+  error_ = errno_text("recorder: cannot append to " + options_.dir + "/" + kCalibrationFile,
+                      w < 0 ? errno : ENOSPC);
+  return false;
+}
+
+bool Recorder::sync_files() {
+  last_sync_ = std::chrono::steady_clock::now();
+  for (int fd : {frames_fd_, index_fd_, calibration_fd_}) {
+    if (fd >= 0 && ::fdatasync(fd) != 0) {
+      std::lock_guard lock(mutex_);
+      error_ = errno_text("recorder: fdatasync " + options_.dir, errno);
+      return false;
+    }
+  }
+  std::lock_guard lock(mutex_);
+  ++stats_.syncs;
+  return true;
+}
+
 void Recorder::finalise(bool failed) {
   std::string sync_error;
-  if (::fdatasync(frames_fd_) != 0) sync_error = errno_text("recorder: fdatasync", errno);
+  for (int fd : {frames_fd_, calibration_fd_})
+    if (fd >= 0 && ::fdatasync(fd) != 0 && sync_error.empty())
+      sync_error = errno_text("recorder: fdatasync", errno);
   ::close(frames_fd_);
   ::close(index_fd_);
-  frames_fd_ = index_fd_ = -1;
+  if (calibration_fd_ >= 0) ::close(calibration_fd_);
+  frames_fd_ = index_fd_ = calibration_fd_ = -1;
 
   TakeInfo final_info = info_;
   RecorderStats stats;

@@ -59,6 +59,15 @@ void box_cols(Image<Rgb8>& img, int r, std::vector<uint16_t>& tmp) {
   }
 }
 
+bool same_camera(const Camera& a, const Camera& b) {
+  const auto &ia = a.intrinsics, &ib = b.intrinsics;
+  return ia.fx == ib.fx && ia.fy == ib.fy && ia.cx == ib.cx && ia.cy == ib.cy &&
+         ia.skew == ib.skew && a.distortion.model == b.distortion.model &&
+         a.distortion.rd3 == b.distortion.rd3 && a.distortion.rd5 == b.distortion.rd5 &&
+         a.cam_from_world.R() == b.cam_from_world.R() &&
+         a.cam_from_world.translation == b.cam_from_world.translation;
+}
+
 }  // namespace
 
 Expected<void> SimSourceOptions::validate() const {
@@ -148,6 +157,16 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
     if (skipped) last_frame_ = f - 1;
     return std::optional<Frame>();
   }
+  if (pose_) {
+    if (auto camera = pose_(f); camera && !same_camera(*camera, studio_.cameras()[0])) {
+      Camera c = *camera;
+      c.id = options_.camera.id;
+      c.width = options_.camera.width;
+      c.height = options_.camera.height;
+      if (auto moved = studio_.set_camera(0, c); !moved)
+        return fail("sim source " + id() + ": tracked pose: " + moved.error().message);
+    }
+  }
   Frame frame;
   frame.frame = f;
   frame.capture_ns = capture_ns;
@@ -199,6 +218,11 @@ Expected<double> SimFrameSource::set_feature(std::string_view name, double value
     return exposure_us_ = std::clamp(value, kExposureMin, exposure_max(options_.clock));
   if (name == "Focus") return focus_ = std::clamp(value, 0.0, 1.0);
   return fail("camera " + id() + ": feature '" + std::string(name) + "' is not available");
+}
+
+bool SimFrameSource::follow_pose(PoseOfFrame pose) {
+  pose_ = std::move(pose);
+  return true;
 }
 
 SourceStats SimFrameSource::stats() const {

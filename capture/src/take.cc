@@ -87,10 +87,16 @@ Expected<void> write_atomic(const std::string& dir, const std::string& name,
     }
   }
   if (::rename(tmp.c_str(), path.c_str()) != 0) return fail(errno_text("cannot rename " + tmp));
-  return {};
+  return sync_directory(dir);  // the rename itself is durable
 }
 
 }  // namespace
+
+Expected<void> sync_directory(const std::string& dir) {
+  Fd fd(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (fd.get() < 0 || ::fsync(fd.get()) != 0) return fail(errno_text("cannot sync folder " + dir));
+  return {};
+}
 
 const char* pixel_format_name(PixelFormat format) {
   switch (format) {

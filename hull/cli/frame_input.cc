@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "capture/take.h"
+#include "capture/take_calibration.h"
 #include "keyer/keyer.h"
 #include "yaml_io/node.h"
 #include "yaml_io/rig_yaml.h"
@@ -67,8 +68,10 @@ class Take final : public FrameInput {
  public:
   Take(const std::vector<Camera>& cameras, std::vector<std::string> camera_dirs,
        std::vector<uint64_t> numbers, std::vector<std::map<uint64_t, uint64_t>> offsets,
-       std::vector<std::vector<keyer::Keyer>> keyers)
+       std::vector<std::vector<keyer::Keyer>> keyers,
+       std::vector<std::map<uint64_t, Camera>> tracked)
       : cameras_(cameras),
+        tracked_(std::move(tracked)),
         camera_dirs_(std::move(camera_dirs)),
         numbers_(std::move(numbers)),
         offsets_(std::move(offsets)),
@@ -115,8 +118,14 @@ class Take final : public FrameInput {
     return {};
   }
 
+  const Camera* camera(std::size_t k, std::size_t c) const override {
+    const auto it = tracked_[c].find(numbers_[k]);
+    return it == tracked_[c].end() ? nullptr : &it->second;
+  }
+
  private:
   const std::vector<Camera>& cameras_;
+  std::vector<std::map<uint64_t, Camera>> tracked_;  // per camera: frame -> its calibration
   std::vector<std::string> camera_dirs_;
   std::vector<uint64_t> numbers_;
   std::vector<std::map<uint64_t, uint64_t>> offsets_;  // per camera: frame -> byte offset
@@ -207,8 +216,12 @@ Expected<std::unique_ptr<FrameInput>> open_take(const std::string& dir,
   }
   std::vector<std::string> camera_dirs;
   std::vector<std::map<uint64_t, uint64_t>> offsets(cameras.size());
+  std::vector<std::map<uint64_t, Camera>> tracked(cameras.size());
   for (std::size_t c = 0; c < cameras.size(); ++c) {
     const std::string cam_dir = (fs::path(dir) / cameras[c].id).string();
+    auto per_frame = capture::read_take_calibration(cam_dir, cameras[c]);
+    if (!per_frame) return fail("take " + dir + ": " + per_frame.error().message);
+    tracked[c] = std::move(*per_frame);
     if (!fs::exists(fs::path(cam_dir) / capture::kFramesFile)) {
       return fail("take " + dir + ": no recording of camera " + cameras[c].id + " (" + cam_dir +
                   "/" + capture::kFramesFile + " is missing)");
@@ -243,6 +256,11 @@ Expected<std::unique_ptr<FrameInput>> open_take(const std::string& dir,
         return fail("take " + dir + ": camera " + cameras[c].id + " has no frame " +
                     std::to_string(f) + " (dropped while recording?); use --frames to skip it");
       }
+      if (!tracked[c].empty() && !tracked[c].contains(f)) {
+        return fail("take " + dir + ": tracked camera " + cameras[c].id +
+                    " has no calibration for frame " + std::to_string(f) +
+                    "; use --frames to skip it");
+      }
     }
   }
   std::vector<std::vector<keyer::Keyer>> keyers(std::size_t(std::max(slots, 1)));
@@ -254,7 +272,8 @@ Expected<std::unique_ptr<FrameInput>> open_take(const std::string& dir,
     }
   }
   return std::unique_ptr<FrameInput>(new Take(cameras, std::move(camera_dirs), std::move(numbers),
-                                              std::move(offsets), std::move(keyers)));
+                                              std::move(offsets), std::move(keyers),
+                                              std::move(tracked)));
 }
 
 }  // namespace studio::hull::cli

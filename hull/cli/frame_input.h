@@ -6,7 +6,9 @@
 // - a recorded take: DIR/<camera_id>/ as written by the capture recorder (capture/take.h:
 //   frames.raw + index), keyed on the fly with the keyer library (keyer/keyer.h). Frames are
 //   matched across cameras by their recorded frame number; the index is used when it is readable,
-//   a scan of frames.raw otherwise.
+//   a scan of frames.raw otherwise. A camera whose folder holds per-frame calibration (a Free-D
+//   tracked camera) is cut with its calibration of each frame (id and size from the rig), and
+//   every selected frame must have one.
 //
 // Both check everything a frame needs before any work where it is cheap (a camera without a mask
 // or recording, a frame one camera lacks) and, while loading, every mask or frame against its
@@ -47,6 +49,12 @@ class FrameInput {
   // `slot`s (0 .. slots-1 given at opening) may run concurrently.
   virtual Expected<void> load(std::size_t k, int slot, std::vector<RunMask>& masks,
                               LoadTimes& times) = 0;
+  // Camera c (rig order) as it was at frame k when the input records per-frame calibration (a
+  // tracked camera's take: capture/take_calibration.h), else nullptr: the rig's camera.
+  virtual const Camera* camera(std::size_t k, std::size_t c) const {
+    (void)k, (void)c;
+    return nullptr;
+  }
 
  protected:
   std::vector<std::string> frames_;

@@ -47,7 +47,8 @@ constexpr const char* kUsage =
 Offline visual hull (line-segment representation, segment marching cubes) from silhouettes.
   --rig FILE        rig.yaml with the calibrated cameras; with --take the default is the
                     calibration each camera recorded in its take.yaml (its pose when the take
-                    began: give a rig for tracked cameras that moved)
+                    began); a tracked (Free-D) camera's take records its calibration per frame,
+                    and each frame is cut with that
   --masks DIR       DIR/<camera_id>.png (one frame) or DIR/<frame>/<camera_id>.png (a sequence);
                     0 = background, non-zero = actor; every camera of the rig needs its mask
   --take DIR        a recorded take, takes/<take>/ holding <camera_id>/frames.raw (+ index) for
@@ -338,7 +339,10 @@ int run_offline(int argc, char** argv) {
       if (auto ok = in.load(k, slot, masks, load); !ok) return give_up(ok.error().message);
       auto t0 = std::chrono::steady_clock::now();
       views.clear();
-      for (std::size_t c = 0; c < masks.size(); ++c) views.push_back({&cameras[c], &masks[c]});
+      for (std::size_t c = 0; c < masks.size(); ++c) {  // a tracked camera: its frame's pose
+        const Camera* moved = in.camera(k, c);
+        views.push_back({moved ? moved : &cameras[c], &masks[c]});
+      }
       auto hull = visual_hull(grid, views, cut_options);
       if (!hull) return give_up(hull.error().message);
       const double cut = ms_since(t0);

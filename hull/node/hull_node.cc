@@ -66,6 +66,13 @@ class HullNode : public runtime::Node {
         [this](const studio_CameraCalibration& s, const wire::SampleMeta&) {
           return on_calibration(s);
         });
+    loop_.input<studio_CameraState>(
+        {.received = "camera_states_in", .rejected = "camera_states_rejected", .rate = false},
+        [this](const studio_CameraState& s, const wire::SampleMeta&) {
+          if (const int i = assembler_.source_index(s.camera_id); i >= 0)
+            poses_.set_valid(std::size_t(i), s.calibration_valid);
+          return runtime::Outcome{};
+        });
     loop_.input<studio_AlphaMask>(
         {.received = "masks_in", .rejected = "masks_rejected", .reason_prefix = "masks_rejected_"},
         [this](const studio_AlphaMask& s, const wire::SampleMeta&) { return on_mask(s); });
@@ -75,6 +82,7 @@ class HullNode : public runtime::Node {
     for (const char* name : {"frames_complete", "frames_partial", "frames_dropped", "masks_late"})
       frame_counts_.push_back(&loop_.counter(name));
     stale_ = &loop_.counter("calibrations_not_of_frame");
+    invalid_ = &loop_.counter("masks_of_invalid_calibration");
   }
   ~HullNode() override { stop(); }
 
@@ -128,6 +136,10 @@ class HullNode : public runtime::Node {
     std::vector<View> views;
     for (std::size_t i = 0; i < frame.items.size(); ++i) {
       if (!frame.items[i]) continue;
+      if (!poses_.valid(i)) {  // its calibration no longer describes it: leave it out
+        invalid_->add();
+        continue;
+      }
       const CameraPoses::Pose pose = poses_.camera_for(i, frame.frame);
       if (pose.stale) stale_->add();
       views.push_back(View{pose.camera, &*frame.items[i]});
@@ -193,6 +205,7 @@ class HullNode : public runtime::Node {
   runtime::Output<studio_ActorMesh>* meshes_ = nullptr;
   std::vector<runtime::Counter*> frame_counts_;
   runtime::Counter* stale_ = nullptr;
+  runtime::Counter* invalid_ = nullptr;
   runtime::ServiceLoop loop_;  // last: stopped before the state above goes
 };
 

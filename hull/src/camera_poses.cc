@@ -6,7 +6,8 @@
 namespace studio::hull {
 
 CameraPoses::CameraPoses(std::vector<Camera> cameras, std::size_t history)
-    : cameras_(std::move(cameras)),
+    : valid_(cameras.size(), true),
+      cameras_(std::move(cameras)),
       tracked_(cameras_.size()),
       history_(std::max<std::size_t>(history, 1)) {}
 

@@ -79,6 +79,21 @@ void from_core(const CameraStateCore& s, wire::Owned<studio_CameraState>& out) {
       break;
   }
   wire::set(out->error, s.error.substr(0, sizeof out->error - 1));
+  out->calibration_valid = s.calibration_valid;
+  switch (s.time_source) {
+    case capture::TimeSource::host_arrival:
+      out->time_source = studio_TIME_HOST_ARRIVAL;
+      break;
+    case capture::TimeSource::camera:
+      out->time_source = studio_TIME_CAMERA;
+      break;
+    case capture::TimeSource::camera_ptp:
+      out->time_source = studio_TIME_CAMERA_PTP;
+      break;
+    case capture::TimeSource::studio_clock:
+      out->time_source = studio_TIME_STUDIO_CLOCK;
+      break;
+  }
 }
 
 CaptureCommandCore to_core(const studio_CaptureCommand& c) {

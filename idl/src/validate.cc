@@ -161,7 +161,9 @@ Verdict validate(const studio_CameraState& s) {
     if (f.min > f.max) return Reject::out_of_range;
   }
   if (!std::isfinite(s.fps)) return Reject::non_finite;
-  if (s.fps < 0 || raw(s.state) > studio_CAMERA_ERROR) return Reject::out_of_range;
+  if (s.fps < 0 || raw(s.state) > studio_CAMERA_ERROR ||
+      raw(s.time_source) > studio_TIME_STUDIO_CLOCK)
+    return Reject::out_of_range;
   return std::nullopt;
 }
 

@@ -251,6 +251,30 @@ struct SimulatedStudio::Impl {
   std::vector<Camera> cameras;
   std::vector<CameraCache> caches;
   std::vector<int8_t> noise;  // N(0, sigma) per byte, kNoiseWindow longer than any image
+  Image<Rgb8> projection;     // the image on the projection wall (backgrounds are rebuilt)
+
+  // Camera `i`'s cache: its undistorted rays and its view of the empty studio.
+  void build_cache(std::size_t i) {
+    CameraCache& cache = caches[i];
+    cache = CameraCache{};
+    cache.camera = cameras[i];
+    cache.pinhole = cache.camera.distortion.is_identity();
+    cache.R = cache.camera.cam_from_world.R();
+    cache.t = cache.camera.cam_from_world.translation;
+    cache.centre = cache.camera.centre_in_world();
+    if (!cache.pinhole) {
+      const auto& k = cache.camera.intrinsics;
+      cache.rays.resize(static_cast<std::size_t>(cache.camera.width) * cache.camera.height);
+      for (int v = 0; v < cache.camera.height; ++v) {
+        for (int u = 0; u < cache.camera.width; ++u) {
+          const double y = (v - k.cy) / k.fy;
+          cache.rays[static_cast<std::size_t>(v) * cache.camera.width + u] = undistort(
+              cache.camera.distortion, Eigen::Vector2d((u - k.cx - k.skew * y) / k.fx, y));
+        }
+      }
+    }
+    build_background(options, projection, &cache);
+  }
 
   explicit Impl(const StudioOptions& o) : options(o), actor(o.actor) {}
 
@@ -327,32 +351,13 @@ Expected<SimulatedStudio> SimulatedStudio::create(std::vector<Camera> cameras,
     std::normal_distribution<double> gauss(0.0, options.noise_sigma);
     for (int8_t& v : impl->noise) v = static_cast<int8_t>(std::clamp(std::lround(gauss(rng)), -127L, 127L));
   }
-  const Image<Rgb8> projection = options.projection.pixels().empty() ? builtin_projection()
-                                                                     : options.projection;
+  impl->projection =
+      options.projection.pixels().empty() ? builtin_projection() : options.projection;
   impl->caches.resize(impl->cameras.size());
   // Backgrounds are independent per camera: build them on the worker threads too.
   std::atomic<std::size_t> next{0};
   auto build = [&] {
-    for (std::size_t i; (i = next++) < impl->cameras.size();) {
-      CameraCache& cache = impl->caches[i];
-      cache.camera = impl->cameras[i];
-      cache.pinhole = cache.camera.distortion.is_identity();
-      cache.R = cache.camera.cam_from_world.R();
-      cache.t = cache.camera.cam_from_world.translation;
-      cache.centre = cache.camera.centre_in_world();
-      if (!cache.pinhole) {
-        const auto& k = cache.camera.intrinsics;
-        cache.rays.resize(static_cast<std::size_t>(cache.camera.width) * cache.camera.height);
-        for (int v = 0; v < cache.camera.height; ++v) {
-          for (int u = 0; u < cache.camera.width; ++u) {
-            const double y = (v - k.cy) / k.fy;
-            cache.rays[static_cast<std::size_t>(v) * cache.camera.width + u] = undistort(
-                cache.camera.distortion, Eigen::Vector2d((u - k.cx - k.skew * y) / k.fx, y));
-          }
-        }
-      }
-      build_background(impl->options, projection, &cache);
-    }
+    for (std::size_t i; (i = next++) < impl->cameras.size();) impl->build_cache(i);
   };
   {
     std::vector<std::jthread> workers;
@@ -360,6 +365,22 @@ Expected<SimulatedStudio> SimulatedStudio::create(std::vector<Camera> cameras,
     build();
   }
   return SimulatedStudio(std::move(impl));
+}
+
+Expected<void> SimulatedStudio::set_camera(int index, const Camera& camera) {
+  if (index < 0 || index >= camera_count()) return fail(detail::cat("no camera ", index));
+  const Camera& old = impl_->cameras[std::size_t(index)];
+  if (camera.width != old.width || camera.height != old.height)
+    return fail(detail::cat("camera '", old.id, "': a moved camera keeps its size"));
+  const auto& k = camera.intrinsics;
+  if (!(k.fx > 0 && k.fy > 0 && std::isfinite(k.cx) && std::isfinite(k.cy) &&
+        std::isfinite(k.skew)) ||
+      !camera.cam_from_world.translation.allFinite() ||
+      !camera.cam_from_world.rotation.coeffs().allFinite())
+    return fail(detail::cat("camera '", old.id, "': bad intrinsics or pose"));
+  impl_->cameras[std::size_t(index)] = camera;
+  impl_->build_cache(std::size_t(index));
+  return {};
 }
 
 const StudioOptions& SimulatedStudio::options() const { return impl_->options; }

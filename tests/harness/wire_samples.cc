@@ -117,6 +117,8 @@ void fill(studio_CameraState& s, int seed) {
   set(s.take, "take" + std::to_string(seed));
   s.state = studio_CAMERA_STREAMING;
   set(s.error, "");
+  s.calibration_valid = seed % 3 != 0;
+  s.time_source = studio_TIME_CAMERA;
 }
 
 void fill(studio_CameraControl& s, int seed) {
@@ -271,7 +273,8 @@ bool same(const studio_CameraState& a, const studio_CameraState& b) {
       return false;
   return str_same(a.camera_id, b.camera_id) && a.frame == b.frame && a.capture_ns == b.capture_ns &&
          a.fps == b.fps && a.drops == b.drops && a.recording == b.recording &&
-         str_same(a.take, b.take) && a.state == b.state && str_same(a.error, b.error);
+         str_same(a.take, b.take) && a.state == b.state && str_same(a.error, b.error) &&
+         a.calibration_valid == b.calibration_valid && a.time_source == b.time_source;
 }
 bool same(const studio_CameraControl& a, const studio_CameraControl& b) {
   return str_same(a.camera_id, b.camera_id) && str_same(a.feature, b.feature) &&

@@ -8,8 +8,19 @@
 //
 // Streaming: next() pops completed buffers, converts them to RGB8 (Mono8 → grey, RGB8 → copy,
 // Bayer RG/GR/GB/BG 8 → RGB by OpenCV's bilinear demosaic) and returns them to the pool.
-// capture_ns is the host arrival time of the frame (Aravis' system timestamp, CLOCK_REALTIME);
-// frame = clock.frame_at(capture_ns) (DESIGN §5).
+// Camera time: capture_ns is the camera's own timestamp of the frame mapped to the host clock
+// (CLOCK_REALTIME) by a CameraTimeLatch (capture/camera_time.h): seeded by a GenICam latch
+// (TimestampLatch + TimestampLatchValue, or GevTimestampControlLatch + GevTimestampValue, with
+// GevTimestampTickFrequency) when the camera has one, refined by every frame's arrival. A camera
+// that stamps nothing (timestamp 0), or `camera_time: false`, falls back to the host arrival
+// time (Aravis' system timestamp); time_source() says which (TimeSource::camera or
+// host_arrival). frame = clock.frame_at(capture_ns) (DESIGN §5).
+//
+// Software trigger: with TriggerMode::software and `clock_trigger` (the default) a trigger
+// thread fires TriggerSoftware at every studio frame, half a period after the frame's start
+// (clock.time_of(f) + period/2, CLOCK_REALTIME, absolute sleeps), so the camera delivers exactly
+// one frame per studio frame, in step with the studio clock, like a genlocked camera.
+// clock_trigger false leaves the triggering to software_trigger() calls.
 // Drops = stream underruns (a frame arrived while no buffer was free: consumer too slow or pool
 // too small) + buffers completed with an error status (missing packets, timeout, size mismatch)
 // + frames that could not be converted.
@@ -61,6 +72,8 @@ struct AravisOptions {
   double frame_rate = 0;      // frames per second in free run; 0 keeps the camera's
   TriggerMode trigger = TriggerMode::free_run;
   std::string trigger_line = "Line0";  // TriggerSource for TriggerMode::line
+  bool clock_trigger = true;           // software trigger fired at the studio clock (above)
+  bool camera_time = true;             // the camera's timestamps when it has them (above)
   int buffers = 8;                     // stream buffer pool, 2..256
   FrameClock clock;
   std::chrono::milliseconds retry_initial{250};
@@ -96,7 +109,10 @@ class AravisSource : public FrameSource {
   std::vector<Feature> features() const override;
   Expected<double> set_feature(std::string_view name, double value) override;
   SourceStats stats() const override;
+  TimeSource time_source() const override;
 
+  // Software triggers fired by the clock trigger thread (and by software_trigger()).
+  uint64_t triggers() const;
   // TriggerMode::software: one frame per call.
   Expected<void> software_trigger();
 

@@ -65,6 +65,7 @@ class FileSource : public FrameSource {
   void stop() override;
   Expected<std::optional<Frame>> next(std::chrono::milliseconds timeout) override;
   SourceStats stats() const override;
+  TimeSource time_source() const override { return TimeSource::studio_clock; }
 
   std::size_t size() const { return files_.size(); }  // images (or take frames) per pass
   bool is_take() const { return take_; }

@@ -17,6 +17,7 @@
 //   back from the device.
 
 #include <chrono>
+#include <functional>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -28,6 +29,13 @@
 #include "core/image.h"
 
 namespace studio::capture {
+
+// Where a source's capture_ns (and so its frame numbers) come from; CameraState reports it.
+//   camera:       the camera's own timestamp (GenICam Timestamp, latched to the host clock)
+//   camera_ptp:   the camera's timestamp, PTP-synchronised (already on the studio clock)
+//   host_arrival: the host clock when the frame arrived (the fallback: jitter of the transport)
+//   studio_clock: synthesised on the studio clock (simulated camera, file replay)
+enum class TimeSource { host_arrival, camera, camera_ptp, studio_clock };
 
 struct Frame {
   uint64_t frame = 0;       // studio frame number (DESIGN §5)
@@ -64,6 +72,17 @@ class FrameSource {
     return fail("camera " + id() + ": feature '" + std::string(name) + "' is not available");
   }
   virtual SourceStats stats() const = 0;
+  virtual TimeSource time_source() const { return TimeSource::host_arrival; }
+
+  // A source that synthesises its pictures (the simulated camera) can follow a tracked pose:
+  // `pose(frame)` is called on the capture thread before frame `frame` is made and returns the
+  // camera to make it with (nullopt: keep the previous one). Returns false when the source
+  // cannot (real cameras: the tracker follows them, not the other way round).
+  using PoseOfFrame = std::function<std::optional<Camera>(uint64_t frame)>;
+  virtual bool follow_pose(PoseOfFrame pose) {
+    (void)pose;
+    return false;
+  }
 };
 
 }  // namespace studio::capture

@@ -55,9 +55,18 @@ inline constexpr std::size_t kFreeDD1Size = 29;
 inline constexpr uint8_t kFreeDD1Type = 0xD1;
 inline constexpr uint16_t kFreeDDefaultPort = 40000;
 
-// Why a datagram was rejected; used as an index into per-reason counters.
-enum class FreeDReject : uint8_t { wrong_length = 0, unknown_type = 1, bad_checksum = 2 };
-inline constexpr std::size_t kFreeDRejectCount = 3;
+// Why a datagram was rejected; used as an index into per-reason counters. The first three are
+// the decoder's (malformed); the others the listener's (freed_listener.h): a camera id no camera
+// of this process takes, a packet for a frame already delivered, a second packet for one frame.
+enum class FreeDReject : uint8_t {
+  wrong_length = 0,
+  unknown_type = 1,
+  bad_checksum = 2,
+  unknown_id = 3,
+  too_late = 4,
+  duplicate = 5,
+};
+inline constexpr std::size_t kFreeDRejectCount = 6;
 const char* to_string(FreeDReject reason);
 
 struct FreeDPacket {

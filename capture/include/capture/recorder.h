@@ -8,6 +8,14 @@
 // appends the index entry. If the disk cannot keep up, the queue fills and push() drops the frame
 // and counts it (stats().queue_drops): the capture loop never blocks on the disk.
 //
+// Durability: the writer fdatasync()s frames.raw (and the index and the per-frame calibration
+// file) at least every sync_interval_ms while recording, so a power cut loses at most the frames
+// of the last interval (plus the queue); `studio-capture verify-take` rebuilds the index from
+// what frames.raw kept. take.yaml and the index are replaced by rename, and the folder is
+// fsync()ed after each rename and after the files are created.
+// Tracked cameras: a frame pushed with a calibration gets a line in the take's `calibration`
+// file (capture/take_calibration.h), written after the frame.
+//
 // End of a take: stop() makes push() refuse further frames; the writer drains the queue,
 // fdatasync()s frames.raw, rewrites the index atomically and rewrites take.yaml with
 // status complete, first/last frame, count and drops. wait() joins and returns that TakeInfo.
@@ -22,7 +30,9 @@
 
 #include <condition_variable>
 #include <cstdint>
+#include <chrono>
 #include <deque>
+#include <optional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -40,6 +50,7 @@ struct RecorderOptions {
   std::string dir;                // takes/<take>/<camera_id>; created with its parents; must not
                                   // already hold a frames.raw (a take is never overwritten)
   std::size_t queue_frames = 50;  // 2 s at 25 fps; 1 .. 10000
+  int sync_interval_ms = 1000;    // fdatasync at least this often while recording; 1 .. 60000
   Expected<void> validate() const;
 };
 
@@ -52,6 +63,7 @@ struct RecorderStats {
   uint64_t other_drops = 0;  // reported by the caller (add_drops)
   std::size_t max_queue_depth = 0;
   double write_ms_total = 0;  // writer thread time in CRC + writev, for the headroom figure
+  uint64_t syncs = 0;         // fdatasync rounds while recording
 };
 
 class Recorder {
@@ -66,8 +78,11 @@ class Recorder {
 
   // Queues a copy of the frame. False (and nothing written) when the frame's size differs from
   // the take's, when not recording, or when the queue is full (counted in queue_drops).
-  bool push(uint64_t frame, int64_t capture_ns, ImageView<const Rgb8> image);
-  bool push(const Frame& frame) { return push(frame.frame, frame.capture_ns, frame.image.view()); }
+  bool push(uint64_t frame, int64_t capture_ns, ImageView<const Rgb8> image,
+            const std::optional<Camera>& calibration = std::nullopt);
+  bool push(const Frame& frame) {
+    return push(frame.frame, frame.capture_ns, frame.image.view(), frame.calibration);
+  }
   // Frames the source lost during the take (counted in take.yaml's drops).
   void add_drops(uint64_t n);
 
@@ -88,18 +103,23 @@ class Recorder {
   void writer_loop();
   // Appends one frame; false with the error set on failure.
   bool write_frame(const std::vector<uint8_t>& pixels, uint64_t frame, int64_t capture_ns);
+  bool write_calibration(uint64_t frame, const Camera& camera);
+  bool sync_files();
   void finalise(bool failed);
 
   struct Slot {
     uint64_t frame = 0;
     int64_t capture_ns = 0;
     std::vector<uint8_t> pixels;
+    std::optional<Camera> calibration;
   };
 
   const RecorderOptions options_;
   TakeInfo info_;
   int frames_fd_ = -1;
   int index_fd_ = -1;
+  int calibration_fd_ = -1;  // opened with the first calibrated frame
+  std::chrono::steady_clock::time_point last_sync_;
   uint64_t good_bytes_ = 0;  // frames.raw length up to the last complete frame
   std::vector<IndexEntry> index_;
   std::optional<uint64_t> first_frame_, last_frame_;

@@ -18,6 +18,8 @@
 //   Gain          dB, 0..24            image *= 10^(Gain/20)
 //   ExposureTime  µs, 20..period       image *= ExposureTime / nominal_exposure_us
 //   Focus         0..1                 box blur of radius round(|Focus - in_focus| * max_blur_px)
+// Tracked (follow_pose): before rendering frame f the source asks for its camera; a changed
+// camera rebuilds the simulated camera's cached rays and background (SimulatedStudio::set_camera).
 // Brightness is applied through a 256-entry table (saturating), blur as two separable box passes.
 
 #include <atomic>
@@ -58,6 +60,10 @@ class SimFrameSource : public FrameSource {
   std::vector<Feature> features() const override;
   Expected<double> set_feature(std::string_view name, double value) override;
   SourceStats stats() const override;
+  TimeSource time_source() const override { return TimeSource::studio_clock; }
+  // A tracked simulated camera: frame f is rendered from pose(f) (its intrinsics and pose; the
+  // id and size stay), so its image and true mask agree with the tracker's calibration.
+  bool follow_pose(PoseOfFrame pose) override;
 
   const sim::SimulatedStudio& studio() const { return studio_; }
 
@@ -68,6 +74,7 @@ class SimFrameSource : public FrameSource {
 
   SimSourceOptions options_;
   sim::SimulatedStudio studio_;
+  PoseOfFrame pose_;
   std::optional<uint64_t> last_frame_;
   bool started_ = false;
 

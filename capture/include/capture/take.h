@@ -88,7 +88,10 @@ struct ScanReport {
 // Scans <dir>/frames.raw. Error only if the file cannot be opened or read.
 Expected<ScanReport> scan_frames(const std::string& take_dir);
 
-// Writes <dir>/index from `entries` atomically (index.tmp + rename).
+// fsync() of a folder: makes the renames and creations in it durable.
+Expected<void> sync_directory(const std::string& dir);
+
+// Writes <dir>/index from `entries` atomically (index.tmp + rename + folder sync).
 Expected<void> write_index(const std::string& take_dir, std::span<const IndexEntry> entries);
 // Reads <dir>/index; Error if missing or malformed (wrong magic, partial entry).
 Expected<std::vector<IndexEntry>> read_index(const std::string& take_dir);
@@ -118,7 +121,7 @@ struct TakeInfo {
 };
 
 std::string format_take_yaml(const TakeInfo& info);
-// Atomic write (take.yaml.tmp + fsync + rename). The text is padded with a trailing comment to
+// Atomic write (take.yaml.tmp + fsync + rename + folder sync). The text is padded with a trailing comment to
 // kTakeYamlReserve bytes; when the atomic write fails (a full disk), the existing take.yaml is
 // overwritten in place instead if the new text fits in it (no new blocks needed).
 inline constexpr std::size_t kTakeYamlReserve = 4096;

@@ -14,6 +14,9 @@
 //   frame; else its latest pose before `frame` (stale: the pose may be a frame off); else, when
 //   every kept pose is newer than `frame`, the oldest kept (stale); a fixed camera: its latest
 //   calibration (never stale).
+// - set_valid(index, valid): the capture service's word on the calibration (CameraState
+//   calibration_valid: false after a zoom/focus change without a lens table, or a silent
+//   tracker); an invalid camera is left out of the cut rather than cutting with a wrong model.
 
 #include <cstddef>
 #include <cstdint>
@@ -40,8 +43,11 @@ class CameraPoses {
     bool stale;  // not the pose of the frame asked for
   };
   Pose camera_for(std::size_t index, uint64_t frame) const;
+  void set_valid(std::size_t index, bool valid) { valid_[index] = valid; }
+  bool valid(std::size_t index) const { return valid_[index]; }
 
  private:
+  std::vector<bool> valid_;
   std::vector<Camera> cameras_;
   std::vector<std::deque<std::pair<uint64_t, Camera>>> tracked_;  // per camera, by frame
   std::size_t history_;

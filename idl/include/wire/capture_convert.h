@@ -49,6 +49,8 @@ struct CameraStateCore {
   std::string take;  // pending or recording take ("" = none)
   enum class Run { kStopped, kStreaming, kRecording, kError } state = Run::kStopped;
   std::string error;
+  bool calibration_valid = true;
+  capture::TimeSource time_source = capture::TimeSource::host_arrival;
 };
 void from_core(const CameraStateCore& s, wire::Owned<studio_CameraState>& out);
 

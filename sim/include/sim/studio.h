@@ -109,6 +109,9 @@ class SimulatedStudio {
   FrameTruth render_all(int64_t frame, std::vector<Image<Rgb8>>* images,
                         std::vector<Mask>* true_masks,
                         std::vector<Image<uint8_t>>* true_mattes = nullptr) const;
+  // A moving (tracked) camera: camera `index` takes `camera`'s intrinsics and pose (same size);
+  // its cached rays and background are rebuilt, nothing else. Not thread-safe with render().
+  Expected<void> set_camera(int index, const Camera& camera);
   // The empty studio as camera `camera` sees it, without noise (for difference keying).
   const Image<Rgb8>& background(int camera) const;
 
