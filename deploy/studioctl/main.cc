@@ -19,6 +19,7 @@ const char kHelp[] =
     "usage: studioctl COMMAND [options]\n"
     "\n"
     "  status [--require LIST] [--wait S]           live services (studio/service/status)\n"
+    "  status --watch S                             one line per service up / restarted / gone\n"
     "  topic list|info|hz|echo [TOPIC]              topics of the domain; samples with IDL names\n"
     "  capture start|stop [--take NAME] [--at-frame N]   frame-accurate recording on every camera\n"
     "  camera get|set CAM [FEATURE [VALUE]]        camera features, with the camera's read-back\n"
