@@ -376,13 +376,15 @@ Projector studio_projector(const Cyclorama& cyc, const Eigen::Vector3d& centre, 
   c.intrinsics.cx = 0.5 * (width - 1);
   c.intrinsics.cy = 0.5 * (height - 1);
   c.cam_from_world = look_at(centre, target, Eigen::Vector3d::UnitY());
-  // Corner rays of the image (pixel edges) meet the back wall z = -half_width.
+  // Corner rays of the image (pixel edges) meet the wall the target is on: the plane
+  // x = target.x or z = target.z, whichever coordinate is larger in magnitude.
+  const int axis = std::abs(target.x()) > std::abs(target.z()) ? 0 : 2;
   const Pinhole ph(c);
   const Eigen::Vector2d corners[4] = {
       {-0.5, height - 0.5}, {width - 0.5, height - 0.5}, {width - 0.5, -0.5}, {-0.5, -0.5}};
   for (int k = 0; k < 4; ++k) {
     const Eigen::Vector3d d = ph.ray(corners[k].x(), corners[k].y());
-    const double t = (-cyc.half_width - ph.centre.z()) / d.z();
+    const double t = (target[axis] - ph.centre[axis]) / d[axis];
     Eigen::Vector3d X = ph.centre + t * d;
     X.y() = std::clamp(X.y(), 0.0, cyc.height);
     p.screen[static_cast<std::size_t>(k)] = X;

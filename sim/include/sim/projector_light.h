@@ -130,10 +130,12 @@ struct LitCount {
 // Both of the projector's size (a programming error otherwise: throws std::invalid_argument).
 LitCount count_lit(const Mask& actor, const RunMask& blackout);
 
-// A projector placed for the simulated studio: at `centre`, looking at the middle of the back
-// wall (z = -half_width) so that its image spans `wall_width_m` of it, width x height pixels, no
-// distortion; the screen corners are where the image's corner rays meet the back wall (clipped
-// to the cloth's height). Used by tests, the demo and calibration checks.
+// A projector placed for the simulated studio: at `centre`, looking at `target` (by default the
+// middle of the back wall, z = -half_width) so that its image spans `wall_width_m` at the target's
+// distance, width x height pixels, principal point at the image centre, no distortion; the screen
+// corners are where the image's corner rays meet the wall plane through the target (x = target.x
+// or z = target.z, the larger in magnitude), clipped to the cloth's height. Used by tests, the demo
+// and calibration checks.
 Projector studio_projector(const Cyclorama& cyc, const Eigen::Vector3d& centre,
                            double wall_width_m = 6.0, int width = 1920, int height = 1080,
                            const Eigen::Vector3d& target = Eigen::Vector3d(0, 1.6, -4.5),
