@@ -5,6 +5,7 @@
 #include <random>
 
 #include "wire/sample.h"
+#include "wire/types.h"
 
 namespace studio::wire {
 namespace {
@@ -40,6 +41,26 @@ TEST(Convert, MaskCodecSizeMismatchIsAnError) {
   auto back = to_core(*s);
   ASSERT_FALSE(back.has_value());
   EXPECT_NE(back.error().message.find("cam3"), std::string::npos);
+}
+
+TEST(Convert, ProjectorMaskRoundTripsAndValidates) {
+  const RunMask m = random_mask(96, 54, 4);
+  Owned<studio_ProjectorMask> s;
+  set(s->projector_id, "proj0");
+  s->step = 2;
+  from_core(m, *s);
+  EXPECT_FALSE(validate(*s));
+  auto back = to_core(*s);
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  EXPECT_EQ(*back, m);
+  s->step = 0;
+  EXPECT_EQ(validate(*s), Reject::out_of_range);
+  s->step = 2;
+  s->height = 53;  // the run table no longer fits the header
+  EXPECT_EQ(validate(*s), Reject::bad_size);
+  auto bad = to_core(*s);
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("proj0"), std::string::npos);
 }
 
 TEST(Convert, CameraRoundTrips) {

@@ -38,6 +38,7 @@ TEST(Validate, GeneratedSamplesOfEveryTypeAreValid) {
     EXPECT_FALSE(validate(*make<studio_SceneCommand>(seed)));
     EXPECT_FALSE(validate(*make<studio_ProjectorCalibration>(seed)));
     EXPECT_FALSE(validate(*make<studio_ServiceStatus>(seed)));
+    EXPECT_FALSE(validate(*make<studio_ProjectorMask>(seed)));
   }
 }
 

@@ -20,6 +20,7 @@
 #include "calibrate/text.h"
 #include "core/rig.h"
 #include "observations_yaml.h"
+#include "projector_cli.h"
 #include "yaml_io/opencv_yaml.h"
 #include "yaml_io/rig_yaml.h"
 
@@ -55,6 +56,9 @@ One-stage calibration of every camera from synchronous views of a planar target 
   --save-observations FILE   write the detections as observations.yaml
   --quiet                no progress
 Without --origin (or an origin frame in the file) the first camera is the studio frame.
+
+       studio-calibrate projector --rig rig.yaml --captures DIR --pattern SPEC [options]
+Calibrates a projector from a projected pattern (see studio-calibrate projector --help).
 )";
 
 std::vector<std::string> split_list(const std::string& s) {
@@ -92,12 +96,13 @@ std::string without_yaml(const std::string& path) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
+  if (!args.empty() && args[0] == "projector") return run_projector(args);
   for (const auto& a : args)
     if (a == "--help" || a == "-h") {
       std::fputs(kUsage, stdout);
       return 0;
     }
-  if (args.empty()) return usage_error("missing command 'cameras'");
+  if (args.empty()) return usage_error("missing command 'cameras' or 'projector'");
   if (args[0] != "cameras") return usage_error("unknown command '" + args[0] + "'");
 
   std::string images, observations_file, target_spec, out, report, plots, opencv_dir, origin,

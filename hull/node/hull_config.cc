@@ -11,6 +11,8 @@ Expected<void> HullNodeOptions::validate() const {
   if (min_cameras < 1) return fail("min_cameras: must be >= 1");
   if (actor_prefix.empty() || actor_prefix.size() > 40)
     return fail("actor_prefix: 1..40 characters");
+  if (projector_mask_step < 1 || projector_mask_step > 64)
+    return fail("projector_mask_step: must be in 1..64");
   return {};
 }
 
@@ -45,7 +47,11 @@ runtime::ServiceDefinition hull_service_definition() {
       "    mesh: true              publish studio/actor/mesh\n"
       "    refine: true            exact crossings on the mesh (else half-cell vertices)\n"
       "    min_actor_volume: 0.01  smaller components (m^3) are noise\n"
-      "    actor_prefix: actor     actor ids <prefix>0, <prefix>1, ... largest first\n";
+      "    actor_prefix: actor     actor ids <prefix>0, <prefix>1, ... largest first\n"
+      "    projector_masks: false  publish studio/projector/mask: for every projector of the\n"
+      "                            rig, the projector pixels the actors cover (viewpoint cut,\n"
+      "                            eq. 7-8), one sample per frame and projector\n"
+      "    projector_mask_step: 2  the cut samples every step-th projector pixel (1..64)\n";
   d.create = [](yaml::MapReader& config,
                 runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto section = config.required("hull");
@@ -64,12 +70,16 @@ runtime::ServiceDefinition hull_service_definition() {
         yaml::field("refine", &HullNodeOptions::refine),
         yaml::field("min_actor_volume", &HullNodeOptions::min_actor_volume).min(0),
         yaml::field("actor_prefix", &HullNodeOptions::actor_prefix),
+        yaml::field("projector_masks", &HullNodeOptions::projector_masks),
+        yaml::field("projector_mask_step", &HullNodeOptions::projector_mask_step).range(1, 64),
     };
     auto options = schema.read(*section);
     if (!options) return std::unexpected(options.error());
     auto rig = yaml::read_rig(options->rig);
     if (!rig) return std::unexpected(rig.error());
-    return make_hull_node(*options, rig->cameras, ctx);
+    std::vector<Camera> projectors;
+    for (const Projector& p : rig->projectors) projectors.push_back(p.camera);
+    return make_hull_node(*options, rig->cameras, ctx, std::move(projectors));
   };
   return d;
 }

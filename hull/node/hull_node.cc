@@ -8,6 +8,7 @@
 #include "core/log.h"
 #include "hull/camera_poses.h"
 #include "hull/crossing_refine.h"
+#include "hull/projector_mask.h"
 #include "hull/segment_mesh.h"
 #include "hull/visibility.h"
 #include "runtime/service_loop.h"
@@ -48,11 +49,15 @@ Assembler::Options assembler_options(const HullNodeOptions& o, const std::vector
 // segments and mesh out (hull_node.h).
 class HullNode : public runtime::Node {
  public:
-  HullNode(HullNodeOptions options, std::vector<Camera> cameras, runtime::NodeContext& ctx)
+  HullNode(HullNodeOptions options, std::vector<Camera> cameras, std::vector<Camera> projectors,
+           runtime::NodeContext& ctx)
       : options_(std::move(options)),
         assembler_(assembler_options(options_, cameras)),
         poses_(std::move(cameras)),
+        projectors_(std::move(projectors)),
         loop_(ctx, kLog) {
+    if (options_.projector_masks)
+      projector_masks_ = &loop_.output<studio_ProjectorMask>({.counter = "projector_masks_out", .rate = false});
     segs_ = &loop_.output<studio_SegmentSet>({.counter = "segment_sets_out"});
     meshes_ = &loop_.output<studio_ActorMesh>({.counter = "meshes_out", .rate = false});
     // Every per-frame pose of a tracked camera, even when a cut holds this node up (the topic
@@ -160,6 +165,31 @@ class HullNode : public runtime::Node {
     published_actors_ = actors.size();
     loop_.completed(frame.frame, frame.capture_ns);
     last_partial_ = views.size() < poses_.size();
+    if (projector_masks_) publish_projector_masks(frame, views, cut);
+  }
+
+  // Every projector's actor mask by the viewpoint cut (hull/projector_mask.h).
+  void publish_projector_masks(const Assembler::Frame& frame, std::span<const View> views,
+                               const CutOptions& cut) {
+    const GridSpec g = options_.grid_spec();
+    ProjectorMaskOptions po;
+    po.step = options_.projector_mask_step;
+    po.cut = cut;
+    for (const Camera& projector : projectors_) {
+      auto mask = projector_mask(projector, Eigen::AlignedBox3d(g.box_min, g.box_max), views, po);
+      if (!mask) {
+        STUDIO_LOG(warn, kLog) << "frame " << frame.frame << ": projector " << projector.id << ": "
+                               << mask.error().message;
+        continue;
+      }
+      wire::Owned<studio_ProjectorMask> s;
+      wire::set(s->projector_id, projector.id);
+      s->frame = frame.frame;
+      s->capture_ns = frame.capture_ns;
+      s->step = uint32_t(po.step);
+      wire::from_core(*mask, *s);
+      (void)projector_masks_->write(*s);
+    }
   }
 
   void publish(const SegmentSet& set, const std::string& actor_id, const Assembler::Frame& frame,
@@ -203,6 +233,8 @@ class HullNode : public runtime::Node {
   std::atomic<bool> last_partial_{false};
   runtime::Output<studio_SegmentSet>* segs_ = nullptr;
   runtime::Output<studio_ActorMesh>* meshes_ = nullptr;
+  std::vector<Camera> projectors_;
+  runtime::Output<studio_ProjectorMask>* projector_masks_ = nullptr;
   std::vector<runtime::Counter*> frame_counts_;
   runtime::Counter* stale_ = nullptr;
   runtime::Counter* invalid_ = nullptr;
@@ -213,7 +245,8 @@ class HullNode : public runtime::Node {
 
 Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& options,
                                                         std::vector<Camera> cameras,
-                                                        runtime::NodeContext& context) {
+                                                        runtime::NodeContext& context,
+                                                        std::vector<Camera> projectors) {
   if (auto v = options.validate(); !v) return std::unexpected(v.error());
   if (cameras.empty()) return fail("rig " + options.rig + ": no cameras");
   if (std::size_t(options.min_cameras) > cameras.size())
@@ -225,7 +258,8 @@ Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& o
     STUDIO_LOG(info, kLog) << "box coverage: " << 100 * c->unseen << " % seen by no camera, "
                            << 100 * c->below_min_views << " % by fewer than " << c->min_views;
   }
-  return std::unique_ptr<runtime::Node>(new HullNode(options, std::move(cameras), context));
+  return std::unique_ptr<runtime::Node>(
+      new HullNode(options, std::move(cameras), std::move(projectors), context));
 }
 
 }  // namespace studio::hull

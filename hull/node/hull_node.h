@@ -23,6 +23,11 @@
 //                             really ends instead of half a cell
 //   min_actor_volume: 0.01    components smaller than this (m^3) are noise, not actors
 //   actor_prefix: actor       actor ids are <prefix>0, <prefix>1, ... largest first
+//   projector_masks: false    per frame, for every projector of the rig, its actor mask by the
+//                             viewpoint cut (hull/projector_mask.h, eq. 7-8) on
+//                             studio/projector/mask (keyed by projector_id, the masks' frame and
+//                             capture_ns), after the frame's segments and meshes
+//   projector_mask_step: 2    the cut samples every step-th projector pixel (1..64)
 
 #include <memory>
 #include <string>
@@ -47,6 +52,8 @@ struct HullNodeOptions {
   bool refine = true;
   double min_actor_volume = 0.01;
   std::string actor_prefix = "actor";
+  bool projector_masks = false;
+  int projector_mask_step = 2;
 
   Expected<void> validate() const;
   GridSpec grid_spec() const;
@@ -55,8 +62,10 @@ struct HullNodeOptions {
 runtime::ServiceDefinition hull_service_definition();
 
 // Builds the node (rig already read) — exposed for tests that host nodes in-process.
+// `projectors`: the rig's projectors (inverse cameras), used when options.projector_masks.
 Expected<std::unique_ptr<runtime::Node>> make_hull_node(const HullNodeOptions& options,
                                                         std::vector<Camera> cameras,
-                                                        runtime::NodeContext& context);
+                                                        runtime::NodeContext& context,
+                                                        std::vector<Camera> projectors = {});
 
 }  // namespace studio::hull

@@ -12,9 +12,11 @@
 
 #include "harness/fixture.h"
 #include "hull/crossing_refine.h"
+#include "hull/projector_mask.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
 #include "sim/cameras.h"
+#include "sim/projector_light.h"
 #include "sim/studio.h"
 #include "support/cameras.h"
 #include "wire/actor_convert.h"
@@ -332,6 +334,73 @@ TEST_F(HullNodeTest, TrackedCameraIsCutWithThePoseOfItsFrame) {
   EXPECT_EQ(hull.stop(), 0) << hull.log();
 }
 
+// projector_masks: true: per frame, every projector of the rig gets its viewpoint-cut actor mask
+// on studio/projector/mask, stamped like the segments, equal to the library's for the same masks.
+TEST_F(HullNodeTest, ProjectorMasksOut) {
+  const Projector proj = sim::studio_projector(sim::Cyclorama{}, {0.5, 2.5, 3.8});
+  Rig rig;
+  rig.cameras = cameras_;
+  rig.projectors.push_back(proj);
+  ASSERT_TRUE(yaml::write_rig(rig, (dir_ / "rig.yaml").string()).has_value());
+  auto p = wire::Participant::create().value();
+  auto mask_topic = wire::Topic<studio_AlphaMask>::create(p).value();
+  auto masks = wire::Writer<studio_AlphaMask>::create(p, mask_topic).value();
+  auto pm_topic = wire::Topic<studio_ProjectorMask>::create(p).value();
+  auto pms = wire::Reader<studio_ProjectorMask>::create(p, pm_topic).value();
+  auto& hull = spawn("hull", "hull/studio-hull",
+                     {"--config", write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 64\n"
+                                               "  deadline_ms: 300\n  projector_masks: true\n"
+                                               "  projector_mask_step: 2\n")});
+  ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
+  ASSERT_TRUE(masks.wait_for_readers(1, 10s));
+
+  // The library's mask for a frame with every camera's true mask.
+  auto local = [&](int64_t frame) {
+    std::vector<RunMask> runs(cameras_.size());
+    std::vector<View> views;
+    for (std::size_t c = 0; c < cameras_.size(); ++c) {
+      Mask truth;
+      studio_->render(int(c), frame, nullptr, &truth);
+      runs[c] = RunMask::from_mask(truth.view());
+      views.push_back({&cameras_[c], &runs[c]});
+    }
+    ProjectorMaskOptions po;
+    po.step = 2;
+    return projector_mask(proj.camera, Eigen::AlignedBox3d(Eigen::Vector3d(-1.5, 0, -1.5),
+                                                           Eigen::Vector3d(1.5, 2.2, 1.5)),
+                          views, po)
+        .value();
+  };
+  std::vector<int> all(cameras_.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+  const int64_t frame = 40, capture_ns = 1'700'000'000'000'000'000;
+  bool matched = false;
+  int received = 0;
+  for (int attempt = 0; attempt < 20 && !matched; ++attempt) {
+    publish_masks(masks, frame + attempt, capture_ns + attempt, all);
+    const auto until = std::chrono::steady_clock::now() + 2s;
+    while (std::chrono::steady_clock::now() < until && !matched) {
+      for (auto& s : pms.take()) {
+        if (!s.meta.valid_data) continue;
+        ++received;
+        EXPECT_EQ(std::string(s.data->projector_id), "proj0");
+        EXPECT_EQ(s.data->capture_ns - capture_ns, int64_t(s.data->frame) - frame);
+        EXPECT_EQ(s.data->step, 2u);
+        auto core = wire::to_core(*s.data);
+        ASSERT_TRUE(core.has_value()) << core.error().message;
+        ASSERT_EQ(core->width(), 1920);
+        ASSERT_EQ(core->height(), 1080);
+        // Only a mask made from every camera's mask (best-effort masks may be lost).
+        if (*core == local(int64_t(s.data->frame))) matched = true;
+      }
+      std::this_thread::sleep_for(20ms);
+    }
+  }
+  EXPECT_TRUE(matched) << received << " masks received, none equal to the library's\n" << hull.log();
+  EXPECT_EQ(pms.rejected().total(), 0u);
+  EXPECT_EQ(hull.stop(), 0) << hull.log();
+}
+
 TEST_F(HullNodeTest, BadConfigIsOneLine) {
   struct Case {
     std::string section, expect;
@@ -342,6 +411,7 @@ TEST_F(HullNodeTest, BadConfigIsOneLine) {
       {"  box: [0, 0, 0, 1, 1, 1]\n  colour: red\n", "colour: unknown key"},
       {"  box: [0, 0, 0, 1, 1, 1]\n  min_cameras: 9\n", "min_cameras"},
       {"  box: [0, 0, 0, 1, 1, 1]\n  refine: maybe\n", "refine"},
+      {"  box: [0, 0, 0, 1, 1, 1]\n  projector_mask_step: 0\n", "projector_mask_step"},
   };
   for (const auto& c : cases) {
     auto& p = spawn("hull", "hull/studio-hull", {"--config", write_config(c.section)});

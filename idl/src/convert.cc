@@ -96,4 +96,32 @@ Expected<bool> from_core(const Camera& c, studio_CameraCalibration& s) {
   return true;
 }
 
+Expected<RunMask> to_core(const studio_ProjectorMask& s) {
+  const auto row_start = view(s.row_start);
+  const auto runs = view(s.runs);
+  if (row_start.size() != std::size_t(s.height) + 1 || runs.size() != std::size_t(row_start.back()) * 2)
+    return fail("projector mask " + std::string(s.projector_id) + ": run table inconsistent with its height");
+  RunMask out(int(s.width), int(s.height));
+  for (uint32_t y = 0; y < s.height; ++y)
+    for (uint32_t r = row_start[y]; r < row_start[y + 1]; ++r)
+      out.push_run(int(y), int32_t(runs[2 * r]), int32_t(runs[2 * r + 1]));
+  out.finish();
+  if (!out.valid())
+    return fail("projector mask " + std::string(s.projector_id) + ": runs unsorted or outside the image");
+  return out;
+}
+
+void from_core(const RunMask& mask, studio_ProjectorMask& s) {
+  s.width = uint32_t(mask.width());
+  s.height = uint32_t(mask.height());
+  assign(s.row_start, mask.row_start());
+  std::vector<uint32_t> runs;
+  runs.reserve(mask.runs().size() * 2);
+  for (const Run& r : mask.runs()) {
+    runs.push_back(uint32_t(r.begin));
+    runs.push_back(uint32_t(r.end));
+  }
+  assign(s.runs, runs);
+}
+
 }  // namespace studio::wire

@@ -250,4 +250,26 @@ Verdict validate(const studio_ServiceStatus& s) {
   return std::nullopt;
 }
 
+Verdict validate(const studio_ProjectorMask& s) {
+  if (!id_ok(s.projector_id)) return Reject::bad_id;
+  if (!side_ok(s.width, s.height)) return Reject::bad_size;
+  if (s.step < 1 || s.step > 64) return Reject::out_of_range;
+  auto row_start = view(s.row_start);
+  auto runs = view(s.runs);
+  if (row_start.size() != uint64_t(s.height) + 1 || runs.size() % 2 != 0) return Reject::bad_size;
+  if (row_start.front() != 0 || uint64_t(row_start.back()) * 2 != runs.size())
+    return Reject::bad_size;
+  for (uint32_t y = 0; y < s.height; ++y) {
+    const uint32_t a = row_start[y], b = row_start[y + 1];
+    if (b < a) return Reject::bad_runs;
+    int64_t prev_end = -1;
+    for (uint32_t r = a; r < b; ++r) {
+      const uint32_t begin = runs[2 * r], end = runs[2 * r + 1];
+      if (begin >= end || end > s.width || int64_t(begin) <= prev_end) return Reject::bad_runs;
+      prev_end = end;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace studio::wire

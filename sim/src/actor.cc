@@ -93,16 +93,17 @@ const char* motion_name(Motion m) {
     case Motion::raise_hand: return "raise_hand";
     case Motion::crouch: return "crouch";
     case Motion::sequence: return "sequence";
+    case Motion::arm_swing: return "arm_swing";
   }
   return "?";
 }
 
 Expected<Motion> parse_motion(const std::string& name) {
   for (Motion m : {Motion::idle, Motion::walk, Motion::turn, Motion::raise_hand, Motion::crouch,
-                   Motion::sequence}) {
+                   Motion::sequence, Motion::arm_swing}) {
     if (name == motion_name(m)) return m;
   }
-  return fail(detail::cat("unknown motion '", name, "' (expected idle, walk, turn, raise_hand, crouch or sequence)"));
+  return fail(detail::cat("unknown motion '", name, "' (expected idle, walk, turn, raise_hand, crouch, sequence or arm_swing)"));
 }
 
 ActorPose blend(const ActorPose& a, const ActorPose& b, double w) {
@@ -132,6 +133,9 @@ Expected<void> Actor::Options::validate() const {
   }
   if (!(walk_speed > 0 && walk_speed <= 2.0)) {
     return fail(detail::cat("actor walk_speed ", walk_speed, " m/s outside (0, 2]"));
+  }
+  if (!(swing_peak_speed > 0 && swing_peak_speed <= 4.0)) {
+    return fail(detail::cat("actor swing_peak_speed ", swing_peak_speed, " m/s outside (0, 4]"));
   }
   return {};
 }
@@ -288,6 +292,20 @@ ActorPose Actor::motion_pose(Motion m, double t) const {
       arm.shoulder_abduct = deg(7 + 5 * a + 8 * a * std::sin(2 * kPi * 1.5 * tau));
       arm.elbow_flex = deg(10 + 10 * a);
       p.neck_flex = deg(-10 * a);
+      break;
+    }
+    case Motion::arm_swing: {
+      // Shoulder flexion f(t) = mid + amp sin(w t); the fingertip (hand ellipsoid's far end, at
+      // reach L from the shoulder with the elbow at 8 degrees) moves at |f'| L = amp w L, so
+      // w = v_peak / (amp L). The rest of the body keeps its standing pose.
+      const double amp = deg(65), mid = deg(25), elbow = deg(8);
+      const double upper = 0.29 * scale_, lower = 0.26 * scale_ + 0.16 * scale_;
+      const double reach = std::sqrt(upper * upper + lower * lower + 2 * upper * lower * std::cos(elbow));
+      const double w = options_.swing_peak_speed / (amp * reach);
+      auto& arm = p.arm[1];
+      arm.shoulder_flex = mid + amp * std::sin(w * t);
+      arm.shoulder_abduct = deg(10);
+      arm.elbow_flex = elbow;
       break;
     }
     case Motion::crouch: {

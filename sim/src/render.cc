@@ -124,6 +124,7 @@ const Gamma kGamma;
 struct Shader {
   Eigen::Vector3d key, fill;  // camera frame
   double spill, ring;
+  double exposure = 1;  // relative exposure (sim/projector_light.h)
   // Display colour of the hit on `part` along d at t, given the background colour behind it.
   std::array<float, 3> operator()(const CamPart& part, const Eigen::Vector3d& d, double t,
                                   const Rgb8& bg) const {
@@ -139,7 +140,7 @@ struct Shader {
     const float back[3] = {float(bg.r), float(bg.g), float(bg.b)};
     std::array<float, 3> out;
     for (int k = 0; k < 3; ++k) {
-      const float lin = part.albedo[k] * (light + ring_w * kRing[k]);
+      const float lin = static_cast<float>(exposure) * part.albedo[k] * (light + ring_w * kRing[k]);
       out[k] = kGamma(lin) * (1 - s) + back[k] * s;
     }
     return out;
@@ -368,7 +369,9 @@ void render_actor(const StudioOptions& options, const CameraCache& cam, const Pr
   apply_shadow(cam, frame.shadow, image);
   const int width = cam.camera.width, height = cam.camera.height;
   const std::vector<CamPart> parts = to_camera(cam, frame.truth.body, 1);
-  const Shader shader{cam.R * kKeyLight, cam.R * kFillLight, options.spill, options.ring_light};
+  const Shader shader{cam.R * kKeyLight, cam.R * kFillLight, options.spill,
+                      options.ring_light * options.projector_light.ring_level,
+                      options.projector_light.exposure};
   Rect U = union_rect(parts);
   std::vector<std::vector<CamPart>> blur;
   for (const ActorBody& b : frame.blur_bodies) {

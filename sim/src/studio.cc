@@ -13,6 +13,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "projector_light_impl.h"
 #include "studio_impl.h"
 
 #include "message.h"
@@ -47,7 +48,7 @@ Expected<void> StudioOptions::validate() const {
     return fail(detail::cat("aa_samples ", aa_samples, " outside [2, 64]"));
   }
   if (threads < 1 || threads > 64) return fail(detail::cat("threads ", threads, " outside [1, 64]"));
-  return {};
+  return projector_light.validate();
 }
 
 namespace detail {
@@ -215,6 +216,10 @@ void build_background(const StudioOptions& o, const Image<Rgb8>& projection, Cam
                                static_cast<uint8_t>(std::clamp(rgb[1] + 0.5, 0.0, 255.0)),
                                static_cast<uint8_t>(std::clamp(rgb[2] + 0.5, 0.0, 255.0))};
     }
+  }
+  const ProjectorLight& light = o.projector_light;
+  if (!light.empty() || light.ring_level != 1 || light.exposure != 1) {
+    detail::light_background(light, {hw, ht}, cam->camera, &cam->background, &cam->surface);
   }
 }
 

@@ -249,6 +249,22 @@ void fill(studio_SceneState& s, int seed) {
   set(s.last_error, seed % 2 == 0 ? "" : "set_parent: 'a' -> 'b' would make a cycle");
 }
 
+void fill(studio_ProjectorMask& s, int seed) {
+  set(s.projector_id, id("proj", seed));
+  stamp(s.frame, s.capture_ns, seed);
+  s.width = 96;
+  s.height = 54;
+  s.step = 1 + seed % 4;
+  std::vector<uint32_t> row_start{0}, runs;
+  for (uint32_t y = 0; y < s.height; ++y) {
+    if (y >= 8 && y < 50) runs.insert(runs.end(), {30u + seed % 7, 44u + y % 5});  // an actor
+    if (y >= 20 && y < 26) runs.insert(runs.end(), {60u, 70u + seed % 3});         // an arm
+    row_start.push_back(uint32_t(runs.size() / 2));
+  }
+  assign(s.row_start, row_start);
+  assign(s.runs, runs);
+}
+
 bool same(const studio_CameraCalibration& a, const studio_CameraCalibration& b) {
   return str_same(a.camera_id, b.camera_id) && a.frame == b.frame && a.capture_ns == b.capture_ns &&
          a.width == b.width && a.height == b.height && arr_same(a.K, b.K) && a.rd3 == b.rd3 &&
@@ -325,6 +341,12 @@ bool same(const studio_ServiceStatus& a, const studio_ServiceStatus& b) {
          a.capture_ns == b.capture_ns && a.state == b.state && str_same(a.host, b.host) &&
          a.pid == b.pid && a.input_hz == b.input_hz && a.output_hz == b.output_hz &&
          a.latency_ms == b.latency_ms;
+}
+
+bool same(const studio_ProjectorMask& a, const studio_ProjectorMask& b) {
+  return str_same(a.projector_id, b.projector_id) && a.frame == b.frame &&
+         a.capture_ns == b.capture_ns && a.width == b.width && a.height == b.height &&
+         a.step == b.step && seq_same(a.row_start, b.row_start) && seq_same(a.runs, b.runs);
 }
 
 bool same(const studio_SceneState& a, const studio_SceneState& b) {

@@ -29,4 +29,8 @@ Expected<Camera> to_core(const studio_CameraCalibration& sample);
 // convert the camera explicitly with to_paper_model, core/distortion_fit.h, first).
 Expected<bool> from_core(const Camera& camera, studio_CameraCalibration& sample);
 
+// ProjectorMask (the viewpoint-cut actor mask of a projector) ↔ RunMask; `step` is the caller's.
+Expected<RunMask> to_core(const studio_ProjectorMask& sample);
+void from_core(const RunMask& mask, studio_ProjectorMask& sample);
+
 }  // namespace studio::wire

@@ -119,7 +119,10 @@ struct ActorBody {
 
 // Scripted motions. `sequence` loops walk (5 s) → turn on the spot (3 s) → raise the right
 // hand (4 s) → crouch (4 s), blending joint angles over 0.4 s at each change.
-enum class Motion { idle, walk, turn, raise_hand, crouch, sequence };
+// `arm_swing` stands and swings the right arm forward and back through 130 degrees (shoulder
+// flexion -40..90) with the elbow nearly straight, timed so that the fingertips' peak speed is
+// Options::swing_peak_speed (1.5 m/s: the fast motion the projector mask is tested against).
+enum class Motion { idle, walk, turn, raise_hand, crouch, sequence, arm_swing };
 const char* motion_name(Motion m);
 Expected<Motion> parse_motion(const std::string& name);
 
@@ -151,6 +154,7 @@ class Actor {
     Motion motion = Motion::sequence;
     double walk_radius = 0.8;      // metres; the walk follows a circle around the studio centre
     double walk_speed = 0.9;       // metres per second
+    double swing_peak_speed = 1.5;  // arm_swing: peak fingertip speed, metres per second
     Expected<void> validate() const;
   };
 

@@ -38,6 +38,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "sim/actor.h"
+#include "sim/projector_light.h"
 
 namespace studio::sim {
 
@@ -69,6 +70,9 @@ struct StudioOptions {
   bool projected_image = false;  // a faint projected picture on the back wall (z = -half_width)
   double projection_strength = 0.12;
   Image<Rgb8> projection;        // the projected picture; empty = a built-in test scene
+  // Calibrated projectors showing frames on the cloth, boards in the beam, the cameras' ring
+  // level and exposure (sim/projector_light.h (c)); the default changes nothing.
+  ProjectorLight projector_light;
 
   int threads = 2;  // render_all() threads over cameras
 
