@@ -96,4 +96,75 @@ Expected<bool> from_core(const Camera& c, studio_CameraCalibration& s) {
   return true;
 }
 
+Expected<void> from_core(const Projector& p, const Eigen::Matrix3d& pixel_from_screen,
+                         studio_ProjectorCalibration& s) {
+  const Camera& c = p.camera;
+  if (c.distortion.model != Distortion::Model::none)
+    return fail("projector " + c.id + ": lens distortion cannot travel on studio/projector/calibration");
+  if (!pixel_from_screen.allFinite() || std::abs(pixel_from_screen(2, 2)) < 1e-15)
+    return fail("projector " + c.id + ": homography not finite or h[8] = 0");
+  set(s.projector_id, c.id);
+  s.width = uint32_t(c.width);
+  s.height = uint32_t(c.height);
+  const Eigen::Matrix3d K = c.intrinsics.K();
+  const Eigen::Matrix3d R = c.cam_from_world.R();
+  const Eigen::Matrix3d H = pixel_from_screen / pixel_from_screen(2, 2);
+  for (int i = 0; i < 9; ++i) {
+    s.K[i] = K(i / 3, i % 3);
+    s.R[i] = R(i / 3, i % 3);
+    s.homography[i] = H(i / 3, i % 3);
+  }
+  for (int i = 0; i < 3; ++i) s.t[i] = c.cam_from_world.translation[i];
+  for (int k = 0; k < 4; ++k)
+    for (int i = 0; i < 3; ++i) s.screen_corners[3 * k + i] = p.screen[std::size_t(k)][i];
+  return {};
+}
+
+Expected<Projector> to_core(const studio_ProjectorCalibration& s) {
+  studio_CameraCalibration c{};
+  set(c.camera_id, std::string(s.projector_id));
+  c.width = s.width;
+  c.height = s.height;
+  for (int i = 0; i < 9; ++i) {
+    c.K[i] = s.K[i];
+    c.R[i] = s.R[i];
+  }
+  for (int i = 0; i < 3; ++i) c.t[i] = s.t[i];
+  auto camera = to_core(c);
+  if (!camera) return std::unexpected(camera.error());
+  Projector p;
+  p.camera = std::move(*camera);
+  for (int k = 0; k < 4; ++k)
+    p.screen[std::size_t(k)] = Eigen::Vector3d(s.screen_corners[3 * k], s.screen_corners[3 * k + 1],
+                                               s.screen_corners[3 * k + 2]);
+  return p;
+}
+
+void from_core(const RunMask& mask, studio_ProjectorFrame& s) {
+  s.width = uint32_t(mask.width());
+  s.height = uint32_t(mask.height());
+  assign(s.mask_row_start, mask.row_start());
+  std::vector<uint32_t> runs;
+  runs.reserve(mask.runs().size() * 2);
+  for (const Run& r : mask.runs()) {
+    runs.push_back(uint32_t(r.begin));
+    runs.push_back(uint32_t(r.end));
+  }
+  assign(s.mask_runs, runs);
+}
+
+Expected<RunMask> to_core(const studio_ProjectorFrame& s) {
+  const auto row_start = view(s.mask_row_start);
+  const auto runs = view(s.mask_runs);
+  if (row_start.size() != std::size_t(s.height) + 1 || runs.size() != std::size_t(row_start.back()) * 2)
+    return fail("projector frame " + std::string(s.projector_id) + ": mask runs inconsistent with its height");
+  RunMask out(int(s.width), int(s.height));
+  for (uint32_t y = 0; y < s.height; ++y)
+    for (uint32_t r = row_start[y]; r < row_start[y + 1]; ++r)
+      out.push_run(int(y), int32_t(runs[2 * r]), int32_t(runs[2 * r + 1]));
+  out.finish();
+  if (!out.valid()) return fail("projector frame " + std::string(s.projector_id) + ": mask runs invalid");
+  return out;
+}
+
 }  // namespace studio::wire

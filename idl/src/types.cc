@@ -36,6 +36,7 @@ constexpr std::array<TopicRow, kTopicCount> kTopicTable{{
 {R(projector_calibration, ProjectorCalibration), "studio/projector/calibration", kRel, kTL,  1,  0},
 {R(service_status, ServiceStatus),               "studio/service/status",        kBE,  kVol, 1,  3},
 {R(scene_state, SceneState),                     "studio/scene/state",           kRel, kTL,  1,  0},
+{R(projector_frame, ProjectorFrame),             "studio/projector/frame",       kRel, kVol, 1,  0},
 }};
 // clang-format on
 #undef R

@@ -113,8 +113,14 @@ void fill(GpuMesh& mesh, const std::vector<float>& vertices,
 struct Uniforms {
   GLint clip_from_world, world_from_model, normal_matrix, inflate, base, textured, texture,
       emissive, unlit, eye, ambient, light_count, light_position, light_radiance, light_spot,
-      light_spot_inner, light_range;
+      light_spot_inner, light_range, clip_plane, alpha;
 };
+
+// Sets the clip plane (gl_ClipDistance[0] >= 0 is kept); none: everything is kept.
+void set_clip_plane(GLint location, const std::optional<Eigen::Vector4d>& plane) {
+  const Eigen::Vector4f p = plane ? plane->cast<float>() : Eigen::Vector4f(0, 0, 0, 1);
+  glUniform4fv(location, 1, p.data());
+}
 
 }  // namespace
 
@@ -225,7 +231,10 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
   if (!version) return fail("renderer: no current OpenGL context");
   auto impl = std::make_unique<Impl>();
   impl->options = options;
-  auto program = build_program(shaders::kSceneVertex, shaders::kSceneFragment, "scene");
+  const bool fast = options.shading == RendererOptions::Shading::fast;
+  auto program =
+      fast ? build_program(shaders::kFastVertex, shaders::kFastFragment, "scene (fast)")
+           : build_program(shaders::kSceneVertex, shaders::kSceneFragment, "scene");
   if (!program) return std::unexpected(program.error());
   impl->program = *program;
   auto quad = build_program(shaders::kQuadVertex, shaders::kQuadFragment, "texture quad");
@@ -249,7 +258,9 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
                      loc("u_light_radiance[0]"),
                      loc("u_light_spot[0]"),
                      loc("u_light_spot_inner[0]"),
-                     loc("u_light_range[0]")};
+                     loc("u_light_range[0]"),
+                     loc("u_clip_plane"),
+                     loc("u_alpha")};
   impl->quad_texture = glGetUniformLocation(impl->quad_program, "u_texture");
   impl->quad_tex_from_screen = glGetUniformLocation(impl->quad_program, "u_tex_from_screen");
   glGenVertexArrays(1, &impl->quad_vao);
@@ -354,8 +365,13 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
         order[i]->visible && (parent[i] < 0 || r.visible[static_cast<std::size_t>(parent[i])]);
 
   const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
-  const Eigen::Vector3f eye = view.cam_from_world.inverse().col(3).head<3>().cast<float>();
+  const Eigen::Vector3f eye =
+      view.eye_in_world ? view.eye_in_world->cast<float>()
+                        : Eigen::Vector3f(view.cam_from_world.inverse().col(3).head<3>().cast<float>());
   glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+  glEnable(GL_CLIP_DISTANCE0);
+  set_clip_plane(r.u.clip_plane, view.clip_plane_world);
+  glUniform1f(r.u.alpha, 1.0f);
   glUniform3fv(r.u.eye, 1, eye.data());
   glUniform3fv(r.u.ambient, 1, r.options.ambient.data());
   glUniform1f(r.u.inflate, 0.0f);
@@ -421,6 +437,7 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   }
   glBindVertexArray(0);
   glDisable(GL_CULL_FACE);
+  glDisable(GL_CLIP_DISTANCE0);
   r.culling = false;
 }
 
@@ -433,9 +450,11 @@ void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, fl
   glUseProgram(r.program);
   const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
   glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+  set_clip_plane(r.u.clip_plane, std::nullopt);
   r.set_matrices(Eigen::Matrix4d::Identity());  // actor meshes are in the studio frame
   glUniform1f(r.u.inflate, inflate_m);
   glUniform4fv(r.u.base, 1, colour.data());
+  glUniform1f(r.u.alpha, colour[3]);
   glUniform1i(r.u.unlit, 1);
   glUniform1i(r.u.textured, 0);
   r.draw_mesh(it->second);

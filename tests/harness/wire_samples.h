@@ -21,6 +21,7 @@ void fill(studio_SceneCommand& s, int seed);
 void fill(studio_ProjectorCalibration& s, int seed);
 void fill(studio_ServiceStatus& s, int seed);
 void fill(studio_SceneState& s, int seed);
+void fill(studio_ProjectorFrame& s, int seed);
 
 bool same(const studio_CameraCalibration& a, const studio_CameraCalibration& b);
 bool same(const studio_AlphaMask& a, const studio_AlphaMask& b);
@@ -36,6 +37,7 @@ bool same(const studio_SceneCommand& a, const studio_SceneCommand& b);
 bool same(const studio_ProjectorCalibration& a, const studio_ProjectorCalibration& b);
 bool same(const studio_ServiceStatus& a, const studio_ServiceStatus& b);
 bool same(const studio_SceneState& a, const studio_SceneState& b);
+bool same(const studio_ProjectorFrame& a, const studio_ProjectorFrame& b);
 
 template <wire::WireType T>
 wire::Owned<T> make(int seed) {
