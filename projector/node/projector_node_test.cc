@@ -290,3 +290,29 @@ TEST_F(ProjectorNodeTest, EyeBehindTheScreenAsDefaultIsRefusedAtStart) {
 
 }  // namespace
 }  // namespace studio::projector
+
+namespace studio::projector {
+namespace {
+
+// The example configs (projector/node/ and the example studio's, deploy/examples/studio/) start
+// as they are and publish their projector's calibration.
+TEST_F(ProjectorNodeTest, ExampleConfigsStart) {
+  for (const std::string& config : {std::string(STUDIO_SOURCE_DIR) + "/projector/node/projector.example.yaml",
+                                   std::string(STUDIO_SOURCE_DIR) + "/deploy/examples/studio/projector-proj1.yaml"}) {
+    auto& node = spawn("projector", "projector/studio-projector", {"--config", config});
+    ASSERT_TRUE(node.wait_ready(30s)) << config << "\n" << node.log();
+    auto p = wire::Participant::create().value();
+    auto topic = wire::Topic<studio_ProjectorCalibration>::create(p).value();
+    auto cal = wire::Reader<studio_ProjectorCalibration>::create(p, topic).value();
+    bool got = false;
+    for (auto until = SteadyClock::now() + 10s; !got && SteadyClock::now() < until;) {
+      for (auto& s : cal.take()) got = got || (s.meta.valid_data && std::string(s.data->projector_id) == "proj1");
+      std::this_thread::sleep_for(20ms);
+    }
+    EXPECT_TRUE(got) << config;
+    EXPECT_EQ(node.stop(), 0) << node.log();
+  }
+}
+
+}  // namespace
+}  // namespace studio::projector

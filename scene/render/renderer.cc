@@ -135,6 +135,7 @@ struct Renderer::Impl {
   GLuint program = 0, quad_program = 0, quad_vao = 0;
   Uniforms u{};
   GLint quad_texture = -1, quad_tex_from_screen = -1;
+  GLuint sampler = 0;  // fast shading: one mip level, bilinear (0: the textures' own filter)
   std::unordered_map<std::string, GpuAsset> assets;
   std::unordered_map<std::string, GpuMesh> actors;
   std::map<std::string, GLuint> override_textures;  // Material::texture paths
@@ -153,6 +154,7 @@ struct Renderer::Impl {
     if (program) glDeleteProgram(program);
     if (quad_program) glDeleteProgram(quad_program);
     if (quad_vao) glDeleteVertexArrays(1, &quad_vao);
+    if (sampler) glDeleteSamplers(1, &sampler);
   }
 
   GLuint texture_for_path(const std::string& path) {
@@ -264,6 +266,13 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
   impl->quad_texture = glGetUniformLocation(impl->quad_program, "u_texture");
   impl->quad_tex_from_screen = glGetUniformLocation(impl->quad_program, "u_tex_from_screen");
   glGenVertexArrays(1, &impl->quad_vao);
+  if (fast) {  // the nearest mip level, sampled bilinearly: half the texel reads of trilinear
+    glGenSamplers(1, &impl->sampler);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  }
   return Renderer(std::move(impl));
 }
 
@@ -377,6 +386,7 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   glUniform1f(r.u.inflate, 0.0f);
   glUniform1i(r.u.texture, 0);
   glActiveTexture(GL_TEXTURE0);
+  glBindSampler(0, r.sampler);
   r.set_lights(scene);
 
   for (std::size_t i = 0; i < order.size(); ++i) {
@@ -411,6 +421,7 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
           r.culling = cull;
         }
         glUniform4fv(r.u.base, 1, base.data());
+        if (n.material.high_contrast) emissive.setZero();  // unlit: base colour only
         glUniform3fv(r.u.emissive, 1, emissive.data());
         glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
         glUniform1i(r.u.textured, texture ? 1 : 0);
@@ -438,6 +449,7 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   glBindVertexArray(0);
   glDisable(GL_CULL_FACE);
   glDisable(GL_CLIP_DISTANCE0);
+  glBindSampler(0, 0);
   r.culling = false;
 }
 
@@ -455,6 +467,8 @@ void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, fl
   glUniform1f(r.u.inflate, inflate_m);
   glUniform4fv(r.u.base, 1, colour.data());
   glUniform1f(r.u.alpha, colour[3]);
+  const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
+  glUniform3fv(r.u.emissive, 1, zero.data());
   glUniform1i(r.u.unlit, 1);
   glUniform1i(r.u.textured, 0);
   r.draw_mesh(it->second);

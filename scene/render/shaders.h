@@ -108,19 +108,18 @@ uniform vec3 u_light_radiance[8];
 uniform vec4 u_light_spot[8];
 uniform float u_light_spot_inner[8];
 uniform float u_light_range[8];
+uniform vec3 u_ambient;
 out vec2 v_uv;
-out vec3 v_colour;
-out vec3 v_diffuse;   // sum of radiance x attenuation x n.l (multiplies the base colour)
+out vec3 v_light;     // vertex colour x (ambient + sum of radiance x attenuation x n.l)
 out vec3 v_specular;  // sum of the specular terms (added)
 void main() {
   vec4 world = u_world_from_model * vec4(a_position + u_inflate * a_normal, 1.0);
   gl_Position = u_clip_from_world * world;
   gl_ClipDistance[0] = dot(u_clip_plane, world);
   v_uv = a_uv;
-  v_colour = a_colour;
-  v_diffuse = vec3(0.0);
   v_specular = vec3(0.0);
-  if (u_unlit) return;
+  if (u_unlit) { v_light = a_colour; return; }
+  vec3 diffuse = u_ambient;
   vec3 n = normalize(u_normal_matrix * a_normal);
   vec3 v = normalize(u_eye - world.xyz);
   if (dot(n, v) < 0.0) n = -n;  // two-sided
@@ -146,31 +145,27 @@ void main() {
     float ndl = max(dot(n, l), 0.0);
     if (ndl <= 0.0) continue;
     float spec = pow(max(dot(n, normalize(l + v)), 0.0), 32.0) * 0.15;
-    v_diffuse += u_light_radiance[i] * attenuation * ndl;
+    diffuse += u_light_radiance[i] * attenuation * ndl;
     v_specular += u_light_radiance[i] * attenuation * spec;
   }
+  v_light = a_colour * diffuse;
 }
 )";
 
 inline constexpr const char* kFastFragment = R"(#version 330 core
 in vec2 v_uv;
-in vec3 v_colour;
-in vec3 v_diffuse;
+in vec3 v_light;
 in vec3 v_specular;
 out vec4 o_colour;
 uniform vec4 u_base;
 uniform bool u_textured;
 uniform sampler2D u_texture;
-uniform vec3 u_emissive;
-uniform bool u_unlit;
+uniform vec3 u_emissive;  // zero when unlit
 uniform float u_alpha;
-uniform vec3 u_ambient;
 void main() {
-  vec4 base = u_base * vec4(v_colour, 1.0);
-  if (u_textured) base *= texture(u_texture, v_uv);
-  if (u_unlit) { o_colour = vec4(base.rgb, u_alpha); return; }
-  vec3 c = base.rgb * (u_ambient + v_diffuse) + v_specular + u_emissive;
-  o_colour = vec4(clamp(c, 0.0, 1.0), u_alpha);
+  vec3 base = u_base.rgb;
+  if (u_textured) base *= texture(u_texture, v_uv).rgb;
+  o_colour = vec4(clamp(base * v_light + v_specular + u_emissive, 0.0, 1.0), u_alpha);
 }
 )";
 
