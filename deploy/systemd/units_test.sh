@@ -38,15 +38,17 @@ for f in "$prefix/bin/studioctl" "$prefix/bin/studio-capture" "$prefix/bin/studi
          "$prefix/bin/studio-hull" "$prefix/bin/studio-tracker" \
          "$unitdir/studio-capture@.service" "$unitdir/studio-keyer@.service" \
          "$unitdir/studio-hull.service" "$unitdir/studio-tracker.service" "$unitdir/studio.target" \
+         "$unitdir/studio-projector@.service" "$prefix/bin/studio-projector" \
          "$prefix/lib/sysusers.d/studio.conf" "$etc/studio/dds.xml" \
          "$prefix/share/studio/dds/studio.xml" "$prefix/share/studio/dds/loopback.xml" \
          "$prefix/share/doc/studio/examples/studio/capture-cam0.yaml" \
          "$prefix/share/doc/studio/examples/studio/hull.yaml" "$prefix/share/doc/studio/examples/studio/rig.yaml" \
          "$prefix/share/doc/studio/examples/studio/tracker.yaml" \
+         "$prefix/share/doc/studio/examples/studio/projector-proj1.yaml" \
          "$prefix/share/doc/studio/examples/studio/separate-keyer/keyer-keyer0.yaml"; do
   [ -e "$stage$f" ] || bad "not installed: $f"
 done
-for b in studioctl studio-capture studio-keyer studio-hull studio-tracker; do
+for b in studioctl studio-capture studio-keyer studio-hull studio-tracker studio-projector; do
   [ -x "$stage$prefix/bin/$b" ] || bad "$prefix/bin/$b is not executable"
 done
 "$stage$prefix/bin/studioctl" --help >/dev/null || bad "installed studioctl --help failed"
@@ -61,8 +63,8 @@ if [ "$unitdir" != /usr/lib/systemd/system ]; then
   for u in "$stage$unitdir"/studio*; do cp "$u" "$stage/usr/lib/systemd/system/"; done
 fi
 
-units="studio-capture@cam0.service studio-keyer@keyer0.service studio-hull.service studio-tracker.service studio.target"
-headless="studio-capture@cam0.service studio-keyer@keyer0.service studio-hull.service studio-tracker.service"
+units="studio-capture@cam0.service studio-keyer@keyer0.service studio-hull.service studio-tracker.service studio-projector@proj1.service studio.target"
+headless="studio-capture@cam0.service studio-keyer@keyer0.service studio-hull.service studio-tracker.service studio-projector@proj1.service"
 
 # 2. verify.
 for u in $units; do
@@ -113,7 +115,8 @@ mkdir -p "$run/var/lib/studio"
 # The complete studio's configs (deploy/examples/studio/), as an operator copies them to
 # /etc/studio/ (capture's keyer.yaml and the keyer's ../keyer.yaml are relative to each file).
 mkdir -p "$run/separate-keyer"
-for f in capture-cam0.yaml keyer.yaml tracker.yaml separate-keyer/keyer-keyer0.yaml; do
+for f in capture-cam0.yaml keyer.yaml tracker.yaml separate-keyer/keyer-keyer0.yaml \
+         projector-proj1.yaml projectors.yaml; do
   sed "s|/var/lib/studio|$run/var/lib/studio|g" "$examples/studio/$f" >"$run/$f"
 done
 export CYCLONEDDS_URI="file://$source_dir/deploy/dds/loopback.xml"
@@ -122,10 +125,11 @@ export STUDIO_DDS_TAG="units-test-$$-$RANDOM"
 "$stage$prefix/bin/studio-capture" --config "$run/capture-cam0.yaml" >"$run/capture.log" 2>&1 & pids+=($!)
 "$stage$prefix/bin/studio-tracker" --config "$run/tracker.yaml" >"$run/tracker.log" 2>&1 & pids+=($!)
 "$stage$prefix/bin/studio-keyer" --config "$run/separate-keyer/keyer-keyer0.yaml" >"$run/keyer.log" 2>&1 & pids+=($!)
+"$stage$prefix/bin/studio-projector" --config "$run/projector-proj1.yaml" >"$run/projector.log" 2>&1 & pids+=($!)
 ctl="$stage$prefix/bin/studioctl"
 ok=0
 for _ in $(seq 1 15); do
-  if "$ctl" status --require capture:cam0,tracker:tracker,keyer:keyer0 --wait 2 >"$run/status.txt" 2>"$run/status.err"; then
+  if "$ctl" status --require capture:cam0,tracker:tracker,keyer:keyer0,projector:proj1 --wait 2 >"$run/status.txt" 2>"$run/status.err"; then
     ok=1
     break
   fi
@@ -135,7 +139,7 @@ if [ $ok = 1 ]; then
   sed 's/^/       /' "$run/status.txt"
 else
   bad "the example services did not all report: $(cat "$run/status.err")"
-  for l in capture tracker keyer; do echo "---- $l"; cat "$run/$l.log"; done
+  for l in capture tracker keyer projector; do echo "---- $l"; cat "$run/$l.log"; done
 fi
 if "$ctl" status --require hull --wait 1 >/dev/null 2>&1; then
   bad "studioctl status --require hull passed without a hull running"
