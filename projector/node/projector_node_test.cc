@@ -224,8 +224,10 @@ TEST_F(ProjectorNodeTest, RendersTheSceneMasksTheActorAndReportsOverDds) {
     publish_head({0, 1.6, -4});
     for (auto& s : status.take())
       if (s.meta.valid_data && std::string(s.data->service) == "projector")
-        counted =
-            counter(*s.data, "eye_rejected") > 0 && counter(*s.data, "meshes_rejected_empty") >= 1;
+        counted = counter(*s.data, "eye_rejected") > 0 &&
+                  counter(*s.data, "meshes_rejected_empty") >= 1 &&
+                  counter(*s.data, "margin_mm") >= 10 - 1e-6 &&  // gauges: the margin in use
+                  counter(*s.data, "latency_p_ms") > 0;          // and the latency it covers
     for (auto& s : frames.take())
       if (s.meta.valid_data && s.data->render_frame > last_render) {
         last_render = s.data->render_frame;
@@ -297,8 +299,9 @@ namespace {
 // The example configs (projector/node/ and the example studio's, deploy/examples/studio/) start
 // as they are and publish their projector's calibration.
 TEST_F(ProjectorNodeTest, ExampleConfigsStart) {
-  for (const std::string& config : {std::string(STUDIO_SOURCE_DIR) + "/projector/node/projector.example.yaml",
-                                   std::string(STUDIO_SOURCE_DIR) + "/deploy/examples/studio/projector-proj1.yaml"}) {
+  for (const std::string& config :
+       {std::string(STUDIO_SOURCE_DIR) + "/projector/node/projector.example.yaml",
+        std::string(STUDIO_SOURCE_DIR) + "/deploy/examples/studio/projector-proj1.yaml"}) {
     auto& node = spawn("projector", "projector/studio-projector", {"--config", config});
     ASSERT_TRUE(node.wait_ready(30s)) << config << "\n" << node.log();
     auto p = wire::Participant::create().value();
@@ -306,7 +309,8 @@ TEST_F(ProjectorNodeTest, ExampleConfigsStart) {
     auto cal = wire::Reader<studio_ProjectorCalibration>::create(p, topic).value();
     bool got = false;
     for (auto until = SteadyClock::now() + 10s; !got && SteadyClock::now() < until;) {
-      for (auto& s : cal.take()) got = got || (s.meta.valid_data && std::string(s.data->projector_id) == "proj1");
+      for (auto& s : cal.take())
+        got = got || (s.meta.valid_data && std::string(s.data->projector_id) == "proj1");
       std::this_thread::sleep_for(20ms);
     }
     EXPECT_TRUE(got) << config;
