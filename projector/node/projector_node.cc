@@ -9,6 +9,7 @@
 
 #include "core/clock.h"
 #include "core/log.h"
+#include "projector_wire.h"
 #include "runtime/service_loop.h"
 #include "scene_mirror.h"
 #include "scene_render/egl_context.h"
@@ -21,21 +22,6 @@ namespace {
 
 constexpr const char* kLog = "projector";
 using SteadyClock = std::chrono::steady_clock;
-
-// studio/actor/mesh (validated: sizes, indices, finite) → the mask's mesh.
-ActorMesh mesh_of(const studio_ActorMesh& s) {
-  ActorMesh m;
-  auto v = wire::view(s.vertices);
-  auto t = wire::view(s.triangles);
-  m.vertices.reserve(v.size() / 3);
-  for (std::size_t i = 0; i + 2 < v.size(); i += 3)
-    m.vertices.emplace_back(v[i], v[i + 1], v[i + 2]);
-  m.triangles.reserve(t.size() / 3);
-  for (std::size_t i = 0; i + 2 < t.size(); i += 3)
-    m.triangles.push_back({t[i], t[i + 1], t[i + 2]});
-  m.capture_ns = s.capture_ns;
-  return m;
-}
 
 class ProjectorNode : public runtime::Node {
  public:
@@ -271,21 +257,9 @@ class ProjectorNode : public runtime::Node {
                const MaskPlan* plan, const Eigen::Vector3d& eye, uint64_t count, int64_t done_ns) {
     fr.read(rb);
     wire::Owned<studio_ProjectorFrame> f;
-    wire::set(f->projector_id, projector_.camera.id);
-    f->frame = plan ? plan->newest_frame : 0;
-    f->capture_ns = plan ? plan->newest_capture_ns : 0;
-    f->render_frame = count;
-    f->render_done_ns = done_ns;
-    f->latency_ms = f->capture_ns > 0 ? std::max(0.0, (done_ns - f->capture_ns) * 1e-6) : 0.0;
-    f->margin_m = plan ? plan->margin.margin_m : 0.0;
-    f->predicted = plan && plan->margin.predicted;
-    f->actors = plan ? uint32_t(plan->masks.size()) : 0;
-    for (int i = 0; i < 3; ++i) f->eye[i] = eye[i];
-    f->two_pass = options_.form == projector_render::Form::two_pass;
-    wire::from_core(rb.blackout, *f);
-    f->thumb_width = uint32_t(rb.thumb_width);
-    f->thumb_height = uint32_t(rb.thumb_height);
-    wire::assign(f->thumbnail, rb.thumbnail);
+    fill_frame({projector_.camera.id, plan, eye, options_.form == projector_render::Form::two_pass,
+                count, done_ns},
+               rb, *f);
     (void)frames_->write(*f);
   }
 
