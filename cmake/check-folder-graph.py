@@ -79,6 +79,14 @@ ALLOWED = {
     ("deploy/demo", "sim"):
         "the demo's probe (studio-demo-probe, a measuring tool, not a service) scores the live "
         "studio against the simulated studio's truth for the same frame",
+    ("projector", "scene"):
+        "the projector frame (projector/render) draws with the project's one OpenGL renderer "
+        "(scene/render, studio_scene_render: DESIGN §1, shared by projector and preview)",
+    ("projector/node", "scene"):
+        "the projector node mirrors studio/scene/node into a scene::Scene (studio_scene_wire) "
+        "and loads the assets its nodes name (scene_assets)",
+    ("projector/cli", "scene"):
+        "studio-projector render reads a scene file (scene_config) and draws it",
     ("deploy/demo", "tests"):
         "the demo's probe scores meshes with the test helpers' mask IoU and rasteriser",
 }

@@ -39,6 +39,7 @@ TEST(Validate, GeneratedSamplesOfEveryTypeAreValid) {
     EXPECT_FALSE(validate(*make<studio_ProjectorCalibration>(seed)));
     EXPECT_FALSE(validate(*make<studio_ServiceStatus>(seed)));
     EXPECT_FALSE(validate(*make<studio_ProjectorMask>(seed)));
+    EXPECT_FALSE(validate(*make<studio_ProjectorFrame>(seed)));
   }
 }
 
@@ -48,6 +49,27 @@ TEST(Validate, TableRowsValidateTheirOwnType) {
   view(mask->runs)[1] = 1000;
   EXPECT_EQ(topic_row(TopicId::camera_mask).validate(mask.get()), Reject::bad_runs);
   EXPECT_EQ(topic_table().size(), kTopicCount);
+}
+
+TEST(Validate, ProjectorFrameChecksItsMaskRunsThumbnailAndNumbers) {
+  auto f = make<studio_ProjectorFrame>(2);
+  view(f->mask_runs)[1] = f->width + 1;  // leaves the row
+  EXPECT_EQ(validate(*f), Reject::bad_runs);
+  f = make<studio_ProjectorFrame>(2);
+  f->height += 1;  // row_start no longer height + 1 entries
+  EXPECT_EQ(validate(*f), Reject::bad_size);
+  f = make<studio_ProjectorFrame>(2);
+  f->thumb_width += 1;  // thumbnail bytes != w * h * 3
+  EXPECT_EQ(validate(*f), Reject::bad_size);
+  f = make<studio_ProjectorFrame>(2);
+  f->margin_m = kNaN;
+  EXPECT_EQ(validate(*f), Reject::non_finite);
+  f = make<studio_ProjectorFrame>(2);
+  f->latency_ms = -1;
+  EXPECT_EQ(validate(*f), Reject::out_of_range);
+  f = make<studio_ProjectorFrame>(2);
+  set(f->projector_id, "");
+  EXPECT_EQ(validate(*f), Reject::bad_id);
 }
 
 TEST(Validate, CalibrationRejectsNonFiniteAndNonRotations) {

@@ -71,6 +71,7 @@ TEST_F(WireTest, EveryTopicTypeRoundTripsThroughAnotherProcess) {
   round_trip<studio_ServiceStatus>(p, 13);
   round_trip<studio_SceneState>(p, 14);
   round_trip<studio_ProjectorMask>(p, 15);
+  round_trip<studio_ProjectorFrame>(p, 16);
   EXPECT_TRUE(peer.running());
   EXPECT_EQ(peer.stop(), 0) << "peer did not exit cleanly on SIGTERM";
 }

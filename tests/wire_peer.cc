@@ -113,6 +113,7 @@ int run_echo(runtime::SignalWatcher& signals) {
   owned.push_back(echo_of<studio_ServiceStatus>(p));
   owned.push_back(echo_of<studio_SceneState>(p));
   owned.push_back(echo_of<studio_ProjectorMask>(p));
+  owned.push_back(echo_of<studio_ProjectorFrame>(p));
   std::vector<Pump*> pumps;
   for (auto& e : owned) pumps.push_back(e.get());
   return serve(p, pumps, signals);

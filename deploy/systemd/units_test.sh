@@ -38,6 +38,7 @@ for f in "$prefix/bin/studioctl" "$prefix/bin/studio-capture" "$prefix/bin/studi
          "$prefix/bin/studio-hull" "$prefix/bin/studio-tracker" "$prefix/bin/studio-scene" \
          "$unitdir/studio-capture@.service" "$unitdir/studio-scene.service" "$unitdir/studio-keyer@.service" \
          "$unitdir/studio-hull.service" "$unitdir/studio-tracker.service" "$unitdir/studio.target" \
+         "$unitdir/studio-projector@.service" "$prefix/bin/studio-projector" \
          "$prefix/lib/sysusers.d/studio.conf" "$etc/studio/dds.xml" \
          "$prefix/share/studio/dds/studio.xml" "$prefix/share/studio/dds/loopback.xml" \
          "$prefix/share/studio/dds/unicast.xml" "$prefix/share/doc/studio/README.md" \
@@ -46,10 +47,11 @@ for f in "$prefix/bin/studioctl" "$prefix/bin/studio-capture" "$prefix/bin/studi
          "$prefix/share/doc/studio/examples/studio/tracker.yaml" \
          "$prefix/share/doc/studio/examples/studio/scene.yaml" \
          "$prefix/share/studio/scene/scene.yaml" "$prefix/share/studio/scene/museum.glb" \
+         "$prefix/share/doc/studio/examples/studio/projector-proj1.yaml" \
          "$prefix/share/doc/studio/examples/studio/separate-keyer/keyer-keyer0.yaml"; do
   [ -e "$stage$f" ] || bad "not installed: $f"
 done
-for b in studioctl studio-capture studio-keyer studio-hull studio-tracker studio-scene; do
+for b in studioctl studio-capture studio-keyer studio-hull studio-tracker studio-scene studio-projector; do
   [ -x "$stage$prefix/bin/$b" ] || bad "$prefix/bin/$b is not executable"
 done
 "$stage$prefix/bin/studioctl" --help >/dev/null || bad "installed studioctl --help failed"
@@ -64,8 +66,8 @@ if [ "$unitdir" != /usr/lib/systemd/system ]; then
   for u in "$stage$unitdir"/studio*; do cp "$u" "$stage/usr/lib/systemd/system/"; done
 fi
 
-units="studio-capture@cam0.service studio-keyer@keyer0.service studio-hull.service studio-tracker.service studio-scene.service studio.target"
-headless="studio-capture@cam0.service studio-keyer@keyer0.service studio-hull.service studio-tracker.service studio-scene.service"
+units="studio-capture@cam0.service studio-keyer@keyer0.service studio-hull.service studio-tracker.service studio-scene.service studio-projector@proj1.service studio.target"
+headless="studio-capture@cam0.service studio-keyer@keyer0.service studio-hull.service studio-tracker.service studio-scene.service studio-projector@proj1.service"
 
 # 2. verify.
 for u in $units; do
@@ -116,7 +118,8 @@ mkdir -p "$run/var/lib/studio"
 # The complete studio's configs (deploy/examples/studio/), as an operator copies them to
 # /etc/studio/ (capture's keyer.yaml and the keyer's ../keyer.yaml are relative to each file).
 mkdir -p "$run/separate-keyer"
-for f in capture-cam0.yaml keyer.yaml tracker.yaml scene.yaml separate-keyer/keyer-keyer0.yaml; do
+for f in capture-cam0.yaml keyer.yaml tracker.yaml scene.yaml separate-keyer/keyer-keyer0.yaml \
+         projector-proj1.yaml projectors.yaml; do
   sed -e "s|/var/lib/studio|$run/var/lib/studio|g" -e "s|/usr/share/studio|$stage$prefix/share/studio|g" \
     "$examples/studio/$f" >"$run/$f"
 done
@@ -127,10 +130,11 @@ export STUDIO_DDS_TAG="units-test-$$-$RANDOM"
 "$stage$prefix/bin/studio-tracker" --config "$run/tracker.yaml" >"$run/tracker.log" 2>&1 & pids+=($!)
 "$stage$prefix/bin/studio-keyer" --config "$run/separate-keyer/keyer-keyer0.yaml" >"$run/keyer.log" 2>&1 & pids+=($!)
 "$stage$prefix/bin/studio-scene" --config "$run/scene.yaml" >"$run/scene.log" 2>&1 & pids+=($!)
+"$stage$prefix/bin/studio-projector" --config "$run/projector-proj1.yaml" >"$run/projector.log" 2>&1 & pids+=($!)
 ctl="$stage$prefix/bin/studioctl"
 ok=0
 for _ in $(seq 1 15); do
-  if "$ctl" status --require capture:cam0,tracker:tracker,keyer:keyer0,scene:scene --wait 2 >"$run/status.txt" 2>"$run/status.err"; then
+  if "$ctl" status --require capture:cam0,tracker:tracker,keyer:keyer0,scene:scene,projector:proj1 --wait 2 >"$run/status.txt" 2>"$run/status.err"; then
     ok=1
     break
   fi
@@ -140,7 +144,7 @@ if [ $ok = 1 ]; then
   sed 's/^/       /' "$run/status.txt"
 else
   bad "the example services did not all report: $(cat "$run/status.err")"
-  for l in capture tracker keyer scene; do echo "---- $l"; cat "$run/$l.log"; done
+  for l in capture tracker keyer scene projector; do echo "---- $l"; cat "$run/$l.log"; done
 fi
 if "$ctl" status --require hull --wait 1 >/dev/null 2>&1; then
   bad "studioctl status --require hull passed without a hull running"

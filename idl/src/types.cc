@@ -37,6 +37,7 @@ constexpr std::array<TopicRow, kTopicCount> kTopicTable{{
 {R(service_status, ServiceStatus),               "studio/service/status",        kBE,  kVol, 1,  3},
 {R(scene_state, SceneState),                     "studio/scene/state",           kRel, kTL,  1,  0},
 {R(projector_mask, ProjectorMask),               "studio/projector/mask",        kBE,  kVol, 1,  0},
+{R(projector_frame, ProjectorFrame),             "studio/projector/frame",       kRel, kVol, 1,  0},
 }};
 // clang-format on
 #undef R

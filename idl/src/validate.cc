@@ -69,28 +69,32 @@ Verdict check_R(const double (&R)[9]) {
   return std::nullopt;
 }
 
-Verdict check_mask_runs(const studio_AlphaMask& s) {
-  auto row_start = view(s.row_start);
-  auto runs = view(s.runs);
-  if (!view(s.data).empty()) return Reject::bad_size;
-  if (row_start.size() != uint64_t(s.height) + 1 || runs.size() % 2 != 0) return Reject::bad_size;
+// Runs of a w x h mask in MASK_RUNS form (AlphaMask, ProjectorFrame's blackout mask).
+Verdict check_runs(std::span<const uint32_t> row_start, std::span<const uint32_t> runs,
+                   uint32_t width, uint32_t height) {
+  if (row_start.size() != uint64_t(height) + 1 || runs.size() % 2 != 0) return Reject::bad_size;
   if (row_start.front() != 0 || uint64_t(row_start.back()) * 2 != runs.size())
     return Reject::bad_size;
   uint64_t area = 0;
-  for (uint32_t y = 0; y < s.height; ++y) {
+  for (uint32_t y = 0; y < height; ++y) {
     const uint32_t a = row_start[y], b = row_start[y + 1];
     if (b < a) return Reject::bad_runs;
     int64_t prev_end = -1;
     for (uint32_t r = a; r < b; ++r) {
       const uint32_t begin = runs[2 * r], end = runs[2 * r + 1];
       // RunMask invariant: begin < end <= width, runs sorted and not touching.
-      if (begin >= end || end > s.width || int64_t(begin) <= prev_end) return Reject::bad_runs;
+      if (begin >= end || end > width || int64_t(begin) <= prev_end) return Reject::bad_runs;
       prev_end = end;
       area += end - begin;
     }
   }
-  if (area > uint64_t(s.width) * s.height) return Reject::bad_runs;  // implied; kept explicit
+  if (area > uint64_t(width) * height) return Reject::bad_runs;  // implied; kept explicit
   return std::nullopt;
+}
+
+Verdict check_mask_runs(const studio_AlphaMask& s) {
+  if (!view(s.data).empty()) return Reject::bad_size;
+  return check_runs(view(s.row_start), view(s.runs), s.width, s.height);
 }
 
 Verdict check_mask_codec(const studio_AlphaMask& s) {
@@ -254,22 +258,7 @@ Verdict validate(const studio_ProjectorMask& s) {
   if (!id_ok(s.projector_id)) return Reject::bad_id;
   if (!side_ok(s.width, s.height)) return Reject::bad_size;
   if (s.step < 1 || s.step > 64) return Reject::out_of_range;
-  auto row_start = view(s.row_start);
-  auto runs = view(s.runs);
-  if (row_start.size() != uint64_t(s.height) + 1 || runs.size() % 2 != 0) return Reject::bad_size;
-  if (row_start.front() != 0 || uint64_t(row_start.back()) * 2 != runs.size())
-    return Reject::bad_size;
-  for (uint32_t y = 0; y < s.height; ++y) {
-    const uint32_t a = row_start[y], b = row_start[y + 1];
-    if (b < a) return Reject::bad_runs;
-    int64_t prev_end = -1;
-    for (uint32_t r = a; r < b; ++r) {
-      const uint32_t begin = runs[2 * r], end = runs[2 * r + 1];
-      if (begin >= end || end > s.width || int64_t(begin) <= prev_end) return Reject::bad_runs;
-      prev_end = end;
-    }
-  }
-  return std::nullopt;
+  return check_runs(view(s.row_start), view(s.runs), s.width, s.height);
 }
 
 }  // namespace studio::wire

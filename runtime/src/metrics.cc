@@ -31,6 +31,14 @@ Counter& Metrics::counter(const std::string& name) {
   return entries_.back().counter;
 }
 
+Gauge& Metrics::gauge(const std::string& name) {
+  std::lock_guard lock(mutex_);
+  for (auto& [n, g] : gauges_)
+    if (n == name) return g;
+  gauges_.emplace_back(std::piecewise_construct, std::forward_as_tuple(name), std::forward_as_tuple());
+  return gauges_.back().second;
+}
+
 MetricsSnapshot Metrics::snapshot(std::chrono::steady_clock::time_point now) {
   std::lock_guard lock(mutex_);
   MetricsSnapshot out;
@@ -42,6 +50,7 @@ MetricsSnapshot Metrics::snapshot(std::chrono::steady_clock::time_point now) {
     out.rates.push_back({e.name, seconds > 0 ? double(v - e.last_value) / seconds : 0.0});
     e.last_value = v;
   }
+  for (const auto& [n, g] : gauges_) out.counters.push_back({n, g.value()});
   const LatencyMeter::Stats l = latency_.take();
   out.latency_mean_ms = l.mean_ms;
   out.latency_max_ms = l.max_ms;

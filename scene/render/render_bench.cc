@@ -1,5 +1,6 @@
 // Renderer frame time on Mesa llvmpipe (EGL surfaceless) with the default demo scene at 1280x720
-// and 1920x1080, against baselines in the same run: clear only, and clear + read-back.
+// and 1920x1080, against baselines in the same run: clear only, clear + read-back, and the
+// reference shading (Blinn-Phong per fragment) beside the fast one (per vertex, the default).
 #include <benchmark/benchmark.h>
 
 #include <numbers>
@@ -22,6 +23,7 @@ struct Fixture {
   scene_assets::AssetCache cache;
   scene::Scene scene;
   Renderer renderer;
+  Renderer reference;
   scene_assets::ViewSpec view;
 };
 
@@ -34,10 +36,19 @@ Fixture& fixture() {
     scene_assets::AssetCache cache;
     auto s = scene_assets::build_scene(*d, cache);
     if (!s) throw std::runtime_error(s.error().message);
-    auto r = Renderer::create();
+    RendererOptions ro;
+    ro.shading = RendererOptions::Shading::fast;
+    auto r = Renderer::create(ro);
     if (!r) throw std::runtime_error(r.error().message);
-    for (const auto& [p, a] : cache.all()) (void)r->upload(*a);
-    return new Fixture{std::move(*ctx), std::move(cache), std::move(*s), std::move(*r), *d->view};
+    ro.shading = RendererOptions::Shading::reference;
+    auto ref = Renderer::create(ro);
+    if (!ref) throw std::runtime_error(ref.error().message);
+    for (const auto& [p, a] : cache.all()) {
+      (void)r->upload(*a);
+      (void)ref->upload(*a);
+    }
+    return new Fixture{std::move(*ctx), std::move(cache), std::move(*s), std::move(*r),
+                       std::move(*ref), *d->view};
   }();
   return *f;
 }
@@ -50,7 +61,7 @@ View view_for(const scene_assets::ViewSpec& v, int w, int h) {
   return out;
 }
 
-enum class Work { clear, clear_readback, draw, draw_readback };
+enum class Work { clear, clear_readback, draw, draw_readback, draw_reference };
 
 void run(benchmark::State& state, Work work) {
   Fixture& f = fixture();
@@ -65,9 +76,9 @@ void run(benchmark::State& state, Work work) {
   std::int64_t frame = 0;
   for (auto _ : state) {
     target->bind();
-    if (work == Work::draw || work == Work::draw_readback) {
+    if (work == Work::draw || work == Work::draw_readback || work == Work::draw_reference) {
       (void)f.scene.apply({frame++, scene::Tick{}});  // the flyer moves every frame
-      f.renderer.draw(f.scene, view);
+      (work == Work::draw_reference ? f.reference : f.renderer).draw(f.scene, view);
     } else {
       glClearColor(0, 0, 0, 1);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -86,12 +97,14 @@ void BM_Clear(benchmark::State& s) { run(s, Work::clear); }
 void BM_ClearReadback(benchmark::State& s) { run(s, Work::clear_readback); }
 void BM_DrawScene(benchmark::State& s) { run(s, Work::draw); }
 void BM_DrawSceneReadback(benchmark::State& s) { run(s, Work::draw_readback); }
+void BM_DrawSceneReference(benchmark::State& s) { run(s, Work::draw_reference); }
 
 #define SIZES ->Args({1280, 720})->Args({1920, 1080})->Unit(benchmark::kMillisecond)->UseRealTime()
 BENCHMARK(BM_Clear) SIZES;
 BENCHMARK(BM_ClearReadback) SIZES;
 BENCHMARK(BM_DrawScene) SIZES;
 BENCHMARK(BM_DrawSceneReadback) SIZES;
+BENCHMARK(BM_DrawSceneReference) SIZES;
 
 }  // namespace
 

@@ -113,8 +113,14 @@ void fill(GpuMesh& mesh, const std::vector<float>& vertices,
 struct Uniforms {
   GLint clip_from_world, world_from_model, normal_matrix, inflate, base, textured, texture,
       emissive, unlit, eye, ambient, light_count, light_position, light_radiance, light_spot,
-      light_spot_inner, light_range;
+      light_spot_inner, light_range, clip_plane, alpha;
 };
+
+// Sets the clip plane (gl_ClipDistance[0] >= 0 is kept); none: everything is kept.
+void set_clip_plane(GLint location, const std::optional<Eigen::Vector4d>& plane) {
+  const Eigen::Vector4f p = plane ? plane->cast<float>() : Eigen::Vector4f(0, 0, 0, 1);
+  glUniform4fv(location, 1, p.data());
+}
 
 }  // namespace
 
@@ -129,6 +135,7 @@ struct Renderer::Impl {
   GLuint program = 0, quad_program = 0, quad_vao = 0;
   Uniforms u{};
   GLint quad_texture = -1, quad_tex_from_screen = -1;
+  GLuint sampler = 0;  // fast shading: one mip level, bilinear (0: the textures' own filter)
   std::unordered_map<std::string, GpuAsset> assets;
   std::unordered_map<std::string, GpuMesh> actors;
   std::map<std::string, GLuint> override_textures;  // Material::texture paths
@@ -147,6 +154,7 @@ struct Renderer::Impl {
     if (program) glDeleteProgram(program);
     if (quad_program) glDeleteProgram(quad_program);
     if (quad_vao) glDeleteVertexArrays(1, &quad_vao);
+    if (sampler) glDeleteSamplers(1, &sampler);
   }
 
   GLuint texture_for_path(const std::string& path) {
@@ -225,7 +233,10 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
   if (!version) return fail("renderer: no current OpenGL context");
   auto impl = std::make_unique<Impl>();
   impl->options = options;
-  auto program = build_program(shaders::kSceneVertex, shaders::kSceneFragment, "scene");
+  const bool fast = options.shading == RendererOptions::Shading::fast;
+  auto program =
+      fast ? build_program(shaders::kFastVertex, shaders::kFastFragment, "scene (fast)")
+           : build_program(shaders::kSceneVertex, shaders::kSceneFragment, "scene");
   if (!program) return std::unexpected(program.error());
   impl->program = *program;
   auto quad = build_program(shaders::kQuadVertex, shaders::kQuadFragment, "texture quad");
@@ -249,10 +260,19 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
                      loc("u_light_radiance[0]"),
                      loc("u_light_spot[0]"),
                      loc("u_light_spot_inner[0]"),
-                     loc("u_light_range[0]")};
+                     loc("u_light_range[0]"),
+                     loc("u_clip_plane"),
+                     loc("u_alpha")};
   impl->quad_texture = glGetUniformLocation(impl->quad_program, "u_texture");
   impl->quad_tex_from_screen = glGetUniformLocation(impl->quad_program, "u_tex_from_screen");
   glGenVertexArrays(1, &impl->quad_vao);
+  if (fast) {  // the nearest mip level, sampled bilinearly: half the texel reads of trilinear
+    glGenSamplers(1, &impl->sampler);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  }
   return Renderer(std::move(impl));
 }
 
@@ -354,13 +374,19 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
         order[i]->visible && (parent[i] < 0 || r.visible[static_cast<std::size_t>(parent[i])]);
 
   const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
-  const Eigen::Vector3f eye = view.cam_from_world.inverse().col(3).head<3>().cast<float>();
+  const Eigen::Vector3f eye =
+      view.eye_in_world ? view.eye_in_world->cast<float>()
+                        : Eigen::Vector3f(view.cam_from_world.inverse().col(3).head<3>().cast<float>());
   glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+  glEnable(GL_CLIP_DISTANCE0);
+  set_clip_plane(r.u.clip_plane, view.clip_plane_world);
+  glUniform1f(r.u.alpha, 1.0f);
   glUniform3fv(r.u.eye, 1, eye.data());
   glUniform3fv(r.u.ambient, 1, r.options.ambient.data());
   glUniform1f(r.u.inflate, 0.0f);
   glUniform1i(r.u.texture, 0);
   glActiveTexture(GL_TEXTURE0);
+  glBindSampler(0, r.sampler);
   r.set_lights(scene);
 
   for (std::size_t i = 0; i < order.size(); ++i) {
@@ -395,6 +421,7 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
           r.culling = cull;
         }
         glUniform4fv(r.u.base, 1, base.data());
+        if (n.material.high_contrast) emissive.setZero();  // unlit: base colour only
         glUniform3fv(r.u.emissive, 1, emissive.data());
         glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
         glUniform1i(r.u.textured, texture ? 1 : 0);
@@ -421,6 +448,8 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   }
   glBindVertexArray(0);
   glDisable(GL_CULL_FACE);
+  glDisable(GL_CLIP_DISTANCE0);
+  glBindSampler(0, 0);
   r.culling = false;
 }
 
@@ -433,9 +462,13 @@ void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, fl
   glUseProgram(r.program);
   const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
   glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+  set_clip_plane(r.u.clip_plane, std::nullopt);
   r.set_matrices(Eigen::Matrix4d::Identity());  // actor meshes are in the studio frame
   glUniform1f(r.u.inflate, inflate_m);
   glUniform4fv(r.u.base, 1, colour.data());
+  glUniform1f(r.u.alpha, colour[3]);
+  const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
+  glUniform3fv(r.u.emissive, 1, zero.data());
   glUniform1i(r.u.unlit, 1);
   glUniform1i(r.u.textured, 0);
   r.draw_mesh(it->second);

@@ -13,6 +13,7 @@ uniform mat4 u_clip_from_world;
 uniform mat4 u_world_from_model;
 uniform mat3 u_normal_matrix;
 uniform float u_inflate;
+uniform vec4 u_clip_plane;
 out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv;
@@ -24,6 +25,7 @@ void main() {
   v_uv = a_uv;
   v_colour = a_colour;
   gl_Position = u_clip_from_world * world;
+  gl_ClipDistance[0] = dot(u_clip_plane, world);
 }
 )";
 
@@ -38,6 +40,7 @@ uniform bool u_textured;
 uniform sampler2D u_texture;
 uniform vec3 u_emissive;
 uniform bool u_unlit;
+uniform float u_alpha;              // alpha written (1; the actor mask pass writes its colour's)
 uniform vec3 u_eye;
 uniform vec3 u_ambient;
 uniform int u_light_count;
@@ -49,7 +52,7 @@ uniform float u_light_range[8];
 void main() {
   vec4 base = u_base * vec4(v_colour, 1.0);
   if (u_textured) base *= texture(u_texture, v_uv);
-  if (u_unlit) { o_colour = vec4(base.rgb, 1.0); return; }
+  if (u_unlit) { o_colour = vec4(base.rgb, u_alpha); return; }
   vec3 n = normalize(v_normal);
   vec3 v = normalize(u_eye - v_world);
   if (dot(n, v) < 0.0) n = -n;  // two-sided
@@ -78,7 +81,91 @@ void main() {
     float spec = pow(max(dot(n, normalize(l + v)), 0.0), 32.0) * 0.15;
     c += u_light_radiance[i] * attenuation * (base.rgb * ndl + vec3(spec));
   }
-  o_colour = vec4(clamp(c, 0.0, 1.0), 1.0);
+  o_colour = vec4(clamp(c, 0.0, 1.0), u_alpha);
+}
+)";
+
+// Fast lit pass (RendererOptions::Shading::fast): the same lights and Blinn-Phong terms evaluated
+// per vertex (Gouraud), so the fragment stage is texture x interpolated light: what keeps a
+// 1080p frame affordable on a software rasteriser. Close to the reference where meshes are
+// tessellated finer than the light varies (the museum's floor and walls are grids of 0.5-1 m
+// cells under lights 4 m up); a specular highlight smaller than a triangle is smoothed out.
+inline constexpr const char* kFastVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+layout(location = 3) in vec3 a_colour;
+uniform mat4 u_clip_from_world;
+uniform mat4 u_world_from_model;
+uniform mat3 u_normal_matrix;
+uniform float u_inflate;
+uniform vec4 u_clip_plane;
+uniform bool u_unlit;
+uniform vec3 u_eye;
+uniform int u_light_count;
+uniform vec4 u_light_position[8];
+uniform vec3 u_light_radiance[8];
+uniform vec4 u_light_spot[8];
+uniform float u_light_spot_inner[8];
+uniform float u_light_range[8];
+uniform vec3 u_ambient;
+out vec2 v_uv;
+out vec3 v_light;     // vertex colour x (ambient + sum of radiance x attenuation x n.l)
+out vec3 v_specular;  // sum of the specular terms (added)
+void main() {
+  vec4 world = u_world_from_model * vec4(a_position + u_inflate * a_normal, 1.0);
+  gl_Position = u_clip_from_world * world;
+  gl_ClipDistance[0] = dot(u_clip_plane, world);
+  v_uv = a_uv;
+  v_specular = vec3(0.0);
+  if (u_unlit) { v_light = a_colour; return; }
+  vec3 diffuse = u_ambient;
+  vec3 n = normalize(u_normal_matrix * a_normal);
+  vec3 v = normalize(u_eye - world.xyz);
+  if (dot(n, v) < 0.0) n = -n;  // two-sided
+  for (int i = 0; i < u_light_count; ++i) {
+    vec3 l;
+    float attenuation = 1.0;
+    if (u_light_position[i].w == 0.0) {
+      l = u_light_position[i].xyz;
+    } else {
+      vec3 d = u_light_position[i].xyz - world.xyz;
+      float d2 = max(dot(d, d), 1e-4);
+      l = d * inversesqrt(d2);
+      attenuation = 1.0 / max(d2, 1.0);
+      if (u_light_range[i] > 0.0) {
+        float r = sqrt(d2) / u_light_range[i];
+        attenuation *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
+      }
+      if (u_light_spot[i].w >= -1.0) {
+        float cd = dot(-l, u_light_spot[i].xyz);
+        attenuation *= smoothstep(u_light_spot[i].w, u_light_spot_inner[i], cd);
+      }
+    }
+    float ndl = max(dot(n, l), 0.0);
+    if (ndl <= 0.0) continue;
+    float spec = pow(max(dot(n, normalize(l + v)), 0.0), 32.0) * 0.15;
+    diffuse += u_light_radiance[i] * attenuation * ndl;
+    v_specular += u_light_radiance[i] * attenuation * spec;
+  }
+  v_light = a_colour * diffuse;
+}
+)";
+
+inline constexpr const char* kFastFragment = R"(#version 330 core
+in vec2 v_uv;
+in vec3 v_light;
+in vec3 v_specular;
+out vec4 o_colour;
+uniform vec4 u_base;
+uniform bool u_textured;
+uniform sampler2D u_texture;
+uniform vec3 u_emissive;  // zero when unlit
+uniform float u_alpha;
+void main() {
+  vec3 base = u_base.rgb;
+  if (u_textured) base *= texture(u_texture, v_uv).rgb;
+  o_colour = vec4(clamp(base * v_light + v_specular + u_emissive, 0.0, 1.0), u_alpha);
 }
 )";
 

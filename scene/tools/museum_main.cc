@@ -99,7 +99,10 @@ int main(int argc, char** argv) {
     return add_model(w, root, name, mesh, material, at);
   };
   model("floor", grid({x0, 0, z1}, (x1 - x0) * X, (z0 - z1) * Z, 48, 56, 4.0f), m_floor, {0, 0, 0});
-  model("ceiling", grid({x0, h, z0}, (x1 - x0) * X, (z1 - z0) * Z, 12, 14, 4.0f), m_ceiling,
+  // 0.5 m cells like the floor: the lights hang 1.7 m below the ceiling, so its light changes
+  // within a metre, and a renderer that lights per vertex (scene_render's fast shading) needs
+  // the vertices to follow it.
+  model("ceiling", grid({x0, h, z0}, (x1 - x0) * X, (z1 - z0) * Z, 48, 56, 4.0f), m_ceiling,
         {0, 0, 0});
   MeshBuild walls;
   walls.append(grid({x0, 0, z0}, (x1 - x0) * X, h * Y, 24, 6, 3.0f));  // back, facing +z

@@ -359,4 +359,44 @@ bool same(const studio_SceneState& a, const studio_SceneState& b) {
          a.last_accepted == b.last_accepted && str_same(a.last_error, b.last_error);
 }
 
+void fill(studio_ProjectorFrame& s, int seed) {
+  set(s.projector_id, id("proj", seed));
+  stamp(s.frame, s.capture_ns, seed);
+  s.render_frame = 7 + uint64_t(seed);
+  s.render_done_ns = s.capture_ns + 31'000'000;
+  s.latency_ms = 31.0;
+  s.margin_m = 0.02 + 0.001 * seed;
+  s.predicted = seed % 2;
+  s.actors = 1 + uint32_t(seed % 2);
+  s.eye[0] = 0.1 * seed;
+  s.eye[1] = 1.7;
+  s.eye[2] = 1.0;
+  s.two_pass = seed % 3 == 0;
+  s.width = 96;
+  s.height = 54;
+  std::vector<uint32_t> row_start{0}, runs;
+  for (uint32_t y = 0; y < s.height; ++y) {
+    if (y >= 8 && y < 50) runs.insert(runs.end(), {40u + seed % 5, 52u + y % 5});
+    row_start.push_back(uint32_t(runs.size() / 2));
+  }
+  assign(s.mask_row_start, row_start);
+  assign(s.mask_runs, runs);
+  s.thumb_width = 16;
+  s.thumb_height = 9;
+  std::vector<uint8_t> rgb(16 * 9 * 3);
+  for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = uint8_t(i * 7 + seed);
+  assign(s.thumbnail, rgb);
+}
+
+bool same(const studio_ProjectorFrame& a, const studio_ProjectorFrame& b) {
+  return str_same(a.projector_id, b.projector_id) && a.frame == b.frame &&
+         a.capture_ns == b.capture_ns && a.render_frame == b.render_frame &&
+         a.render_done_ns == b.render_done_ns && a.latency_ms == b.latency_ms &&
+         a.margin_m == b.margin_m && a.predicted == b.predicted && a.actors == b.actors &&
+         arr_same(a.eye, b.eye) && a.two_pass == b.two_pass && a.width == b.width &&
+         a.height == b.height && seq_same(a.mask_row_start, b.mask_row_start) &&
+         seq_same(a.mask_runs, b.mask_runs) && a.thumb_width == b.thumb_width &&
+         a.thumb_height == b.thumb_height && seq_same(a.thumbnail, b.thumbnail);
+}
+
 }  // namespace studio::testing

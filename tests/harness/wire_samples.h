@@ -22,6 +22,7 @@ void fill(studio_ProjectorCalibration& s, int seed);
 void fill(studio_ServiceStatus& s, int seed);
 void fill(studio_SceneState& s, int seed);
 void fill(studio_ProjectorMask& s, int seed);
+void fill(studio_ProjectorFrame& s, int seed);
 
 bool same(const studio_CameraCalibration& a, const studio_CameraCalibration& b);
 bool same(const studio_AlphaMask& a, const studio_AlphaMask& b);
@@ -38,6 +39,7 @@ bool same(const studio_ProjectorCalibration& a, const studio_ProjectorCalibratio
 bool same(const studio_ServiceStatus& a, const studio_ServiceStatus& b);
 bool same(const studio_SceneState& a, const studio_SceneState& b);
 bool same(const studio_ProjectorMask& a, const studio_ProjectorMask& b);
+bool same(const studio_ProjectorFrame& a, const studio_ProjectorFrame& b);
 
 template <wire::WireType T>
 wire::Owned<T> make(int seed) {

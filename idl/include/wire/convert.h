@@ -12,6 +12,7 @@
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/mask_codec.h"
+#include "core/rig.h"
 #include "core/run_mask.h"
 #include "studio.h"
 
@@ -32,5 +33,17 @@ Expected<bool> from_core(const Camera& camera, studio_CameraCalibration& sample)
 // ProjectorMask (the viewpoint-cut actor mask of a projector) ↔ RunMask; `step` is the caller's.
 Expected<RunMask> to_core(const studio_ProjectorMask& sample);
 void from_core(const RunMask& mask, studio_ProjectorMask& sample);
+// Projector (K, pose, size, screen corners) + its screen->pixel homography (row-major, scaled
+// so h[8] = 1) → ProjectorCalibration (projector_id = camera id). Fails for a projector with
+// lens distortion (the topic has no distortion fields) or a homography with h[8] = 0.
+Expected<void> from_core(const Projector& projector, const Eigen::Matrix3d& pixel_from_screen,
+                         studio_ProjectorCalibration& sample);
+// ProjectorCalibration → Projector (no distortion).
+Expected<Projector> to_core(const studio_ProjectorCalibration& sample);
+
+// studio/projector/frame's blackout mask: RunMask → width, height, mask_row_start, mask_runs
+// (and back; the sample's validator has checked the runs).
+void from_core(const RunMask& mask, studio_ProjectorFrame& sample);
+Expected<RunMask> to_core(const studio_ProjectorFrame& sample);
 
 }  // namespace studio::wire

@@ -30,8 +30,9 @@ enum class TopicId : uint8_t {
   service_status,
   scene_state,
   projector_mask,
+  projector_frame,
 };
-inline constexpr std::size_t kTopicCount = 15;
+inline constexpr std::size_t kTopicCount = 16;
 
 // Why a received sample was rejected (counted per reason by every Reader).
 enum class Reject : uint8_t {
@@ -79,6 +80,7 @@ Verdict validate(const studio_ProjectorCalibration& s);
 Verdict validate(const studio_ServiceStatus& s);
 Verdict validate(const studio_SceneState& s);
 Verdict validate(const studio_ProjectorMask& s);
+Verdict validate(const studio_ProjectorFrame& s);
 
 template <class T>
 struct TopicTraits;  // specialised below for every topic type only
@@ -106,6 +108,7 @@ STUDIO_WIRE_TOPIC(ProjectorCalibration, projector_calibration)
 STUDIO_WIRE_TOPIC(ServiceStatus, service_status)
 STUDIO_WIRE_TOPIC(SceneState, scene_state)
 STUDIO_WIRE_TOPIC(ProjectorMask, projector_mask)
+STUDIO_WIRE_TOPIC(ProjectorFrame, projector_frame)
 #undef STUDIO_WIRE_TOPIC
 
 template <class T>

@@ -27,6 +27,17 @@ class Counter {
 };
 
 // Latency samples in nanoseconds; keeps the sum, count and max since the last snapshot.
+// A value that goes up and down (e.g. a projector's margin in use, mm): reported in
+// ServiceStatus among the counters by its name, with no "_hz" rate. Thread-safe.
+class Gauge {
+ public:
+  void set(double v) { value_.store(v, std::memory_order_relaxed); }
+  double value() const { return value_.load(std::memory_order_relaxed); }
+
+ private:
+  std::atomic<double> value_{0};
+};
+
 class LatencyMeter {
  public:
   void record(int64_t ns);
@@ -48,7 +59,7 @@ struct MetricsSnapshot {
     std::string name;
     double value;
   };
-  std::vector<Named> counters;  // totals since start
+  std::vector<Named> counters;  // totals since start, then the gauges' current values
   std::vector<Named> rates;     // per second over the period since the previous snapshot
   double latency_mean_ms = 0;
   double latency_max_ms = 0;
@@ -59,6 +70,7 @@ class Metrics {
  public:
   // A counter that is also reported as a rate (e.g. "masks_published").
   Counter& counter(const std::string& name);
+  Gauge& gauge(const std::string& name);
   LatencyMeter& latency() { return latency_; }
   MetricsSnapshot snapshot(std::chrono::steady_clock::time_point now = std::chrono::steady_clock::now());
 
@@ -70,6 +82,7 @@ class Metrics {
   };
   std::mutex mutex_;
   std::deque<Entry> entries_;  // deque: stable addresses for handed-out references
+  std::deque<std::pair<std::string, Gauge>> gauges_;
   LatencyMeter latency_;
   std::chrono::steady_clock::time_point last_snapshot_ = std::chrono::steady_clock::now();
 };

@@ -6,7 +6,9 @@
 // (clip_from_cam, taken as given: the projector passes an off-axis frustum): every visible model
 // node's meshes with its asset material (base colour x texture x node colour), every actor node's
 // latest ActorMesh, lit by the scene's light nodes (up to 8; Blinn-Phong with inverse-square
-// fall-off for point and spot lights) plus an ambient term; high-contrast nodes (paper §V-F) and
+// fall-off for point and spot lights) plus an ambient term, evaluated per vertex by default
+// (RendererOptions::Shading::fast, a textured 1080p frame costs ~4x less on llvmpipe) or per
+// fragment (reference); high-contrast nodes (paper §V-F) and
 // emissive materials are drawn unlit at full intensity. Back faces of asset meshes are culled
 // unless their material is double-sided (glTF's rule); actor meshes are drawn two-sided.
 //
@@ -17,6 +19,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +31,10 @@
 namespace studio::scene_render {
 
 struct RendererOptions {
+  // reference: Blinn-Phong per fragment (the exact path, for quality tests);
+  // fast: the same lighting per vertex, the fragment stage is texture x light (shaders.h).
+  enum class Shading { reference, fast };
+  Shading shading = Shading::fast;
   Eigen::Vector4f clear_colour{0.05f, 0.05f, 0.07f, 1.0f};
   Eigen::Vector3f ambient{0.22f, 0.22f, 0.24f};
   // Scale from light units (candela, lux) to the shader's unit radiance.
@@ -38,6 +45,12 @@ struct RendererOptions {
 struct View {
   Eigen::Matrix4d cam_from_world = Eigen::Matrix4d::Identity();
   Eigen::Matrix4d clip_from_cam = Eigen::Matrix4d::Identity();
+  // The eye for specular light; absent: the origin of cam_from_world (a projector passes its
+  // combined clip_from_world as clip_from_cam with an identity cam_from_world, and the eye here).
+  std::optional<Eigen::Vector3d> eye_in_world;
+  // World plane (a, b, c, d): only points with a x + b y + c z + d >= 0 are drawn
+  // (gl_ClipDistance[0]); the projector's single-pass form clips behind the eye with it.
+  std::optional<Eigen::Vector4d> clip_plane_world;
 };
 
 struct AssetStatus {
@@ -67,7 +80,9 @@ class Renderer {
   // Clears colour and depth of the bound framebuffer and draws the scene.
   void draw(const scene::Scene& scene, const View& view);
   // The actor mask of the projector: the actor's mesh in one flat colour (black), depth test
-  // off, every vertex moved `inflate_m` metres along its normal (the security margin).
+  // off, every vertex moved `inflate_m` metres along its normal (the security margin). The
+  // colour's alpha is written too (draw() writes alpha 1): a mask drawn with alpha 0 can be told
+  // from black scene pixels in the read-back.
   void draw_actor_flat(const std::string& actor_id, const View& view, float inflate_m = 0.0f,
                        const Eigen::Vector4f& colour = Eigen::Vector4f(0, 0, 0, 1));
   // Draws a texture (e.g. a RenderTarget's colour texture) over the whole bound framebuffer;

@@ -1,0 +1,77 @@
+#pragma once
+// The projector's actor mask, frame by frame (TCSVT 2004 §V-D, and beyond it): keeps the latest
+// mesh of every actor and its motion, and for each projector frame returns the meshes to draw
+// black: each moved forward by its predicted motion to the moment the frame is shown and grown
+// by the computed security margin (projector/mask_margin.h, motion.h, mask_geometry.h).
+//
+// Latency L for the margin: the configured quantile of the measured motion-to-photon latencies
+// (mesh capture_ns -> frame rendered, recorded by shown()); before any measurement,
+// `initial_latency_s`. Prediction horizon per mesh: its age when the frame is shown,
+// display_ns - capture_ns. One margin for all actors: the largest of theirs (head speed of an
+// actor from set_head_speed(), 0 when unknown).
+//
+// Bad input is refused by set_mesh() (empty, malformed, capture time going backwards) and the
+// previous mesh of that actor stays in use; the caller counts the refusal.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "projector/actor_mesh.h"
+#include "projector/mask_geometry.h"
+#include "projector/mask_margin.h"
+#include "projector/motion.h"
+
+namespace studio::projector {
+
+struct MaskPlannerOptions {
+  MarginOptions margin;
+  MotionOptions motion;
+  GrowOptions grow;
+  std::size_t latency_window = 100;  // frames
+  double latency_quantile = 0.95;
+  double initial_latency_s = 0.04;
+  Expected<void> validate() const;
+};
+
+struct MaskPlan {
+  std::vector<ActorMesh> masks;        // predicted and grown, one per actor
+  Margin margin;                       // the margin in use (the largest of the actors')
+  std::int64_t newest_capture_ns = 0;  // of the newest mesh in the plan (0: none)
+  std::uint64_t newest_frame = 0;
+};
+
+class MaskPlanner {
+ public:
+  explicit MaskPlanner(MaskPlannerOptions options = {});
+
+  // The latest mesh of an actor (frame: its studio frame). Errors: invalid mesh, capture time not
+  // after the actor's previous mesh. The motion is estimated against that previous mesh.
+  Expected<void> set_mesh(const std::string& actor_id, std::uint64_t frame, ActorMesh mesh);
+  void remove(const std::string& actor_id);
+  void set_head_speed(const std::string& actor_id, double speed_mps);
+  std::size_t actors() const { return actors_.size(); }
+
+  // The masks for a frame to be shown at display_ns (CLOCK_REALTIME).
+  Expected<MaskPlan> plan(std::int64_t display_ns) const;
+  // The frame using `plan` was rendered at shown_ns: records its latency. False when rejected
+  // (no mesh, or a latency that is negative or above 10 s).
+  bool shown(const MaskPlan& plan, std::int64_t shown_ns);
+  double latency_s() const;
+
+ private:
+  struct Actor {
+    ActorMesh mesh;
+    std::uint64_t frame = 0;
+    MotionTracker tracker;
+    std::optional<MeshMotion> motion;
+    double head_speed_mps = 0;
+  };
+  MaskPlannerOptions options_;
+  std::map<std::string, Actor> actors_;
+  LatencyWindow latencies_;
+};
+
+}  // namespace studio::projector

@@ -1,0 +1,98 @@
+// MaskPlanner (projector/mask_planner.h): a still actor gets the floor margin; a moving one is
+// moved forward by its predicted motion to the display time (its predicted mask covers where it
+// really is then); a refused mesh keeps the previous one; the latency window fills from shown().
+#include "projector/mask_planner.h"
+
+#include <gtest/gtest.h>
+
+namespace studio::projector {
+namespace {
+
+// A finely tessellated sphere (enough vertices per motion region) of radius r at c.
+ActorMesh sphere(const Eigen::Vector3f& c, float r, int64_t capture_ns) {
+  ActorMesh m;
+  const int n = 24;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j < 2 * n; ++j) {
+      const float th = float(M_PI) * i / n, ph = float(M_PI) * j / n;
+      m.vertices.push_back(c + r * Eigen::Vector3f(std::sin(th) * std::cos(ph), std::cos(th),
+                                                   std::sin(th) * std::sin(ph)));
+    }
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < 2 * n; ++j) {
+      const uint32_t a = i * 2 * n + j, b = i * 2 * n + (j + 1) % (2 * n), c2 = a + 2 * n,
+                     d = b + 2 * n;
+      m.triangles.push_back({a, c2, b});
+      m.triangles.push_back({b, c2, d});
+    }
+  m.capture_ns = capture_ns;
+  return m;
+}
+
+Eigen::Vector3f centroid(const ActorMesh& m) {
+  Eigen::Vector3f s = Eigen::Vector3f::Zero();
+  for (const auto& v : m.vertices) s += v;
+  return s / float(m.vertices.size());
+}
+
+constexpr int64_t kT0 = 1'700'000'000'000'000'000, kDt = 40'000'000;  // 25 fps
+
+TEST(MaskPlanner, StillActorGetsTheFloorAndMovingActorIsPredicted) {
+  MaskPlannerOptions o;
+  o.initial_latency_s = 0.04;
+  MaskPlanner planner(o);
+  ASSERT_TRUE(planner.set_mesh("still", 1, sphere({-1, 1, 0}, 0.2f, kT0)));
+  auto plan = planner.plan(kT0 + kDt);
+  ASSERT_TRUE(plan);
+  EXPECT_NEAR(plan->margin.margin_m, o.margin.floor_m, 1e-9);
+  ASSERT_EQ(plan->masks.size(), 1u);
+
+  // A second actor moving at 1 m/s along x, three meshes (the third gives accelerations).
+  MaskPlanner moving(o);
+  for (int k = 0; k < 3; ++k)
+    ASSERT_TRUE(moving.set_mesh("a", k, sphere({0.04f * k, 1, 0}, 0.2f, kT0 + k * kDt)));
+  const int64_t display = kT0 + 2 * kDt + 50'000'000;  // 50 ms after the last capture
+  plan = moving.plan(display);
+  ASSERT_TRUE(plan);
+  EXPECT_TRUE(plan->margin.predicted);
+  EXPECT_EQ(plan->newest_frame, 2u);
+  // Grown symmetrically, so the centroid is where the prediction puts the sphere: 0.08 + 0.05.
+  EXPECT_NEAR(centroid(plan->masks[0]).x(), 0.13f, 0.01f);
+  EXPECT_LT(plan->margin.margin_m, 0.03);
+
+  // Without prediction the margin has to cover the motion instead.
+  o.margin.prediction = false;
+  MaskPlanner plain(o);
+  for (int k = 0; k < 3; ++k)
+    ASSERT_TRUE(plain.set_mesh("a", k, sphere({0.04f * k, 1, 0}, 0.2f, kT0 + k * kDt)));
+  auto p2 = plain.plan(display);
+  ASSERT_TRUE(p2);
+  EXPECT_FALSE(p2->margin.predicted);
+  EXPECT_NEAR(centroid(p2->masks[0]).x(), 0.08f, 0.005f);
+  EXPECT_GT(p2->margin.margin_m, plan->margin.margin_m);
+}
+
+TEST(MaskPlanner, RefusedMeshKeepsThePreviousAndLatencyComesFromShownFrames) {
+  MaskPlanner planner;
+  ASSERT_TRUE(planner.set_mesh("a", 1, sphere({0, 1, 0}, 0.2f, kT0)));
+  EXPECT_FALSE(planner.set_mesh("a", 2, ActorMesh{}));                         // empty
+  EXPECT_FALSE(planner.set_mesh("a", 0, sphere({1, 1, 0}, 0.2f, kT0 - kDt)));  // older
+  ActorMesh bad = sphere({0, 1, 0}, 0.2f, kT0 + kDt);
+  bad.triangles[0][0] = 1u << 30;  // index out of range
+  EXPECT_FALSE(planner.set_mesh("a", 2, bad));
+  auto plan = planner.plan(kT0 + kDt);
+  ASSERT_TRUE(plan);
+  ASSERT_EQ(plan->masks.size(), 1u);
+  EXPECT_NEAR(centroid(plan->masks[0]).x(), 0.0f, 1e-3f);  // the first mesh
+  EXPECT_EQ(plan->newest_capture_ns, kT0);
+
+  EXPECT_DOUBLE_EQ(planner.latency_s(), MaskPlannerOptions{}.initial_latency_s);
+  EXPECT_TRUE(planner.shown(*plan, kT0 + 30'000'000));
+  EXPECT_NEAR(planner.latency_s(), 0.030, 1e-9);
+  EXPECT_FALSE(planner.shown(MaskPlan{}, kT0));  // no mesh: nothing to measure
+  planner.remove("a");
+  EXPECT_EQ(planner.actors(), 0u);
+}
+
+}  // namespace
+}  // namespace studio::projector

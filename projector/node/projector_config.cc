@@ -1,0 +1,115 @@
+// The projector service's options and its definition for runtime::service_main
+// (projector_node.h).
+#include <algorithm>
+
+#include "projector_node.h"
+#include "yaml_io/options.h"
+#include "yaml_io/rig_yaml.h"
+
+namespace studio::projector {
+
+Expected<void> ProjectorNodeOptions::validate() const {
+  if (projector.empty()) return fail("id: the projector's id in the rig is required");
+  if (actor.empty() || actor.size() > 63 || mesh_actor.empty() || mesh_actor.size() > 63)
+    return fail("actor, mesh_actor: 1..63 characters");
+  if (!(rate >= 1 && rate <= 240)) return fail("rate: 1..240 frames per second");
+  if (eye_texture.size() != 2 || thumbnail.size() != 2 || default_eye.size() != 3)
+    return fail("eye_texture and thumbnail: 2 numbers; default_eye: 3");
+  if (frame_every < 0) return fail("frame_every: >= 0");
+  if (!(head_timeout_s > 0)) return fail("head_timeout: > 0 seconds");
+  return mask_options().validate();
+}
+
+MaskPlannerOptions ProjectorNodeOptions::mask_options() const {
+  MaskPlannerOptions m;
+  m.margin = margin;
+  m.latency_window = std::size_t(std::max(latency.window, 1));
+  m.latency_quantile = latency.quantile;
+  m.initial_latency_s = latency.initial;
+  return m;
+}
+
+runtime::ServiceDefinition projector_service_definition() {
+  runtime::ServiceDefinition d;
+  d.name = "projector";
+  d.summary =
+      "One data projector: the scene from the actor's eye onto its screen, actors masked black.";
+  d.config_help =
+      "  projector:                (required section)\n"
+      "    rig: FILE               rig.yaml holding the projector (relative to the config file)\n"
+      "    id: proj0               the projector's id in the rig (required)\n"
+      "    actor: actor            the head (studio/actor/head key; the tracker's actor_id)\n"
+      "                            that is the eye\n"
+      "    mesh_actor: actor0      that actor's mesh (studio/actor/mesh key; the hull's ids):\n"
+      "                            the head's speed joins its margin. Every actor's mesh is\n"
+      "                            masked, whichever head is followed\n"
+      "    rate: 25                frames per second rendered (1..240)\n"
+      "    form: single_pass       single_pass (homography folded into the projection, the\n"
+      "                            paper's) or two_pass (eye texture + 3x3 warp)\n"
+      "    eye_texture: [0, 0]     two_pass eye texture size; 0 0 = one texel per projector pixel\n"
+      "    default_eye: [0, 1.7, 2]  eye (studio frame, m) until the actor's head arrives\n"
+      "    head_timeout: 2.0       seconds; an older head pose keeps the last good eye\n"
+      "    frame_every: 1          publish studio/projector/frame every N frames (0: never)\n"
+      "    thumbnail: [160, 90]    RGB8 thumbnail size in studio/projector/frame ([0, 0]: none)\n"
+      "    margin:                 the mask's security margin (projector/mask_margin.h)\n"
+      "      floor: 0.01           metres, what motion does not explain (hull error, ...)\n"
+      "      cap: 0.20             metres, largest margin (clamped and flagged above)\n"
+      "      prediction: true      move every mesh forward by its predicted motion\n"
+      "      velocity_uncertainty: 0.05  m/s, sigma of the velocity estimate\n"
+      "      head_disagreement: 0.5      m/s; a head faster than the mesh by more: no prediction\n"
+      "    latency:                motion to photon (mesh capture_ns -> frame rendered)\n"
+      "      window: 100           frames measured\n"
+      "      quantile: 0.95        the latency the margin covers\n"
+      "      initial: 0.04         seconds, before the first measurement\n"
+      "  Output: headless (EGL surfaceless, Mesa llvmpipe without a GPU); the frame is read back\n"
+      "  for studio/projector/frame. A real projector needs a window on its output: run the same\n"
+      "  renderer in a graphical session (not built yet: see deploy/systemd/studio-projector@).\n"
+      "  Topics: studio/scene/node, studio/actor/mesh, studio/actor/head in;\n"
+      "  studio/projector/calibration, studio/projector/frame, studio/service/status out\n"
+      "  (latency = motion to photon; margin_mm, latency_p_ms, eye_rejected, meshes_rejected).\n";
+  d.create = [](yaml::MapReader& config,
+                runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
+    auto section = config.required("projector");
+    if (!section) return std::unexpected(section.error());
+    static const yaml::Schema<MarginOptions> margin_schema{
+        yaml::field("floor", &MarginOptions::floor_m).min(0),
+        yaml::field("cap", &MarginOptions::cap_m).min(0),
+        yaml::field("prediction", &MarginOptions::prediction),
+        yaml::field("velocity_uncertainty", &MarginOptions::velocity_uncertainty_mps).min(0),
+        yaml::field("head_disagreement", &MarginOptions::head_disagreement_mps).min(0),
+    };
+    static const yaml::Schema<LatencyOptions> latency_schema{
+        yaml::field("window", &LatencyOptions::window).range(1, 100000),
+        yaml::field("quantile", &LatencyOptions::quantile).range(0.01, 1),
+        yaml::field("initial", &LatencyOptions::initial).range(0, 10),
+    };
+    static const yaml::Schema<ProjectorNodeOptions> schema{
+        yaml::field("rig", &ProjectorNodeOptions::rig).required().relative_path(),
+        yaml::field("id", &ProjectorNodeOptions::projector).required(),
+        yaml::field("actor", &ProjectorNodeOptions::actor),
+        yaml::field("mesh_actor", &ProjectorNodeOptions::mesh_actor),
+        yaml::field("rate", &ProjectorNodeOptions::rate).range(1, 240),
+        yaml::enum_field("form", &ProjectorNodeOptions::form,
+                         {{"single_pass", projector_render::Form::single_pass},
+                          {"two_pass", projector_render::Form::two_pass}}),
+        yaml::field("eye_texture", &ProjectorNodeOptions::eye_texture).size(2),
+        yaml::field("default_eye", &ProjectorNodeOptions::default_eye).size(3),
+        yaml::field("head_timeout", &ProjectorNodeOptions::head_timeout_s).min(0.01),
+        yaml::field("frame_every", &ProjectorNodeOptions::frame_every).range(0, 100000),
+        yaml::field("thumbnail", &ProjectorNodeOptions::thumbnail).size(2),
+        yaml::field("margin", &ProjectorNodeOptions::margin, margin_schema),
+        yaml::field("latency", &ProjectorNodeOptions::latency, latency_schema),
+    };
+    auto read = schema.read(*section);
+    if (!read) return std::unexpected(read.error());
+    const ProjectorNodeOptions& options = *read;
+    auto rig = yaml::read_rig(options.rig);
+    if (!rig) return std::unexpected(rig.error());
+    const Projector* p = rig->find_projector(options.projector);
+    if (!p) return fail(options.rig + ": no projector '" + options.projector + "'");
+    return make_projector_node(options, *p, ctx);
+  };
+  return d;
+}
+
+}  // namespace studio::projector

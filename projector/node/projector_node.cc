@@ -1,0 +1,312 @@
+#include "projector_node.h"
+
+#include <chrono>
+#include <condition_variable>
+#include <future>
+#include <mutex>
+#include <optional>
+#include <set>
+
+#include "core/clock.h"
+#include "core/log.h"
+#include "projector_wire.h"
+#include "runtime/service_loop.h"
+#include "scene_mirror.h"
+#include "scene_render/egl_context.h"
+#include "wire/convert.h"
+#include "wire/sample.h"
+#include "wire/scene_convert.h"
+
+namespace studio::projector {
+namespace {
+
+constexpr const char* kLog = "projector";
+using SteadyClock = std::chrono::steady_clock;
+
+class ProjectorNode : public runtime::Node {
+ public:
+  ProjectorNode(ProjectorNodeOptions options, ProjectorView view, const Projector& projector,
+                runtime::NodeContext& ctx)
+      : options_(std::move(options)),
+        view_(std::move(view)),
+        projector_(projector),
+        planner_(options_.mask_options()),
+        loop_(ctx, kLog) {
+    calibration_ =
+        &loop_.output<studio_ProjectorCalibration>({.counter = "calibrations_out", .rate = false});
+    frames_ = &loop_.output<studio_ProjectorFrame>({.counter = "frames_published", .rate = false});
+    loop_.input<studio_SceneNode>({.received = "scene_nodes_in",
+                                   .rejected = "scene_nodes_rejected",
+                                   .reason_prefix = "scene_nodes_rejected_",
+                                   .rate = false,
+                                   .instance_changes = true,
+                                   .batch = 1024},
+                                  [this](const studio_SceneNode& s, const wire::SampleMeta& meta) {
+                                    return on_node(s, meta);
+                                  });
+    loop_.input<studio_ActorMesh>({.received = "meshes_in",
+                                   .rejected = "meshes_rejected",
+                                   .reason_prefix = "meshes_rejected_",
+                                   .instance_changes = true},
+                                  [this](const studio_ActorMesh& s, const wire::SampleMeta& meta) {
+                                    return on_mesh(s, meta);
+                                  });
+    loop_.input<studio_HeadPose>(
+        {.received = "heads_in",
+         .rejected = "heads_rejected",
+         .reason_prefix = "heads_rejected_",
+         .rate = false},
+        [this](const studio_HeadPose& s, const wire::SampleMeta&) { return on_head(s); });
+    loop_.thread(
+        "render", [this] { render_loop(); },
+        [this] {
+          std::lock_guard lock(mutex_);
+          stop_ = true;
+          wake_.notify_all();
+        });
+    rendered_ = &loop_.counter("frames_rendered");
+    loop_.count_as_output(*rendered_);
+    eye_rejected_ = &loop_.counter("eye_rejected");
+    head_stale_ = &loop_.counter("head_stale");
+    scene_left_out_ = &loop_.counter("scene_nodes_left_out");
+    assets_failed_ = &loop_.counter("assets_failed");
+    margin_mm_ = &loop_.metrics().gauge("margin_mm");
+    latency_p_ms_ = &loop_.metrics().gauge("latency_p_ms");
+    render_ms_ = &loop_.metrics().gauge("render_ms");
+  }
+  ~ProjectorNode() override { stop(); }
+
+  Expected<void> start() override {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = false;
+      init_ = std::promise<Expected<void>>();
+    }
+    auto init = init_.get_future();
+    if (auto ok = loop_.start(); !ok) return ok;
+    if (auto ok = init.get(); !ok) {  // GL context or renderer failed
+      loop_.stop();
+      return ok;
+    }
+    wire::Owned<studio_ProjectorCalibration> c;
+    if (auto ok = wire::from_core(projector_, view_.pixel_from_screen(), *c); ok)
+      (void)calibration_->write(*c);
+    else
+      STUDIO_LOG(warn, kLog) << ok.error().message << " (not published)";
+    return {};
+  }
+  void stop() override { loop_.stop(); }
+  runtime::NodeHealth health() override {
+    runtime::NodeHealth h = loop_.health();
+    h.degraded = degraded_.load();
+    return h;
+  }
+
+ private:
+  runtime::Outcome on_node(const studio_SceneNode& s, const wire::SampleMeta& meta) {
+    std::lock_guard lock(mutex_);
+    if (meta.disposed || !meta.valid_data) {  // a disposed instance, with or without data
+      mirror_.remove(std::string(s.node_id));
+      return {};
+    }
+    auto node = wire::to_core(s);
+    if (!node) return runtime::reject("to_core", node.error().message);
+    mirror_.update(std::move(*node));
+    return {};
+  }
+
+  runtime::Outcome on_mesh(const studio_ActorMesh& s, const wire::SampleMeta& meta) {
+    const std::string id(s.actor_id);
+    if (meta.disposed || !meta.valid_data) {
+      std::lock_guard lock(mutex_);
+      planner_.remove(id);
+      return {};
+    }
+    if (s.vertices._length == 0 || s.triangles._length == 0)
+      return runtime::reject("empty", "actor " + id + ": empty mesh (previous mask kept)");
+    std::lock_guard lock(mutex_);
+    if (auto ok = planner_.set_mesh(id, s.frame, mesh_of(s)); !ok)
+      return runtime::reject("mesh", ok.error().message);
+    return {};
+  }
+
+  runtime::Outcome on_head(const studio_HeadPose& s) {
+    const Eigen::Vector3d p(s.position[0], s.position[1], s.position[2]);
+    const Eigen::Vector3d v(s.velocity[0], s.velocity[1], s.velocity[2]);
+    std::lock_guard lock(mutex_);
+    if (options_.actor != s.actor_id) return {};  // another actor's head
+    planner_.set_head_speed(options_.mesh_actor, v.norm());
+    head_ = Head{p, SteadyClock::now()};
+    return {};
+  }
+
+  // The eye for this frame: the followed head when fresh, else the last good eye.
+  Eigen::Vector3d eye_now(SteadyClock::time_point now) {
+    std::lock_guard lock(mutex_);
+    if (head_) {
+      if (now - head_->arrived < std::chrono::duration<double>(options_.head_timeout_s))
+        return head_->position;
+      head_.reset();
+      head_stale_->add();
+    }
+    return last_good_eye_;
+  }
+
+  // The render thread: its own GL context (EGL surfaceless), one frame per period.
+  void render_loop() {
+    std::optional<scene_render::HeadlessContext> context;  // outlives the renderer, this thread
+    auto fr = init_renderer(context);
+    init_.set_value(fr ? Expected<void>{} : std::unexpected(fr.error()));
+    if (!fr) return;
+    Frame state;
+    const auto period = std::chrono::duration_cast<SteadyClock::duration>(
+        std::chrono::duration<double>(1.0 / options_.rate));
+    auto next = SteadyClock::now();
+    while (loop_.running()) {
+      {
+        std::unique_lock lock(mutex_);
+        if (wake_.wait_until(lock, next, [this] { return stop_; })) return;
+      }
+      next += period;
+      if (const auto now = SteadyClock::now(); next < now) next = now;  // behind: no burst
+      render_one(*fr, state);
+    }
+  }
+
+  Expected<projector_render::FrameRenderer> init_renderer(
+      std::optional<scene_render::HeadlessContext>& out) {
+    auto context = scene_render::HeadlessContext::create();
+    if (!context) return std::unexpected(context.error());
+    projector_render::FrameRendererOptions fo;
+    fo.form = options_.form;
+    fo.eye_texture_size = {options_.eye_texture[0], options_.eye_texture[1]};
+    fo.thumb_width = options_.thumbnail[0];
+    fo.thumb_height = options_.thumbnail[1];
+    auto fr = projector_render::FrameRenderer::create(view_, fo);
+    if (!fr) return fr;
+    STUDIO_LOG(info, kLog) << "rendering " << fr->width() << "x" << fr->height() << " on "
+                           << context->renderer();
+    out.emplace(std::move(*context));
+    return fr;
+  }
+
+  // What the render thread keeps from frame to frame.
+  struct Frame {
+    scene::Scene scene;
+    scene_assets::AssetCache cache;
+    std::set<std::string> failed_assets;
+    projector_render::Readback readback;
+    double render_s = 0;  // smoothed render time: a frame is shown about this much later
+    uint64_t count = 0;
+  };
+
+  void render_one(projector_render::FrameRenderer& fr, Frame& st) {
+    std::optional<std::map<scene::NodeId, scene::Node>> nodes;
+    {
+      std::lock_guard lock(mutex_);
+      if (mirror_.dirty()) {
+        nodes = mirror_.nodes();
+        mirror_.clean();
+      }
+    }
+    if (nodes) {
+      auto r = SceneMirror::rebuild(*nodes, st.scene, st.cache, st.failed_assets, fr.renderer());
+      scene_left_out_->add(r.left_out);
+      assets_failed_->add(r.assets_failed);
+    }
+    Eigen::Vector3d eye = eye_now(SteadyClock::now());
+    const int64_t start_ns = realtime_ns();
+    std::optional<MaskPlan> plan;
+    {
+      std::lock_guard lock(mutex_);
+      if (auto p = planner_.plan(start_ns + int64_t(st.render_s * 1e9))) plan = std::move(*p);
+    }
+    const std::span<const ActorMesh> masks =
+        plan ? std::span<const ActorMesh>(plan->masks) : std::span<const ActorMesh>();
+    auto drawn = fr.render(st.scene, eye, masks);
+    if (!drawn) {  // an eye the projection refuses: the last good eye (checked at start)
+      eye_rejected_->add();
+      STUDIO_LOG(debug, kLog) << drawn.error().message;
+      {
+        std::lock_guard lock(mutex_);
+        eye = last_good_eye_;
+      }
+      drawn = fr.render(st.scene, eye, masks);
+    }
+    fr.finish();
+    const int64_t done_ns = realtime_ns();
+    const double took = (done_ns - start_ns) * 1e-9;
+    st.render_s = st.count++ == 0 ? took : 0.9 * st.render_s + 0.1 * took;
+    rendered_->add();
+    {
+      std::lock_guard lock(mutex_);
+      if (drawn) last_good_eye_ = eye;
+      if (plan) planner_.shown(*plan, done_ns);
+      latency_p_ms_->set(planner_.latency_s() * 1e3);
+    }
+    render_ms_->set(st.render_s * 1e3);
+    if (plan) margin_mm_->set(plan->margin.margin_m * 1e3);
+    if (plan && plan->newest_capture_ns > 0)
+      loop_.completed(plan->newest_frame, plan->newest_capture_ns);
+    degraded_ = !drawn;
+    if (options_.frame_every > 0 && st.count % uint64_t(options_.frame_every) == 0)
+      publish(fr, st.readback, plan ? &*plan : nullptr, eye, st.count, done_ns);
+  }
+
+  void publish(projector_render::FrameRenderer& fr, projector_render::Readback& rb,
+               const MaskPlan* plan, const Eigen::Vector3d& eye, uint64_t count, int64_t done_ns) {
+    fr.read(rb);
+    wire::Owned<studio_ProjectorFrame> f;
+    fill_frame({projector_.camera.id, plan, eye, options_.form == projector_render::Form::two_pass,
+                count, done_ns},
+               rb, *f);
+    (void)frames_->write(*f);
+  }
+
+  struct Head {
+    Eigen::Vector3d position;
+    SteadyClock::time_point arrived;
+  };
+
+  ProjectorNodeOptions options_;
+  ProjectorView view_;
+  Projector projector_;
+  std::mutex mutex_;  // guards what follows up to the loop (handlers vs the render thread)
+  std::condition_variable wake_;
+  bool stop_ = false;
+  SceneMirror mirror_;
+  MaskPlanner planner_;
+  std::optional<Head> head_;
+  Eigen::Vector3d last_good_eye_ = Eigen::Vector3d::Zero();
+  std::promise<Expected<void>> init_;
+  std::atomic<bool> degraded_{false};
+  runtime::Output<studio_ProjectorCalibration>* calibration_ = nullptr;
+  runtime::Output<studio_ProjectorFrame>* frames_ = nullptr;
+  runtime::Counter *rendered_ = nullptr, *eye_rejected_ = nullptr, *head_stale_ = nullptr,
+                   *scene_left_out_ = nullptr, *assets_failed_ = nullptr;
+  runtime::Gauge *margin_mm_ = nullptr, *latency_p_ms_ = nullptr, *render_ms_ = nullptr;
+  runtime::ServiceLoop loop_;  // last: stopped before the state above goes
+
+ public:
+  void set_default_eye(const Eigen::Vector3d& eye) { last_good_eye_ = eye; }
+};
+
+}  // namespace
+
+Expected<std::unique_ptr<runtime::Node>> make_projector_node(const ProjectorNodeOptions& options,
+                                                             const Projector& projector,
+                                                             runtime::NodeContext& context) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  auto view = ProjectorView::create(projector);
+  if (!view) return fail("projector " + projector.camera.id + ": " + view.error().message);
+  const Eigen::Vector3d eye(options.default_eye[0], options.default_eye[1], options.default_eye[2]);
+  // The default eye must give a picture: it is what the projector shows without a head.
+  if (auto ok = view->single_pass(eye); !ok && options.form == projector_render::Form::single_pass)
+    return fail("default_eye: " + ok.error().message);
+  if (auto ok = view->two_pass(eye); !ok) return fail("default_eye: " + ok.error().message);
+  auto node = std::make_unique<ProjectorNode>(options, std::move(*view), projector, context);
+  node->set_default_eye(eye);
+  return std::unique_ptr<runtime::Node>(std::move(node));
+}
+
+}  // namespace studio::projector

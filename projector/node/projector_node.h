@@ -1,0 +1,65 @@
+#pragma once
+// The projector service (issue 15 item 3; TCSVT 2004 §V-C/D): one data projector's visualisation
+// server. Renders the virtual scene from the actor's eye through the projector's screen rectangle
+// (single pass: the homography folded into the projection, or two pass: eye texture + warp) at
+// the projector's rate, headless (EGL surfaceless; no window), and blacks out every actor: their
+// latest meshes, moved forward by the predicted motion and grown by the computed margin, drawn
+// black from the projector with no depth test (projector/mask_planner.h).
+//
+// Topics in: studio/scene/node (the scene, mirrored; assets loaded from the paths the nodes
+// name, checked by hash), studio/actor/mesh (every actor's mesh; a disposed instance removes the
+// actor), studio/actor/head (the followed actor's head = the eye; others give head speeds).
+// Topics out: studio/projector/calibration (from the rig file, once, transient-local),
+// studio/projector/frame (per rendered frame: frame numbers, capture_ns -> render_done_ns,
+// margin, the blackout mask at full resolution as runs, a thumbnail), studio/service/status
+// (latency = motion to photon of the newest mesh; gauges margin_mm, latency_p_ms).
+//
+// Bad input never stops the projection: a degenerate or unseen screen fails at start (one line);
+// an eye behind or too close to the screen, a malformed or empty mesh, a scene node that does not
+// fit (unknown parent, unreadable asset) are counted rejections and the last good state is kept.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "core/rig.h"
+#include "projector/mask_planner.h"
+#include "projector_render/frame_renderer.h"
+#include "runtime/service.h"
+
+namespace studio::projector {
+
+struct LatencyOptions {
+  int window = 100;        // frames measured
+  double quantile = 0.95;  // the latency the margin covers
+  double initial = 0.04;   // seconds, before the first measurement
+  Expected<void> validate() const { return {}; }
+};
+
+struct ProjectorNodeOptions {
+  std::string rig;              // rig.yaml holding the projector (relative to the config file)
+  std::string projector;        // its id
+  std::string actor = "actor";  // the head (studio/actor/head key) that is the eye
+  std::string mesh_actor = "actor0";  // that actor's mesh id: the head's speed joins its margin
+  double rate = 25;                   // frames per second
+  projector_render::Form form = projector_render::Form::single_pass;
+  std::vector<int> eye_texture{0, 0};            // two pass: eye texture size, 0 0 = suggested
+  std::vector<double> default_eye{0, 1.7, 2.0};  // eye until a head pose arrives, studio frame
+  double head_timeout_s = 2.0;  // an older head pose falls back to the last good eye (counted)
+  int frame_every = 1;          // publish studio/projector/frame every N rendered frames (0: never)
+  std::vector<int> thumbnail{160, 90};
+  MarginOptions margin;
+  LatencyOptions latency;
+
+  Expected<void> validate() const;
+  MaskPlannerOptions mask_options() const;
+};
+
+runtime::ServiceDefinition projector_service_definition();
+
+// Builds the node (projector already read from the rig) — exposed for in-process tests.
+Expected<std::unique_ptr<runtime::Node>> make_projector_node(const ProjectorNodeOptions& options,
+                                                             const Projector& projector,
+                                                             runtime::NodeContext& context);
+
+}  // namespace studio::projector

@@ -1,0 +1,191 @@
+#include "projector_render/frame_renderer.h"
+
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+
+#include "projector/camera_clip.h"
+#include "scene_render/render_target.h"
+
+namespace studio::projector_render {
+namespace {
+const std::string kFrameId = "\x01screen-frame";
+}  // namespace
+
+Expected<void> FrameRendererOptions::validate() const {
+  if (auto ok = off_axis.validate(); !ok) return ok;
+  if (auto ok = renderer.validate(); !ok) return ok;
+  if (eye_texture_size.x() < 0 || eye_texture_size.y() < 0 || eye_texture_size.x() > 8192 ||
+      eye_texture_size.y() > 8192 || (eye_texture_size.x() == 0) != (eye_texture_size.y() == 0))
+    return fail("eye_texture: both sides 1..8192, or both 0 (suggested size)");
+  if (thumb_width < 0 || thumb_height < 0 || thumb_width > 1024 || thumb_height > 1024 ||
+      (thumb_width == 0) != (thumb_height == 0))
+    return fail("thumbnail: both sides 1..1024, or both 0 (none)");
+  return {};
+}
+
+RunMask blackout_of(std::span<const std::uint8_t> rgba, int width, int height) {
+  RunMask mask(width, height);
+  for (int y = 0; y < height; ++y) {
+    const std::uint8_t* row = rgba.data() + std::size_t(y) * width * 4;
+    int x = 0;
+    while (x < width) {
+      while (x < width && row[4 * x + 3] != 0) ++x;
+      if (x >= width) break;
+      const int begin = x;
+      while (x < width && row[4 * x + 3] == 0) ++x;
+      mask.push_run(y, begin, x);
+    }
+  }
+  mask.finish();
+  return mask;
+}
+
+struct FrameRenderer::Impl {
+  projector::ProjectorView view;
+  FrameRendererOptions options;
+  scene_render::Renderer renderer;
+  scene_render::RenderTarget target;
+  std::optional<scene_render::RenderTarget> eye_target;  // two pass
+  scene_render::View mask_view;
+  std::vector<std::string> mask_ids;
+  scene::ActorMesh scratch;
+  std::vector<std::uint8_t> rgba;
+};
+
+FrameRenderer::FrameRenderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+FrameRenderer::FrameRenderer(FrameRenderer&&) noexcept = default;
+FrameRenderer& FrameRenderer::operator=(FrameRenderer&&) noexcept = default;
+FrameRenderer::~FrameRenderer() = default;
+
+Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& view,
+                                              const FrameRendererOptions& options) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  const Camera& cam = view.camera();
+  if (options.form == Form::two_pass && cam.distortion.model != Distortion::Model::none)
+    return fail("projector " + cam.id +
+                ": two-pass form with lens distortion needs the exact warp map (not supported by "
+                "this renderer); use a distortion-free calibration");
+  if (options.form == Form::single_pass && cam.distortion.model != Distortion::Model::none)
+    return fail("projector " + cam.id + ": the single-pass form cannot fold lens distortion");
+  auto renderer = scene_render::Renderer::create(options.renderer);
+  if (!renderer) return std::unexpected(renderer.error());
+  // Outside the screen: the screen's plane around the rectangle, out to 50 m, drawn black from
+  // the projector after a single pass (whose projection extends past the cloth; the two-pass warp
+  // is black there by construction).
+  {
+    const projector::Screen& sc = view.screen();
+    const auto c = sc.corners();
+    const Eigen::Vector3d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+    scene::ActorMesh frame;
+    frame.actor_id = kFrameId;
+    for (const auto& k : c) frame.vertices.push_back(k.cast<float>());
+    for (const auto& k : c)
+      frame.vertices.push_back((centre + (k - centre).normalized() * 50.0).cast<float>());
+    for (std::uint32_t i = 0; i < 4; ++i) {
+      const std::uint32_t j = (i + 1) % 4;
+      frame.triangles.push_back({i, j, 4 + j});
+      frame.triangles.push_back({i, 4 + j, 4 + i});
+    }
+    frame.normals.assign(frame.vertices.size(), sc.normal.cast<float>());
+    if (auto ok = renderer->set_actor_mesh(frame); !ok) return std::unexpected(ok.error());
+  }
+  auto target = scene_render::RenderTarget::create(cam.width, cam.height);
+  if (!target) return std::unexpected(target.error());
+  std::optional<scene_render::RenderTarget> eye_target;
+  if (options.form == Form::two_pass) {
+    Eigen::Vector2i size = options.eye_texture_size;
+    if (size.x() == 0) size = view.suggested_texture_size().cwiseMin(8192).cwiseMax(16);
+    auto t = scene_render::RenderTarget::create(size.x(), size.y());
+    if (!t) return std::unexpected(t.error());
+    eye_target.emplace(std::move(*t));
+  }
+  scene_render::View mask_view;
+  mask_view.clip_from_cam = projector::clip_from_world(cam, 0.05, 100.0);
+  return FrameRenderer(std::unique_ptr<Impl>(new Impl{view,
+                                                      options,
+                                                      std::move(*renderer),
+                                                      std::move(*target),
+                                                      std::move(eye_target),
+                                                      mask_view,
+                                                      {},
+                                                      {},
+                                                      {}}));
+}
+
+scene_render::Renderer& FrameRenderer::renderer() { return impl_->renderer; }
+const projector::ProjectorView& FrameRenderer::view() const { return impl_->view; }
+unsigned FrameRenderer::colour_texture() const { return impl_->target.colour_texture(); }
+unsigned FrameRenderer::framebuffer() const { return impl_->target.framebuffer(); }
+int FrameRenderer::width() const { return impl_->target.width(); }
+int FrameRenderer::height() const { return impl_->target.height(); }
+
+Expected<int> FrameRenderer::render(const scene::Scene& scene, const Eigen::Vector3d& eye,
+                                    std::span<const projector::ActorMesh> masks) {
+  Impl& r = *impl_;
+  if (r.options.form == Form::single_pass) {
+    auto pass = r.view.single_pass(eye, r.options.off_axis);
+    if (!pass) return std::unexpected(pass.error());
+    scene_render::View v;
+    v.clip_from_cam = pass->clip_from_world;
+    v.eye_in_world = eye;
+    v.clip_plane_world = pass->eye_clip_plane;
+    r.target.bind();
+    r.renderer.draw(scene, v);
+    r.renderer.draw_actor_flat(kFrameId, r.mask_view, 0.0f, Eigen::Vector4f(0, 0, 0, 1));
+  } else {
+    auto pass = r.view.two_pass(eye, r.options.off_axis);
+    if (!pass) return std::unexpected(pass.error());
+    scene_render::View v;
+    v.clip_from_cam = pass->eye.clip_from_world;
+    v.eye_in_world = eye;
+    r.eye_target->bind();
+    r.renderer.draw(scene, v);
+    r.target.bind();
+    // The quad's coordinates p in [0, 1]^2 are NDC (2p - 1): texture = texture_from_ndc * ndc.
+    Eigen::Matrix3d ndc_from_unit;
+    ndc_from_unit << 2, 0, -1, 0, 2, -1, 0, 0, 1;
+    r.renderer.draw_texture(r.eye_target->colour_texture(),
+                            (pass->texture_from_ndc * ndc_from_unit).cast<float>());
+  }
+  int drawn = 0;
+  for (std::size_t i = 0; i < masks.size(); ++i) {
+    const projector::ActorMesh& m = masks[i];
+    if (!m.validate()) continue;
+    if (r.mask_ids.size() <= i) r.mask_ids.push_back("\x01mask" + std::to_string(i));
+    r.scratch.actor_id = r.mask_ids[i];
+    r.scratch.vertices = m.vertices;
+    r.scratch.triangles = m.triangles;
+    r.scratch.normals.assign(m.vertices.size(), Eigen::Vector3f::UnitZ());  // unused: unlit
+    if (!r.renderer.set_actor_mesh(r.scratch)) continue;
+    r.renderer.draw_actor_flat(r.mask_ids[i], r.mask_view, 0.0f, Eigen::Vector4f::Zero());
+    ++drawn;
+  }
+  return drawn;
+}
+
+void FrameRenderer::finish() { glFinish(); }
+
+void FrameRenderer::read(Readback& out, bool keep_rgba) {
+  Impl& r = *impl_;
+  const int w = r.target.width(), h = r.target.height();
+  r.target.read_rgba(r.rgba);
+  out.blackout = blackout_of(r.rgba, w, h);
+  out.thumb_width = r.options.thumb_width;
+  out.thumb_height = r.options.thumb_height;
+  if (out.thumb_width > 0) {
+    const cv::Mat full(h, w, CV_8UC4, r.rgba.data());
+    cv::Mat small, rgb;
+    cv::resize(full, small, cv::Size(out.thumb_width, out.thumb_height), 0, 0, cv::INTER_AREA);
+    cv::cvtColor(small, rgb, cv::COLOR_RGBA2RGB);
+    out.thumbnail.assign(rgb.data, rgb.data + rgb.total() * 3);
+  } else {
+    out.thumbnail.clear();
+  }
+  if (keep_rgba) out.rgba = r.rgba;
+}
+
+}  // namespace studio::projector_render

@@ -1,0 +1,96 @@
+#pragma once
+// One projector frame on the GPU (TCSVT 2004 §V-C/D), shared by the projector node, the
+// `studio-projector render` CLI and the benchmark: the virtual scene seen from the actor's eye
+// through the projector's screen rectangle, then every actor's mask mesh drawn black from the
+// projector's viewpoint with no depth test. Needs a current OpenGL 3.3 context (a
+// HeadlessContext, or a GLFW window's) on the calling thread.
+//
+// Forms (projector/projector_view.h):
+// - single pass: the scene drawn once with ProjectorView::single_pass's clip_from_world (the
+//   homography folded into the off-axis projection) and its eye clip plane; what lies outside
+//   the screen rectangle in the projector's image is then drawn black (no cloth there: the same
+//   frame as the two-pass warp's);
+// - two pass: the eye's off-axis view rendered into a texture covering the screen rectangle
+//   (ProjectorView::suggested_texture_size, or the configured size), then warped onto the
+//   projector frame by one full-screen quad sampling it through the 3x3 texture_from_ndc.
+//   A projector with lens distortion is refused here (the exact warp map is not wired up).
+// Mask: drawn with colour (0, 0, 0, 0) after the scene, so the read-back tells a blacked-out
+// pixel (alpha 0) from a black scene pixel (alpha 1): `Readback::blackout` is exactly the set of
+// projector pixels the mask covered.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/run_mask.h"
+#include "projector/actor_mesh.h"
+#include "projector/projector_view.h"
+#include "scene/scene.h"
+#include "scene_render/renderer.h"
+
+namespace studio::projector_render {
+
+enum class Form { single_pass, two_pass };
+
+struct FrameRendererOptions {
+  Form form = Form::single_pass;
+  // Two-pass eye texture size; 0 x 0: ProjectorView::suggested_texture_size().
+  Eigen::Vector2i eye_texture_size = Eigen::Vector2i::Zero();
+  projector::OffAxisOptions off_axis;
+  scene_render::RendererOptions renderer;
+  int thumb_width = 160;  // 0: no thumbnail
+  int thumb_height = 90;
+  Expected<void> validate() const;
+};
+
+struct Readback {
+  std::vector<std::uint8_t> rgba;       // full frame, top row first (kept when asked)
+  RunMask blackout;                     // projector pixels the mask covered, top row first
+  std::vector<std::uint8_t> thumbnail;  // RGB8, thumb_width x thumb_height, top row first
+  int thumb_width = 0, thumb_height = 0;
+};
+
+class FrameRenderer {
+ public:
+  // Errors: invalid options, a two-pass projector with lens distortion, GL resources that cannot
+  // be created.
+  static Expected<FrameRenderer> create(const projector::ProjectorView& view,
+                                        const FrameRendererOptions& options = {});
+  FrameRenderer(FrameRenderer&&) noexcept;
+  FrameRenderer& operator=(FrameRenderer&&) noexcept;
+  ~FrameRenderer();
+
+  // The scene renderer (upload assets, actor meshes of the scene's actor nodes).
+  scene_render::Renderer& renderer();
+  const projector::ProjectorView& view() const;
+
+  // Draws one frame into the projector target: the scene from `eye`, then every mask mesh
+  // (already grown and predicted, studio frame) black. Errors: those of the projection (eye
+  // behind or too close to the screen) — nothing is drawn then; an invalid mask mesh is skipped
+  // and counted in the result. Returns the number of masks drawn.
+  Expected<int> render(const scene::Scene& scene, const Eigen::Vector3d& eye,
+                       std::span<const projector::ActorMesh> masks);
+  // Finishes the frame (glFinish): after this the frame is rendered.
+  void finish();
+  // Reads the frame back: blackout mask and thumbnail (and the full RGBA when keep_rgba).
+  void read(Readback& out, bool keep_rgba = false);
+  // The projector target's colour texture and framebuffer (to show it in a window).
+  unsigned colour_texture() const;
+  unsigned framebuffer() const;
+  int width() const;
+  int height() const;
+
+ private:
+  struct Impl;
+  explicit FrameRenderer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+// RGBA (top row first) → the run mask of pixels whose alpha is 0.
+RunMask blackout_of(std::span<const std::uint8_t> rgba, int width, int height);
+
+}  // namespace studio::projector_render

@@ -1,0 +1,97 @@
+#include "projector/mask_planner.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace studio::projector {
+
+Expected<void> MaskPlannerOptions::validate() const {
+  if (auto ok = margin.validate(); !ok) return ok;
+  if (auto ok = motion.validate(); !ok) return ok;
+  if (latency_window < 1 || latency_window > 100000) return fail("latency_window: 1..100000");
+  if (!(latency_quantile > 0 && latency_quantile <= 1)) return fail("latency_quantile: (0, 1]");
+  if (!(initial_latency_s >= 0 && initial_latency_s <= 10))
+    return fail("initial_latency_s: 0..10 seconds");
+  return {};
+}
+
+MaskPlanner::MaskPlanner(MaskPlannerOptions options)
+    : options_(std::move(options)),
+      latencies_(options_.latency_window, options_.latency_quantile) {}
+
+Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t frame,
+                                     ActorMesh mesh) {
+  if (auto ok = mesh.validate(); !ok) return fail("actor " + actor_id + ": " + ok.error().message);
+  auto it = actors_.find(actor_id);
+  if (it == actors_.end())
+    it = actors_.emplace(actor_id, Actor{{}, 0, MotionTracker(options_.motion), {}, 0}).first;
+  Actor& a = it->second;
+  if (!a.mesh.vertices.empty() && mesh.capture_ns <= a.mesh.capture_ns)
+    return fail("actor " + actor_id + ": mesh capture time not after the previous mesh's");
+  auto motion = a.tracker.update(mesh);
+  a.motion = motion ? *motion : std::nullopt;  // no motion: the margin's no-prediction term
+  a.mesh = std::move(mesh);
+  a.frame = frame;
+  return {};
+}
+
+void MaskPlanner::remove(const std::string& actor_id) { actors_.erase(actor_id); }
+
+void MaskPlanner::set_head_speed(const std::string& actor_id, double speed_mps) {
+  if (!std::isfinite(speed_mps) || speed_mps < 0) return;
+  auto it = actors_.find(actor_id);
+  if (it != actors_.end()) it->second.head_speed_mps = speed_mps;
+}
+
+double MaskPlanner::latency_s() const {
+  return latencies_.empty() ? options_.initial_latency_s : latencies_.latency_s();
+}
+
+Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
+  MaskPlan out;
+  const double latency = latency_s();
+  std::vector<bool> predicted;
+  bool first = true;
+  for (const auto& [id, a] : actors_) {
+    auto m = security_margin(options_.margin, latency, a.head_speed_mps,
+                             a.motion ? &*a.motion : nullptr);
+    if (!m) return std::unexpected(m.error());
+    predicted.push_back(m->predicted);
+    if (first || m->margin_m > out.margin.margin_m) out.margin = *m;
+    first = false;
+    if (a.mesh.capture_ns > out.newest_capture_ns) {
+      out.newest_capture_ns = a.mesh.capture_ns;
+      out.newest_frame = a.frame;
+    }
+  }
+  if (first) {  // no actor: the floor, for the record
+    out.margin.margin_m = out.margin.floor_m = options_.margin.floor_m;
+    out.margin.latency_s = latency;
+  }
+  std::size_t k = 0;
+  for (const auto& [id, a] : actors_) {
+    const ActorMesh* mesh = &a.mesh;
+    ActorMesh moved;
+    // Each actor moved forward when its own margin relies on the prediction; the margin drawn
+    // is the largest, which covers every actor's own.
+    if (predicted[k++] && a.motion) {
+      const double horizon = std::clamp((display_ns - a.mesh.capture_ns) * 1e-9, 0.0, 1.0);
+      auto p = predict(a.mesh, *a.motion, horizon);
+      if (p) {
+        moved = std::move(*p);
+        mesh = &moved;
+      }
+    }
+    auto grown = grow_mesh(*mesh, out.margin.margin_m, options_.grow);
+    if (!grown) return std::unexpected(grown.error());
+    out.masks.push_back(std::move(*grown));
+  }
+  return out;
+}
+
+bool MaskPlanner::shown(const MaskPlan& plan, std::int64_t shown_ns) {
+  if (plan.newest_capture_ns == 0) return false;
+  return latencies_.add(plan.newest_capture_ns, shown_ns);
+}
+
+}  // namespace studio::projector
