@@ -70,6 +70,8 @@ TEST_F(WireTest, EveryTopicTypeRoundTripsThroughAnotherProcess) {
   round_trip<studio_ProjectorCalibration>(p, 12);
   round_trip<studio_ServiceStatus>(p, 13);
   round_trip<studio_SceneState>(p, 14);
+  round_trip<studio_ImageRequest>(p, 15);
+  round_trip<studio_ImageReply>(p, 16);
   EXPECT_TRUE(peer.running());
   EXPECT_EQ(peer.stop(), 0) << "peer did not exit cleanly on SIGTERM";
 }

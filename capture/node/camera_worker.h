@@ -19,6 +19,7 @@
 #include "capture/recorder.h"
 #include "capture/take_schedule.h"
 #include "capture_node.h"
+#include "image_ring.h"
 #include "wire/capture_convert.h"
 #include "keyer/config/kept_plates.h"
 #include "keyer/plate_keyer.h"
@@ -54,6 +55,8 @@ class CameraWorker {
 
   const std::string& id() const { return id_; }
   const std::optional<studio::Camera>& calibration() const { return calibration_; }
+  // The last second of frames, for frame-exact image requests (image_ring.h).
+  const ImageRing& ring() const { return ring_; }
 
   // Creates the keyer (with a plate kept from before a restart) and starts the source.
   Expected<void> start();
@@ -96,6 +99,7 @@ class CameraWorker {
   std::string id_;
   std::unique_ptr<FrameSource> source_;
   std::optional<studio::Camera> calibration_;
+  ImageRing ring_{25};
   // Grab thread only.
   std::optional<keyer::PlateKeyer> keyer_;
   RunMask mask_;

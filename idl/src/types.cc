@@ -36,6 +36,8 @@ constexpr std::array<TopicRow, kTopicCount> kTopicTable{{
 {R(projector_calibration, ProjectorCalibration), "studio/projector/calibration", kRel, kTL,  1,  0},
 {R(service_status, ServiceStatus),               "studio/service/status",        kBE,  kVol, 1,  3},
 {R(scene_state, SceneState),                     "studio/scene/state",           kRel, kTL,  1,  0},
+{R(image_request, ImageRequest),                 "studio/camera/image_request",  kRel, kVol, 32, 0},
+{R(image_reply, ImageReply),                     "studio/camera/image_reply",    kRel, kVol, 4,  0},
 }};
 // clang-format on
 #undef R

@@ -21,6 +21,8 @@ void fill(studio_SceneCommand& s, int seed);
 void fill(studio_ProjectorCalibration& s, int seed);
 void fill(studio_ServiceStatus& s, int seed);
 void fill(studio_SceneState& s, int seed);
+void fill(studio_ImageRequest& s, int seed);
+void fill(studio_ImageReply& s, int seed);
 
 bool same(const studio_CameraCalibration& a, const studio_CameraCalibration& b);
 bool same(const studio_AlphaMask& a, const studio_AlphaMask& b);
@@ -36,6 +38,8 @@ bool same(const studio_SceneCommand& a, const studio_SceneCommand& b);
 bool same(const studio_ProjectorCalibration& a, const studio_ProjectorCalibration& b);
 bool same(const studio_ServiceStatus& a, const studio_ServiceStatus& b);
 bool same(const studio_SceneState& a, const studio_SceneState& b);
+bool same(const studio_ImageRequest& a, const studio_ImageRequest& b);
+bool same(const studio_ImageReply& a, const studio_ImageReply& b);
 
 template <wire::WireType T>
 wire::Owned<T> make(int seed) {

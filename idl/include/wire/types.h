@@ -29,8 +29,10 @@ enum class TopicId : uint8_t {
   projector_calibration,
   service_status,
   scene_state,
+  image_request,
+  image_reply,
 };
-inline constexpr std::size_t kTopicCount = 14;
+inline constexpr std::size_t kTopicCount = 16;
 
 // Why a received sample was rejected (counted per reason by every Reader).
 enum class Reject : uint8_t {
@@ -77,6 +79,8 @@ Verdict validate(const studio_SceneCommand& s);
 Verdict validate(const studio_ProjectorCalibration& s);
 Verdict validate(const studio_ServiceStatus& s);
 Verdict validate(const studio_SceneState& s);
+Verdict validate(const studio_ImageRequest& s);
+Verdict validate(const studio_ImageReply& s);
 
 template <class T>
 struct TopicTraits;  // specialised below for every topic type only
@@ -103,6 +107,8 @@ STUDIO_WIRE_TOPIC(SceneCommand, scene_command)
 STUDIO_WIRE_TOPIC(ProjectorCalibration, projector_calibration)
 STUDIO_WIRE_TOPIC(ServiceStatus, service_status)
 STUDIO_WIRE_TOPIC(SceneState, scene_state)
+STUDIO_WIRE_TOPIC(ImageRequest, image_request)
+STUDIO_WIRE_TOPIC(ImageReply, image_reply)
 #undef STUDIO_WIRE_TOPIC
 
 template <class T>

@@ -70,6 +70,8 @@ struct StudioOptions {
   double projection_strength = 0.12;
   Image<Rgb8> projection;        // the projected picture; empty = a built-in test scene
 
+  bool frame_code = false;  // the actor wears the frame number (sim/frame_code.h)
+
   int threads = 2;  // render_all() threads over cameras
 
   Expected<void> validate() const;
