@@ -36,6 +36,8 @@ void main() {
   gl_Position = clip_from_world * vec4(world, 1);
 })";
 // Slots: clip (the camera's clip_from_world), cam (cam_from_world), colour and depth textures.
+// Slots 0..2: clip (the camera's clip_from_world), cam (cam_from_world), colour and depth
+// textures (separate uniforms: GLSL 3.30 cannot index sampler arrays with a loop variable).
 constexpr const char* kDrawFs = R"(#version 330 core
 in vec3 p;
 in vec3 n;
@@ -46,31 +48,34 @@ uniform float tolerance;
 uniform float weight[3];
 uniform mat4 clip[3];
 uniform mat4 cam[3];
-uniform sampler2D colour[3];
-uniform sampler2D depth[3];
+uniform sampler2D colour0, colour1, colour2;
+uniform sampler2D depth0, depth1, depth2;
 out vec4 frag;
 vec3 shade(vec3 c) {
   vec3 nn = normalize(n);
   float l = 0.45 + 0.55 * abs(dot(nn, normalize(vec3(0.4, 1.0, 0.5))));
   return c * l;
 }
+void add(int i, sampler2D colour, sampler2D depth, inout vec3 sum, inout float wsum) {
+  if (weight[i] <= 0.0) return;
+  vec4 q = clip[i] * vec4(p, 1);
+  if (q.w <= 0.0) return;
+  vec3 ndc = q.xyz / q.w;
+  if (any(greaterThan(abs(ndc.xy), vec2(1.0)))) return;
+  float z = (cam[i] * vec4(p, 1)).z;
+  float seen = texture(depth, ndc.xy * 0.5 + 0.5).r;
+  if (z > seen + tolerance) return;  // another part of the actor is nearer to camera i
+  vec2 uv = vec2(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);  // image rows top first
+  sum += weight[i] * texture(colour, uv).rgb;
+  wsum += weight[i];
+}
 void main() {
   if (textured == 0) { frag = vec4(shade(flat_colour), 1); return; }
   vec3 sum = vec3(0);
   float wsum = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    if (weight[i] <= 0.0) continue;
-    vec4 q = clip[i] * vec4(p, 1);
-    if (q.w <= 0.0) continue;
-    vec3 ndc = q.xyz / q.w;
-    if (any(greaterThan(abs(ndc.xy), vec2(1.0)))) continue;
-    float z = (cam[i] * vec4(p, 1)).z;
-    float seen = texture(depth[i], ndc.xy * 0.5 + 0.5).r;
-    if (z > seen + tolerance) continue;  // another part of the actor is nearer to camera i
-    vec2 uv = vec2(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);  // image rows top first
-    sum += weight[i] * texture(colour[i], uv).rgb;
-    wsum += weight[i];
-  }
+  add(0, colour0, depth0, sum, wsum);
+  add(1, colour1, depth1, sum, wsum);
+  add(2, colour2, depth2, sum, wsum);
   frag = vec4(wsum > 0.0 ? sum / wsum : shade(unseen), 1);
 })";
 
@@ -317,10 +322,10 @@ void ActorTexturer::draw(const Eigen::Matrix4d& clip_from_world,
     set_matrix(p, ("cam" + k).c_str(), s.cam);
     glActiveTexture(GL_TEXTURE0 + 2 * i);
     glBindTexture(GL_TEXTURE_2D, s.colour);
-    glUniform1i(glGetUniformLocation(p, ("colour" + k).c_str()), 2 * i);
+    glUniform1i(glGetUniformLocation(p, ("colour" + std::to_string(i)).c_str()), 2 * i);
     glActiveTexture(GL_TEXTURE0 + 2 * i + 1);
     glBindTexture(GL_TEXTURE_2D, s.depth);
-    glUniform1i(glGetUniformLocation(p, ("depth" + k).c_str()), 2 * i + 1);
+    glUniform1i(glGetUniformLocation(p, ("depth" + std::to_string(i)).c_str()), 2 * i + 1);
   }
   r.draw_mesh();
   glActiveTexture(GL_TEXTURE0);

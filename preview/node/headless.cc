@@ -70,9 +70,14 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   if (!options.record.empty()) log.open(options.record + "/frames.jsonl");
   std::vector<uint8_t> rgba;
   const auto start = Clock::now();
-  const auto deadline = start + std::chrono::duration<double>(options.timeout_s);
+  const double limit_s = options.duration_s > 0 ? options.duration_s : options.timeout_s;
+  const auto deadline = start + std::chrono::duration<double>(limit_s);
   int drawn = 0;
   while (Clock::now() < deadline) {
+    if (options.frames > 0 && !(*pipeline)->has_work()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(3));
+      continue;
+    }
     target->bind();
     const FrameReport r = (*pipeline)->render(config.viewpoint, config.width, config.height, true);
     if (options.frames == 0) {
@@ -80,10 +85,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
       continue;
     }
-    if (!r.new_mesh) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-      continue;
-    }
+    if (!r.new_mesh) continue;
     ++drawn;
     if (!options.record.empty()) {
       target->read_rgba(rgba);
@@ -97,7 +99,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
       log << "]}\n";
       log.flush();
     }
-    if (drawn >= options.frames) break;
+    if (options.duration_s <= 0 && drawn >= options.frames) break;
   }
   target->bind();
   target->read_rgba(rgba);
@@ -106,20 +108,25 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (options.json)
     std::printf(
-        "{\"screenshot\":\"%s\",\"width\":%d,\"height\":%d,\"meshes_drawn\":%d,\"meshes\":%llu,"
-        "\"textured\":%llu,\"untextured\":%llu,\"seconds\":%.3f,\"renderer\":\"%s\"}\n",
-        options.screenshot.c_str(), config.width, config.height, drawn,
-        (unsigned long long)c.meshes, (unsigned long long)c.textured,
-        (unsigned long long)c.untextured, seconds, context->renderer().c_str());
+        "{\"screenshot\":\"%s\",\"width\":%d,\"height\":%d,\"meshes\":%llu,"
+        "\"textured\":%llu,\"untextured\":%llu,\"late\":%llu,\"refused\":%llu,"
+        "\"skipped\":%llu,\"seconds\":%.3f,\"renderer\":\"%s\"}\n",
+        options.screenshot.c_str(), config.width, config.height, (unsigned long long)c.meshes,
+        (unsigned long long)c.textured, (unsigned long long)c.untextured,
+        (unsigned long long)c.late, (unsigned long long)c.refused, (unsigned long long)c.skipped,
+        seconds, context->renderer().c_str());
   else
-    std::printf("%s: %dx%d, %d meshes drawn (%llu textured, %llu untextured) in %.1f s, %s\n",
-                options.screenshot.c_str(), config.width, config.height, drawn,
-                (unsigned long long)c.textured, (unsigned long long)c.untextured, seconds,
-                context->renderer().c_str());
+    std::printf(
+        "%s: %dx%d, %d meshes drawn (%llu textured, %llu untextured: %llu late, %llu refused; "
+        "%llu skipped) in %.1f s, %s\n",
+        options.screenshot.c_str(), config.width, config.height, drawn,
+        (unsigned long long)c.textured, (unsigned long long)c.untextured,
+        (unsigned long long)c.late, (unsigned long long)c.refused, (unsigned long long)c.skipped,
+        seconds, context->renderer().c_str());
   for (const auto& p : (*pipeline)->asset_problems()) std::fprintf(stderr, "asset: %s\n", p.c_str());
   node.stop();
   if (!written) return error("cannot write '" + options.screenshot + "'", 1);
-  if (drawn < options.frames)
+  if (options.duration_s <= 0 && drawn < options.frames)
     return error("only " + std::to_string(drawn) + " of " + std::to_string(options.frames) +
                      " meshes within " + std::to_string(int(options.timeout_s)) + " s",
                  1);

@@ -18,7 +18,8 @@ namespace {
 constexpr const char* kUsage =
     R"(usage: studio-preview [--config preview.yaml] [--viewpoint V] [--texturing blend|nearest]
                       [--size WxH]
-       studio-preview --headless --screenshot PNG [--frames N] [--record DIR] [--timeout S]
+       studio-preview --headless --screenshot PNG [--frames N | --duration S] [--record DIR]
+                      [--timeout S]
                       [--json] [same options]
 
 The director's preview and control panel: the virtual scene (studio/scene/node) and the live
@@ -38,6 +39,8 @@ Options:
   --record DIR      headless: every drawn mesh's frame as DIR/<n>.png plus DIR/frames.jsonl
                     ({"image", "source_frame", "textured", "cameras"} per line)
   --timeout S       headless: give up after S seconds (default 30)
+  --duration S      headless: draw every mesh that arrives for S seconds, then stop (instead
+                    of --frames)
   --json            headless: the summary as one JSON line
   --test-script F   GUI: scripted input for tests (gui.h: one action per line)
 
@@ -92,6 +95,8 @@ int run(int argc, char** argv) {
       h.record = value();
     } else if (a == "--timeout") {
       h.timeout_s = number<double>(a, value(), 0.1, 86400);
+    } else if (a == "--duration") {
+      h.duration_s = number<double>(a, value(), 0.1, 86400);
     } else if (a == "--json") {
       h.json = true;
     } else if (a == "--test-script") {

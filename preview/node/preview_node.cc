@@ -213,6 +213,11 @@ std::optional<LiveMesh> PreviewNode::mesh_after(uint64_t sequence) const {
   return *best;
 }
 
+uint64_t PreviewNode::mesh_sequence() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->mesh_sequence;
+}
+
 std::optional<scene::Scene> PreviewNode::scene_after(uint64_t& version) const {
   std::lock_guard lock(impl_->mutex);
   if (impl_->scene_version == version) return std::nullopt;
@@ -273,9 +278,8 @@ void PreviewNode::request_images(uint64_t frame, const std::vector<std::string>&
   }
 }
 
-std::optional<std::vector<FrameImage>> PreviewNode::images(uint64_t frame,
-                                                           const std::vector<std::string>& cameras,
-                                                           std::chrono::milliseconds wait) {
+std::expected<std::vector<FrameImage>, PreviewNode::Missing> PreviewNode::images(
+    uint64_t frame, const std::vector<std::string>& cameras, std::chrono::milliseconds wait) {
   std::unique_lock lock(impl_->mutex);
   auto ready = [&] {
     for (const auto& c : cameras)
@@ -288,7 +292,7 @@ std::optional<std::vector<FrameImage>> PreviewNode::images(uint64_t frame,
     return false;
   };
   impl_->changed.wait_for(lock, wait, [&] { return ready() || refused(); });
-  if (!ready()) return std::nullopt;
+  if (!ready()) return std::unexpected(refused() ? Missing::refused : Missing::late);
   std::vector<FrameImage> out;
   for (const auto& c : cameras) out.push_back(impl_->images.at({c, frame}));
   return out;

@@ -19,6 +19,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <expected>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -80,6 +81,7 @@ class PreviewNode : public runtime::Node {
   // Snapshots (copies) for the render and GUI thread.
   std::map<std::string, Camera> cameras() const;
   std::optional<LiveMesh> mesh_after(uint64_t sequence) const;  // newest, if newer than sequence
+  uint64_t mesh_sequence() const;  // of the newest mesh (0: none yet)
   // The scene mirror, rebuilt when it changed since `version` (nullopt: unchanged).
   std::optional<scene::Scene> scene_after(uint64_t& version) const;
   std::vector<CameraStateView> camera_states() const;
@@ -88,10 +90,12 @@ class PreviewNode : public runtime::Node {
   // Requests the images of `frame` from the named cameras (those not already here).
   void request_images(uint64_t frame, const std::vector<std::string>& cameras);
   // The images of exactly `frame` of every named camera, once all have arrived; waits up to
-  // `wait`. nullopt: missing (late, evicted from the capture ring, or no reply).
-  std::optional<std::vector<FrameImage>> images(uint64_t frame,
-                                                const std::vector<std::string>& cameras,
-                                                std::chrono::milliseconds wait);
+  // `wait`. Missing: `refused` (a capture server answered EVICTED or NOT_YET) or late (no reply
+  // yet).
+  enum class Missing { late, refused };
+  std::expected<std::vector<FrameImage>, Missing> images(uint64_t frame,
+                                                         const std::vector<std::string>& cameras,
+                                                         std::chrono::milliseconds wait);
 
   Expected<void> send_control(const std::string& camera, const std::string& feature, double value);
   Expected<void> send_capture(const std::string& take, bool start, uint64_t at_frame);

@@ -63,10 +63,7 @@ struct ViewPipeline::Impl {
   void take_new_mesh(const Viewpoint& view) {
     auto m = node->mesh_after(mesh_sequence);
     if (!m) return;
-    if (pending) {  // superseded before its images came: counted untextured, never drawn
-      ++counts.meshes;
-      ++counts.untextured;
-    }
+    if (pending) ++counts.skipped;  // superseded before its images came: never drawn
     mesh_sequence = m->sequence;
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
     for (const auto& v : m->mesh.vertices) {
@@ -101,12 +98,14 @@ struct ViewPipeline::Impl {
     if (!pending) return false;
     const auto waited = std::chrono::steady_clock::now() - pending_since;
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(options.wait - waited);
+    using Missing = PreviewNode::Missing;
     const auto imgs = pending_cameras.empty()
-                          ? std::nullopt
+                          ? std::expected<std::vector<FrameImage>, Missing>(
+                                std::unexpected(Missing::refused))
                           : node->images(pending->source_frame, pending_cameras,
                                          block ? std::max(left, std::chrono::milliseconds(0))
                                                : std::chrono::milliseconds(0));
-    if (!imgs && waited < options.wait) return false;
+    if (!imgs && imgs.error() == Missing::late && waited < options.wait) return false;
     if (auto ok = texturer.set_mesh(pending->mesh); !ok) {
       STUDIO_LOG(warn, "preview") << "mesh: " << ok.error().message;
       pending.reset();
@@ -132,6 +131,7 @@ struct ViewPipeline::Impl {
     have_current = true;
     ++counts.meshes;
     ++(textured ? counts.textured : counts.untextured);
+    if (!imgs) ++(imgs.error() == Missing::late ? counts.late : counts.refused);
     pending.reset();
     return true;
   }
@@ -173,6 +173,9 @@ FrameReport ViewPipeline::render(const Viewpoint& view, int width, int height, b
 }
 
 const PipelineCounts& ViewPipeline::counts() const { return impl_->counts; }
+bool ViewPipeline::has_work() const {
+  return impl_->pending || impl_->node->mesh_sequence() > impl_->mesh_sequence;
+}
 std::vector<std::string> ViewPipeline::asset_problems() const { return impl_->problems; }
 Eigen::Vector3d ViewPipeline::actor_centre() const { return impl_->centre; }
 void ViewPipeline::set_blend(bool blend) { impl_->options.blend = blend; }

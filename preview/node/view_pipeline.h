@@ -38,8 +38,11 @@ struct FrameReport {
   std::vector<float> weights;
 };
 
+// meshes = drawn meshes = textured + untextured; untextured = late (no reply within `wait`) +
+// refused (a capture server no longer or not yet had the frame); skipped: meshes superseded by
+// a newer one while their images were on the way (never drawn).
 struct PipelineCounts {
-  uint64_t meshes = 0, textured = 0, untextured = 0;
+  uint64_t meshes = 0, textured = 0, untextured = 0, late = 0, refused = 0, skipped = 0;
 };
 
 class ViewPipeline {
@@ -52,6 +55,8 @@ class ViewPipeline {
   // images of a new mesh here (headless); else return at once and look again next frame (GUI).
   FrameReport render(const Viewpoint& view, int width, int height, bool block);
   const PipelineCounts& counts() const;
+  // A mesh is waiting for its images or a newer one has arrived (render() has work).
+  bool has_work() const;
   // Assets the scene names that could not be loaded, one line each.
   std::vector<std::string> asset_problems() const;
   // The newest mesh's centre (for orbiting), or the origin.
