@@ -5,13 +5,15 @@
 //    textured; the scene (the museum, from studio/scene/node) is drawn around the actor;
 //  - quality against truth: a held-out camera that feeds nothing; the preview from its pose vs
 //    the simulator's image of that camera over the union of the true and rendered silhouettes,
-//    PSNR of nearest-camera texturing and of the blend: the blend beats nearest and reaches 28 dB.
+//    PSNR of nearest-camera texturing and of the blend: the blend beats nearest (the issue's
+//    28 dB is not reached yet: see the test).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <regex>
 
 #include "preview/viewpoint.h"
@@ -125,6 +127,106 @@ TEST_F(PreviewStudioTest, TexturesEveryMeshWithTheImagesOfItsOwnFrame) {
       background += std::abs(c[0] - 18) <= 2 && std::abs(c[1] - 13) <= 2 && std::abs(c[2] - 13) <= 2;
     }
   EXPECT_LT(background, shot.rows * shot.cols / 2) << "the museum is not drawn";
+}
+
+// PSNR over the union of the true silhouette (the simulator's mask of the held-out camera) and
+// the rendered one (pixels that are not the renderer's clear colour), pooled over the frames.
+struct Score {
+  double squared = 0;
+  uint64_t samples = 0;
+  int frames = 0;
+  // Pixels by where they fall: both silhouettes, only the rendered, only the true.
+  uint64_t both = 0, rendered_only = 0, true_only = 0;
+  double squared_both = 0;
+  double psnr() const { return 10 * std::log10(255.0 * 255.0 / (squared / double(samples))); }
+};
+
+Score score(const std::vector<Record>& records, const std::filesystem::path& dir,
+            const sim::SimulatedStudio& truth_studio) {
+  Score s;
+  Image<Rgb8> truth;
+  Mask mask;
+  for (const Record& r : records) {
+    if (!r.textured) continue;
+    const cv::Mat img = cv::imread((dir / r.image).string(), cv::IMREAD_COLOR);
+    if (img.empty()) continue;
+    truth_studio.render(0, int64_t(r.source_frame), &truth, &mask);
+    if (img.cols != truth.width() || img.rows != truth.height()) continue;
+    if (s.frames == 0) {  // the first pair, for a person looking at a failure
+      cv::Mat t(truth.height(), truth.width(), CV_8UC3, truth.data()), bgr;
+      cv::cvtColor(t, bgr, cv::COLOR_RGB2BGR);
+      cv::imwrite((dir / ("truth-" + r.image)).string(), bgr);
+    }
+    ++s.frames;
+    for (int y = 0; y < img.rows; ++y)
+      for (int x = 0; x < img.cols; ++x) {
+        const cv::Vec3b c = img.at<cv::Vec3b>(y, x);
+        const bool rendered = !(std::abs(c[0] - 18) <= 2 && std::abs(c[1] - 13) <= 2 &&
+                                std::abs(c[2] - 13) <= 2);
+        if (!rendered && !mask(x, y)) continue;
+        const Rgb8 t = truth(x, y);
+        const double d[3] = {double(c[2]) - t.r, double(c[1]) - t.g, double(c[0]) - t.b};
+        const double e = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        s.squared += e;
+        s.samples += 3;
+        if (rendered && mask(x, y)) {
+          ++s.both;
+          s.squared_both += e;
+        } else {
+          ++(rendered ? s.rendered_only : s.true_only);
+        }
+      }
+  }
+  return s;
+}
+
+TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
+  // No scene: the preview's background is the clear colour. The plain actor (no frame code: its
+  // sharp bands are a test artefact, not studio content).
+  // Eight ring cameras + overhead: the hull of four at 90 degrees is a poor solid between them.
+  start_studio(false, false, 9);
+  // Held out: between cam0 (azimuth 0) and cam1 (45), lower than the ring; it feeds nothing.
+  const double az = 20 * std::numbers::pi / 180;
+  const Eigen::Vector3d centre(3.6 * std::sin(az), 1.8, 3.6 * std::cos(az)), target(0, 1.1, 0);
+  const double focal = 560.0 * kWidth / 704.0;
+  const Camera held = support::look_at_camera("held", centre, target, Eigen::Vector3d::UnitY(),
+                                              kWidth, kHeight, focal);
+  const Viewpoint view{centre, target, 2 * std::atan(0.5 * kHeight / focal) * 180 / std::numbers::pi};
+  std::map<std::string, Process*> previews;
+  for (const std::string mode : {"nearest", "blend"})
+    previews[mode] = &spawn(mode, "preview/studio-preview",
+                            {"--headless", "--config", preview_config(mode), "--viewpoint",
+                             to_string(view), "--texturing", mode, "--size",
+                             std::to_string(kWidth) + "x" + std::to_string(kHeight),
+                             "--frames", "16", "--timeout", "120", "--record",
+                             (dir_ / mode).string(), "--screenshot",
+                             (dir_ / (mode + ".png")).string()});
+  for (auto& [mode, p] : previews) {
+    const auto code = p->wait_exit(std::chrono::seconds(150));
+    ASSERT_TRUE(code.has_value()) << mode;
+    ASSERT_EQ(*code, 0) << p->log();
+  }
+  sim::StudioOptions o;
+  o.threads = 1;
+  auto truth = sim::SimulatedStudio::create({held}, o).value();
+  const Score nearest = score(read_records(dir_ / "nearest" / "frames.jsonl"), dir_ / "nearest", truth);
+  const Score blend = score(read_records(dir_ / "blend" / "frames.jsonl"), dir_ / "blend", truth);
+  std::printf("held-out camera, union of silhouettes: nearest %.2f dB (%d frames), blend %.2f dB "
+              "(%d frames)\n",
+              nearest.psnr(), nearest.frames, blend.psnr(), blend.frames);
+  for (const Score* sc : {&nearest, &blend})
+    std::printf("  pixels in both silhouettes %llu (%.2f dB there), only rendered %llu, only true "
+                "%llu\n",
+                (unsigned long long)sc->both,
+                10 * std::log10(255.0 * 255 / (sc->squared_both / (3.0 * sc->both))),
+                (unsigned long long)sc->rendered_only, (unsigned long long)sc->true_only);
+  ASSERT_GE(nearest.frames, 12);
+  ASSERT_GE(blend.frames, 12);
+  EXPECT_GT(blend.psnr(), nearest.psnr());
+  // Issue 16 asks for >= 28 dB; measured here ~19.5 dB for the blend (~24.5 dB inside both
+  // silhouettes): the visual hull's excess over the actor (drawn in actor colours where the
+  // held-out camera sees the backing) and its misregistration cost the rest. Not reached yet:
+  // the number is printed above and reported, not asserted.
 }
 
 }  // namespace

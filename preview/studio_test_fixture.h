@@ -1,6 +1,6 @@
 #pragma once
 // A simulated studio as real processes on loopback for the preview's tests: one studio-capture
-// with the five cameras of a 4 + overhead ring at 352x288 (the actor wears the frame code,
+// with the cameras of a ring + overhead (default 4 + 1) at 352x288 (the actor wears the frame code,
 // sim/frame_code.h), studio-hull, optionally studio-scene with the default museum, and
 // studio-preview instances. Like tests/harness/fixture.h's ProcessTest, with a watchdog long
 // enough for a 40-second run on a loaded 2-core machine.
@@ -53,26 +53,29 @@ class PreviewStudioTest : public ::testing::Test {
     return processes_.back();
   }
 
-  static sim::RingOptions ring() {
+  static sim::RingOptions ring(int count = 5) {
     sim::RingOptions r;
-    r.count = 5;
+    r.count = count;
     r.width = kWidth;
     r.height = kHeight;
     r.focal_px *= double(kWidth) / 704.0;
     return r;
   }
-  std::vector<Camera> cameras() const { return sim::ring_cameras(ring()); }
+  std::vector<Camera> cameras(int count = 5) const { return sim::ring_cameras(ring(count)); }
 
-  // capture (5 cameras) + hull, and the scene server when `scene`; waits until each is ready.
-  void start_studio(bool scene) {
+  // capture (5 cameras; the actor wears the frame code when `frame_code`) + hull, and the scene
+  // server when `scene`; waits until each is ready.
+  // `count` cameras: count - 1 on the ring and one overhead.
+  void start_studio(bool scene, bool frame_code = true, int count = 5) {
     const auto rig = dir_ / "rig.yaml";
-    ASSERT_TRUE(support::write_rig_yaml(cameras(), rig));
+    ASSERT_TRUE(support::write_rig_yaml(cameras(count), rig));
     std::ofstream cap(dir_ / "capture.yaml");
     cap << "instance: cams\nclock: {fps: 25}\ntakes_dir: takes\nstate_period: 0.5\n"
            "image: {rate: 0}\ncameras:\n";
-    for (int i = 0; i < 5; ++i)
-      cap << "  - id: cam" << i << "\n    source: {type: sim, ring: 5, index: " << i
-          << ", width: " << kWidth << ", height: " << kHeight << ", frame_code: true}\n";
+    for (int i = 0; i < count; ++i)
+      cap << "  - id: cam" << i << "\n    source: {type: sim, ring: " << count << ", index: " << i
+          << ", width: " << kWidth << ", height: " << kHeight
+          << ", frame_code: " << (frame_code ? "true" : "false") << "}\n";
     cap.close();
     std::ofstream(dir_ / "hull.yaml")
         << "instance: hull\nhull:\n  rig: rig.yaml\n  box: [-1.5, 0.0, -1.5, 1.5, 2.4, 1.5]\n"

@@ -45,6 +45,7 @@ uniform int textured;
 uniform vec3 flat_colour;
 uniform vec3 unseen;
 uniform float tolerance;
+uniform float key_margin;
 uniform float weight[3];
 uniform mat4 clip[3];
 uniform mat4 cam[3];
@@ -56,7 +57,11 @@ vec3 shade(vec3 c) {
   float l = 0.45 + 0.55 * abs(dot(nn, normalize(vec3(0.4, 1.0, 0.5))));
   return c * l;
 }
-void add(int i, sampler2D colour, sampler2D depth, inout vec3 sum, inout float wsum) {
+// The cyclorama's key (keyer/: blue exceeds red and green by a margin): a camera whose pixel
+// at the point is backing blue sees past the actor there (the hull is larger than the actor).
+bool backing(vec3 c) { return c.b > c.r + key_margin && c.b > c.g + key_margin; }
+void add(int i, sampler2D colour, sampler2D depth, inout vec3 sum, inout float wsum,
+         inout int keyed) {
   if (weight[i] <= 0.0) return;
   vec4 q = clip[i] * vec4(p, 1);
   if (q.w <= 0.0) return;
@@ -66,16 +71,20 @@ void add(int i, sampler2D colour, sampler2D depth, inout vec3 sum, inout float w
   float seen = texture(depth, ndc.xy * 0.5 + 0.5).r;
   if (z > seen + tolerance) return;  // another part of the actor is nearer to camera i
   vec2 uv = vec2(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);  // image rows top first
-  sum += weight[i] * texture(colour, uv).rgb;
+  vec3 c = texture(colour, uv).rgb;
+  if (backing(c)) { keyed += 1; return; }
+  sum += weight[i] * c;
   wsum += weight[i];
 }
 void main() {
   if (textured == 0) { frag = vec4(shade(flat_colour), 1); return; }
   vec3 sum = vec3(0);
   float wsum = 0.0;
-  add(0, colour0, depth0, sum, wsum);
-  add(1, colour1, depth1, sum, wsum);
-  add(2, colour2, depth2, sum, wsum);
+  int keyed = 0;
+  add(0, colour0, depth0, sum, wsum, keyed);
+  add(1, colour1, depth1, sum, wsum, keyed);
+  add(2, colour2, depth2, sum, wsum, keyed);
+  if (wsum == 0.0 && keyed > 0) discard;  // every camera that sees the point sees the backing
   frag = vec4(wsum > 0.0 ? sum / wsum : shade(unseen), 1);
 })";
 
@@ -239,6 +248,10 @@ Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const u
   if (camera.width < 1 || camera.height < 1 || !rgb)
     return fail("actor texturer: camera " + camera.id + " without an image");
   Slot& s = impl_->slots[slot];
+  // The caller's framebuffer and viewport, restored at the end (creating the slot binds its own).
+  GLint previous_fbo = 0, viewport[4];
+  glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous_fbo);
+  glGetIntegerv(GL_VIEWPORT, viewport);
   if (s.width != camera.width || s.height != camera.height) {
     if (!s.colour) {
       glGenTextures(1, &s.colour);
@@ -266,8 +279,10 @@ Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const u
     glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, s.depth, 0);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, s.depth_rb);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous_fbo));
       return fail("actor texturer: depth framebuffer incomplete");
+    }
   }
   glBindTexture(GL_TEXTURE_2D, s.colour);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
@@ -275,9 +290,6 @@ Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const u
   s.cam = cam_from_world(camera);
   s.clip = clip_from_camera(camera) * s.cam;
   // Visibility: the nearest depth of the mesh along every pixel's ray of this camera.
-  GLint previous_fbo = 0, viewport[4];
-  glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous_fbo);
-  glGetIntegerv(GL_VIEWPORT, viewport);
   glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
   glViewport(0, 0, s.width, s.height);
   const float far_depth[4] = {1e9f, 0, 0, 0};
@@ -313,6 +325,7 @@ void ActorTexturer::draw(const Eigen::Matrix4d& clip_from_world,
   glUniform3fv(glGetUniformLocation(p, "flat_colour"), 1, r.options.untextured.data());
   glUniform3fv(glGetUniformLocation(p, "unseen"), 1, r.options.unseen.data());
   glUniform1f(glGetUniformLocation(p, "tolerance"), r.options.depth_tolerance_m);
+  glUniform1f(glGetUniformLocation(p, "key_margin"), r.options.key_margin);
   for (int i = 0; i < kMaxCameras; ++i) {
     const Slot& s = r.slots[i];
     const std::string k = "[" + std::to_string(i) + "]";

@@ -6,9 +6,13 @@
 //   visible_i(x): x projects inside camera i's image, in front of it, and no other part of the
 //                 mesh is nearer to camera i along that ray (a depth map of the mesh rendered
 //                 from camera i, tolerance `depth_tolerance_m`);
-//   colour(x)   = sum_i w_i visible_i(x) image_i(proj_i(x)) / sum_i w_i visible_i(x),
-// with the weights of camera_select.h (nearest: one camera of weight 1). A point no selected
-// camera sees is drawn in `unseen` (flat); an untextured draw (no images of the mesh's frame)
+//   backing_i(x): camera i's pixel at x is the blue backing (blue above red and green by
+//                 `key_margin`, the chroma key's rule): camera i sees past the actor there;
+//   colour(x)   = sum_i w_i v_i(x) image_i(proj_i(x)) / sum_i w_i v_i(x), v_i = visible_i and
+//                 not backing_i,
+// with the weights of camera_select.h (nearest: one camera of weight 1). A point every camera
+// that sees it sees as backing is not drawn (the visual hull's excess over the actor); a point
+// no selected camera sees is drawn in `unseen` (flat); an untextured draw (no images of the mesh's frame)
 // draws the whole mesh flat-shaded in `untextured`.
 // Cameras are pinholes (K, cam_from_world, image size; the paper's radial distortion is
 // ignored here: below a pixel for the studio's lenses at the preview's scale).
@@ -28,6 +32,7 @@ namespace studio::preview {
 
 struct TexturerOptions {
   float depth_tolerance_m = 0.03f;
+  float key_margin = 0.2f;  // of full scale: the backing is blue above red and green by this
   Eigen::Vector3f unseen{0.35f, 0.35f, 0.35f};
   Eigen::Vector3f untextured{0.75f, 0.72f, 0.68f};
 };
