@@ -53,6 +53,16 @@ class PreviewStudioTest : public ::testing::Test {
     return processes_.back();
   }
 
+  // A program outside the build tree (xvfb-run).
+  Process& spawn_path(const std::string& name, const std::filesystem::path& binary,
+                      std::vector<std::string> args) {
+    auto p = Process::start(
+        {.name = name, .binary = binary, .args = std::move(args), .env = dds_.env(), .dir = dir_});
+    if (!p) throw std::runtime_error(p.error().message);
+    processes_.push_back(std::move(*p));
+    return processes_.back();
+  }
+
   static sim::RingOptions ring(int count = 5) {
     sim::RingOptions r;
     r.count = count;
