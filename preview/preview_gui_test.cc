@@ -11,7 +11,7 @@
 #include <regex>
 #include <thread>
 
-#include "studio_test_fixture.h"
+#include "testing/studio_fixture.h"
 #include "wire/endpoint.h"
 
 namespace studio::preview::testing {

@@ -9,6 +9,7 @@
 //    28 dB is not reached yet: see the test).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -20,7 +21,7 @@
 #include "scene/view.h"
 #include "sim/frame_code.h"
 #include "sim/studio.h"
-#include "studio_test_fixture.h"
+#include "testing/studio_fixture.h"
 
 namespace studio::preview::testing {
 namespace {
@@ -72,6 +73,33 @@ std::optional<int> decode_preview(const cv::Mat& bgr, const Viewpoint& view,
     digits.push_back(sim::frame_code::classify(sum[0] / 9, sum[1] / 9, sum[2] / 9));
   }
   return sim::frame_code::decode(digits);
+}
+
+TEST_F(PreviewStudioTest, BadInputIsOneLineAndExitTwo) {
+  std::ofstream(dir_ / "bad.yaml") << "instance: x\ntexturing: sharpest\n";
+  std::ofstream(dir_ / "unknown.yaml") << "instance: x\nzoom: 3\n";
+  const std::vector<std::vector<std::string>> cases{
+      {"--config", (dir_ / "bad.yaml").string(), "--headless", "--screenshot", "a.png"},
+      {"--config", (dir_ / "unknown.yaml").string(), "--headless", "--screenshot", "a.png"},
+      {"--config", (dir_ / "missing.yaml").string()},
+      {"--viewpoint", "eye=1,2,at=0,0,0", "--headless", "--screenshot", "a.png"},
+      {"--headless"},
+      {"--frames", "-3", "--headless", "--screenshot", "a.png"},
+      {"--screenshot", "a.png"},
+      {"--bogus"}};
+  for (const auto& args : cases) {
+    Process& p = spawn("bad", "preview/studio-preview", args);
+    const auto code = p.wait_exit(std::chrono::seconds(20));
+    ASSERT_TRUE(code.has_value());
+    EXPECT_EQ(*code, 2) << args[0] << " " << p.log();
+    const std::string log = p.log();
+    EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
+    EXPECT_EQ(log.rfind("studio-preview: ", 0), 0u) << log;
+  }
+  // Positive control: a good config and --help succeed.
+  Process& help = spawn("help", "preview/studio-preview", {"--help"});
+  EXPECT_EQ(help.wait_exit(std::chrono::seconds(20)), 0);
+  EXPECT_NE(help.log().find("--headless"), std::string::npos);
 }
 
 TEST_F(PreviewStudioTest, TexturesEveryMeshWithTheImagesOfItsOwnFrame) {
