@@ -76,8 +76,8 @@ Fixture& fixture() {
     for (const auto& [p, a] : cache.all()) (void)r.upload(*a);
     auto t = preview::ActorTexturer::create().value();
     auto target = scene_render::RenderTarget::create(kW, kH).value();
-    auto* out = new Fixture{std::move(*ctx), std::move(*s), std::move(r), std::move(t),
-                            std::move(target), {}};
+    auto* out = new Fixture{std::move(*ctx), std::move(*s),     std::move(r),
+                            std::move(t),    std::move(target), {}};
     out->samples[352] = make_samples(352);
     out->samples[704] = make_samples(704);
     return out;
@@ -119,7 +119,8 @@ void BM_PreviewFrame(benchmark::State& state) {
     if (cameras > 0) f.texturer.draw(v.clip_from_cam * v.cam_from_world, w, true, kW, kH);
     glFinish();
   }
-  state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["fps"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["triangles"] = double(s.mesh.triangles.size());
 }
 BENCHMARK(BM_PreviewFrame)

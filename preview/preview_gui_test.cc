@@ -24,7 +24,8 @@ std::string slurp(const std::filesystem::path& p) {
 
 // [x, y, w, h(, value)] of `key` in the layout file.
 std::vector<double> rect(const std::string& json, const std::string& key) {
-  const std::regex re("\"" + key + "\":\\[([-0-9.e]+),([-0-9.e]+),([-0-9.e]+),([-0-9.e]+)(,([-0-9.e]+))?\\]");
+  const std::regex re("\"" + key +
+                      "\":\\[([-0-9.e]+),([-0-9.e]+),([-0-9.e]+),([-0-9.e]+)(,([-0-9.e]+))?\\]");
   std::smatch m;
   if (!std::regex_search(json, m, re)) return {};
   std::vector<double> out;
@@ -51,7 +52,8 @@ TEST_F(PreviewStudioTest, GuiPanelsDriveTheStudioAndTwoViewsRunSideBySide) {
   auto states = wire::Reader<studio_CameraState>::create(p, topic).value();
   const std::string director = (dir_ / "director.txt").string(), op = (dir_ / "op.txt").string();
   std::ofstream(director) << "wait_meshes 3\nopen cameras\nwait 2\nset cam0 Gain 7.5\nwait 2\n"
-                             "screenshot " << (dir_ / "director.png").string() << "\nquit\n";
+                             "screenshot "
+                          << (dir_ / "director.png").string() << "\nquit\n";
   std::ofstream(op) << "wait_meshes 3\nwait 1\nscreenshot " << (dir_ / "operator.png").string()
                     << "\nquit\n";
   std::map<std::string, Process*> guis;
@@ -59,11 +61,11 @@ TEST_F(PreviewStudioTest, GuiPanelsDriveTheStudioAndTwoViewsRunSideBySide) {
       {"director", "eye=0.6,1.9,3.7,at=0,1.1,0,fov=55"},
       {"operator", "eye=-3.5,2.5,1.0,at=0,1.0,0,fov=60"}};
   for (const auto& [name, view] : views)
-    guis[name] = &spawn_path(
-        name, "/usr/bin/xvfb-run",
-        {"-a", "-s", "-screen 0 1024x768x24", studio::testing::built_binary("preview/studio-preview").string(),
-         "--config", preview_config(name), "--viewpoint", view, "--size", "960x640",
-         "--test-script", name == "director" ? director : op});
+    guis[name] = &spawn_path(name, "/usr/bin/xvfb-run",
+                             {"-a", "-s", "-screen 0 1024x768x24",
+                              studio::testing::built_binary("preview/studio-preview").string(),
+                              "--config", preview_config(name), "--viewpoint", view, "--size",
+                              "960x640", "--test-script", name == "director" ? director : op});
   for (auto& [name, g] : guis) {
     const auto code = g->wait_exit(std::chrono::seconds(150));
     ASSERT_TRUE(code.has_value()) << name << " did not finish";
@@ -100,7 +102,8 @@ TEST_F(PreviewStudioTest, GuiPanelsDriveTheStudioAndTwoViewsRunSideBySide) {
   for (int y = 0; y < shot.rows; ++y)
     for (int x = 0; x < shot.cols; ++x) {
       const cv::Vec3b c = shot.at<cv::Vec3b>(y, x);
-      background += std::abs(c[0] - 18) <= 2 && std::abs(c[1] - 13) <= 2 && std::abs(c[2] - 13) <= 2;
+      background +=
+          std::abs(c[0] - 18) <= 2 && std::abs(c[1] - 13) <= 2 && std::abs(c[2] - 13) <= 2;
       const cv::Vec3b d = other.at<cv::Vec3b>(y, x);
       differ += std::abs(c[0] - d[0]) + std::abs(c[1] - d[1]) + std::abs(c[2] - d[2]) > 30;
     }

@@ -38,8 +38,7 @@ std::vector<Record> read_records(const std::filesystem::path& file) {
   const std::regex re(R"re("image":"([^"]+)","source_frame":(\d+),"textured":(true|false))re");
   for (std::string line; std::getline(in, line);) {
     std::smatch m;
-    if (std::regex_search(line, m, re))
-      out.push_back({m[1], std::stoull(m[2]), m[3] == "true"});
+    if (std::regex_search(line, m, re)) out.push_back({m[1], std::stoull(m[2]), m[3] == "true"});
   }
   return out;
 }
@@ -116,11 +115,13 @@ TEST_F(PreviewStudioTest, TexturesEveryMeshWithTheImagesOfItsOwnFrame) {
   ASSERT_EQ(*code, 0) << p.log();
   const auto records = read_records(rec / "frames.jsonl");
   ASSERT_GE(records.size(), 10u) << p.log();
-  auto studio = sim::SimulatedStudio::create(cameras(), [] {
-                  sim::StudioOptions o;
-                  o.frame_code = true;
-                  return o;
-                }()).value();
+  auto studio = sim::SimulatedStudio::create(cameras(),
+                                             [] {
+                                               sim::StudioOptions o;
+                                               o.frame_code = true;
+                                               return o;
+                                             }())
+                    .value();
   int textured = 0, decoded = 0, mismatched = 0;
   for (const Record& r : records) {
     if (!r.textured) continue;
@@ -137,10 +138,10 @@ TEST_F(PreviewStudioTest, TexturesEveryMeshWithTheImagesOfItsOwnFrame) {
     }
   }
   const uint64_t span = records.back().source_frame - records.front().source_frame;
-  std::printf("frame-exact: %zu meshes drawn over %llu studio frames, %d textured, %d decoded "
-              "from the rendered pixels, %d mismatched\n%s\n",
-              records.size(), (unsigned long long)span, textured, decoded, mismatched,
-              p.log().c_str());
+  std::printf(
+      "frame-exact: %zu meshes drawn over %llu studio frames, %d textured, %d decoded "
+      "from the rendered pixels, %d mismatched\n%s\n",
+      records.size(), (unsigned long long)span, textured, decoded, mismatched, p.log().c_str());
   EXPECT_EQ(mismatched, 0);
   EXPECT_GE(span, 1000u) << "the run must cover >= 1000 studio frames";
   EXPECT_GE(textured, int(std::ceil(0.95 * double(records.size()))));
@@ -152,7 +153,8 @@ TEST_F(PreviewStudioTest, TexturesEveryMeshWithTheImagesOfItsOwnFrame) {
   for (int y = 0; y < shot.rows; ++y)
     for (int x = 0; x < shot.cols; ++x) {
       const cv::Vec3b c = shot.at<cv::Vec3b>(y, x);
-      background += std::abs(c[0] - 18) <= 2 && std::abs(c[1] - 13) <= 2 && std::abs(c[2] - 13) <= 2;
+      background +=
+          std::abs(c[0] - 18) <= 2 && std::abs(c[1] - 13) <= 2 && std::abs(c[2] - 13) <= 2;
     }
   EXPECT_LT(background, shot.rows * shot.cols / 2) << "the museum is not drawn";
 }
@@ -189,8 +191,8 @@ Score score(const std::vector<Record>& records, const std::filesystem::path& dir
     for (int y = 0; y < img.rows; ++y)
       for (int x = 0; x < img.cols; ++x) {
         const cv::Vec3b c = img.at<cv::Vec3b>(y, x);
-        const bool rendered = !(std::abs(c[0] - 18) <= 2 && std::abs(c[1] - 13) <= 2 &&
-                                std::abs(c[2] - 13) <= 2);
+        const bool rendered =
+            !(std::abs(c[0] - 18) <= 2 && std::abs(c[1] - 13) <= 2 && std::abs(c[2] - 13) <= 2);
         if (!rendered && !mask(x, y)) continue;
         const Rgb8 t = truth(x, y);
         const double d[3] = {double(c[2]) - t.r, double(c[1]) - t.g, double(c[0]) - t.b};
@@ -219,16 +221,16 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
   const double focal = 560.0 * kWidth / 704.0;
   const Camera held = support::look_at_camera("held", centre, target, Eigen::Vector3d::UnitY(),
                                               kWidth, kHeight, focal);
-  const Viewpoint view{centre, target, 2 * std::atan(0.5 * kHeight / focal) * 180 / std::numbers::pi};
+  const Viewpoint view{centre, target,
+                       2 * std::atan(0.5 * kHeight / focal) * 180 / std::numbers::pi};
   std::map<std::string, Process*> previews;
   for (const std::string mode : {"nearest", "blend"})
-    previews[mode] = &spawn(mode, "preview/studio-preview",
-                            {"--headless", "--config", preview_config(mode, 1000), "--viewpoint",
-                             to_string(view), "--texturing", mode, "--size",
-                             std::to_string(kWidth) + "x" + std::to_string(kHeight),
-                             "--frames", "20", "--timeout", "120", "--record",
-                             (dir_ / mode).string(), "--screenshot",
-                             (dir_ / (mode + ".png")).string()});
+    previews[mode] = &spawn(
+        mode, "preview/studio-preview",
+        {"--headless", "--config", preview_config(mode, 1000), "--viewpoint", to_string(view),
+         "--texturing", mode, "--size", std::to_string(kWidth) + "x" + std::to_string(kHeight),
+         "--frames", "20", "--timeout", "120", "--record", (dir_ / mode).string(), "--screenshot",
+         (dir_ / (mode + ".png")).string()});
   for (auto& [mode, p] : previews) {
     const auto code = p->wait_exit(std::chrono::seconds(150));
     ASSERT_TRUE(code.has_value()) << mode;
@@ -237,17 +239,20 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
   sim::StudioOptions o;
   o.threads = 1;
   auto truth = sim::SimulatedStudio::create({held}, o).value();
-  const Score nearest = score(read_records(dir_ / "nearest" / "frames.jsonl"), dir_ / "nearest", truth);
+  const Score nearest =
+      score(read_records(dir_ / "nearest" / "frames.jsonl"), dir_ / "nearest", truth);
   const Score blend = score(read_records(dir_ / "blend" / "frames.jsonl"), dir_ / "blend", truth);
-  std::printf("held-out camera, union of silhouettes: nearest %.2f dB (%d frames), blend %.2f dB "
-              "(%d frames)\n",
-              nearest.psnr(), nearest.frames, blend.psnr(), blend.frames);
+  std::printf(
+      "held-out camera, union of silhouettes: nearest %.2f dB (%d frames), blend %.2f dB "
+      "(%d frames)\n",
+      nearest.psnr(), nearest.frames, blend.psnr(), blend.frames);
   for (const Score* sc : {&nearest, &blend})
-    std::printf("  pixels in both silhouettes %llu (%.2f dB there), only rendered %llu, only true "
-                "%llu\n",
-                (unsigned long long)sc->both,
-                10 * std::log10(255.0 * 255 / (sc->squared_both / (3.0 * sc->both))),
-                (unsigned long long)sc->rendered_only, (unsigned long long)sc->true_only);
+    std::printf(
+        "  pixels in both silhouettes %llu (%.2f dB there), only rendered %llu, only true "
+        "%llu\n",
+        (unsigned long long)sc->both,
+        10 * std::log10(255.0 * 255 / (sc->squared_both / (3.0 * sc->both))),
+        (unsigned long long)sc->rendered_only, (unsigned long long)sc->true_only);
   ASSERT_GE(nearest.frames, 10);
   ASSERT_GE(blend.frames, 10);
   EXPECT_GT(blend.psnr(), nearest.psnr());

@@ -20,9 +20,9 @@ TEST(Viewpoint, ParsesAndPrintsTheCommandLineForm) {
 }
 
 TEST(Viewpoint, RefusesBadText) {
-  for (const char* bad : {"", "eye=1,2,at=0,0,0", "eye=1,2,3,at=1,2,3", "eye=1,2,3,at=0,0,0,fov=0",
-                          "eye=1,x,3,at=0,0,0", "look=1,2,3", "eye=0,5,0,at=0,0,0",
-                          "eye=1,2,3,at=0,0,0,eye=1,1,1"}) {
+  for (const char* bad :
+       {"", "eye=1,2,at=0,0,0", "eye=1,2,3,at=1,2,3", "eye=1,2,3,at=0,0,0,fov=0",
+        "eye=1,x,3,at=0,0,0", "look=1,2,3", "eye=0,5,0,at=0,0,0", "eye=1,2,3,at=0,0,0,eye=1,1,1"}) {
     auto v = parse_viewpoint(bad);
     EXPECT_FALSE(v) << bad;
     if (!v) {
@@ -79,7 +79,7 @@ TEST(CameraMove, PassesThroughItsKeysAndHoldsOutside) {
   EXPECT_DOUBLE_EQ(m->duration(), 4);
   // Smooth through the middle key: the velocity just before and after it agree.
   const double h = 1e-4;
-  const Eigen::Vector3d before = (m->at(2) .eye - m->at(2 - h).eye) / h;
+  const Eigen::Vector3d before = (m->at(2).eye - m->at(2 - h).eye) / h;
   const Eigen::Vector3d after = (m->at(2 + h).eye - m->at(2).eye) / h;
   EXPECT_LT((before - after).norm(), 1e-2);
 }

@@ -12,11 +12,11 @@
 //                 not backing_i,
 // with the weights of camera_select.h (nearest: one camera of weight 1). A point every camera
 // that sees it sees as backing is not drawn (the visual hull's excess over the actor); a point
-// no selected camera sees is drawn in `unseen` (flat); an untextured draw (no images of the mesh's frame)
-// draws the whole mesh flat-shaded in `untextured`.
-// Cameras are pinholes (K, cam_from_world, image size; the paper's radial distortion is
-// ignored here: below a pixel for the studio's lenses at the preview's scale).
-// Needs a current OpenGL 3.3 core context; GL names are plain unsigned ints.
+// no selected camera sees is drawn in `unseen` (flat); an untextured draw (no images of the mesh's
+// frame) draws the whole mesh flat-shaded in `untextured`. Cameras are pinholes (K, cam_from_world,
+// image size; the paper's radial distortion is ignored here: below a pixel for the studio's lenses
+// at the preview's scale). Needs a current OpenGL 3.3 core context; GL names are plain unsigned
+// ints.
 
 #include <Eigen/Core>
 #include <array>

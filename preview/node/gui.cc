@@ -63,9 +63,12 @@ class Script {
       } else if (verb == "open") {
         std::string p;
         in >> p;
-        bool* flag = p == "cameras" ? &panels.cameras : p == "capture" ? &panels.capture
-                     : p == "animation" ? &panels.animation : p == "services" ? &panels.services
-                     : p == "view" ? &panels.view : nullptr;
+        bool* flag = p == "cameras"     ? &panels.cameras
+                     : p == "capture"   ? &panels.capture
+                     : p == "animation" ? &panels.animation
+                     : p == "services"  ? &panels.services
+                     : p == "view"      ? &panels.view
+                                        : nullptr;
         if (!flag) return failed("open: unknown panel '" + p + "'");
         *flag = true;
       } else if (verb == "set") {
@@ -153,14 +156,15 @@ bool write_screenshot(const std::string& path, int w, int h, const PanelState& p
 int run_gui(const PreviewConfig& config, const std::string& script_path) {
   auto script = Script::open(script_path);
   if (!script) return error(script.error().message, 2);
-  if (!glfwInit()) return error("no display: GLFW could not initialise (set DISPLAY, or use --headless)");
+  if (!glfwInit())
+    return error("no display: GLFW could not initialise (set DISPLAY, or use --headless)");
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);
-  GLFWwindow* window = glfwCreateWindow(config.width, config.height,
-                                        ("studio preview: " + config.instance).c_str(), nullptr,
-                                        nullptr);
+  GLFWwindow* window =
+      glfwCreateWindow(config.width, config.height, ("studio preview: " + config.instance).c_str(),
+                       nullptr, nullptr);
   if (!window) {
     glfwTerminate();
     return error("cannot open an OpenGL 3.3 core window");
@@ -219,7 +223,8 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
       if (!io.WantCaptureKeyboard) {
         const double step = 0.05;
         auto key = [&](int k) { return glfwGetKey(window, k) == GLFW_PRESS ? step : 0.0; };
-        const Eigen::Vector3d d(key(GLFW_KEY_D) - key(GLFW_KEY_A), key(GLFW_KEY_E) - key(GLFW_KEY_Q),
+        const Eigen::Vector3d d(key(GLFW_KEY_D) - key(GLFW_KEY_A),
+                                key(GLFW_KEY_E) - key(GLFW_KEY_Q),
                                 key(GLFW_KEY_W) - key(GLFW_KEY_S));
         if (d.norm() > 0) view = fly(view, d);
       }

@@ -123,7 +123,8 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
         (unsigned long long)c.textured, (unsigned long long)c.untextured,
         (unsigned long long)c.late, (unsigned long long)c.refused, (unsigned long long)c.skipped,
         seconds, context->renderer().c_str());
-  for (const auto& p : (*pipeline)->asset_problems()) std::fprintf(stderr, "asset: %s\n", p.c_str());
+  for (const auto& p : (*pipeline)->asset_problems())
+    std::fprintf(stderr, "asset: %s\n", p.c_str());
   node.stop();
   if (!written) return error("cannot write '" + options.screenshot + "'", 1);
   if (options.duration_s <= 0 && drawn < options.frames)

@@ -19,9 +19,7 @@ void remember_window(PanelState& s, const char* title) {
   s.windows[title] = {p.x, p.y, z.x, z.y, 0};
 }
 
-void report(PanelState& s, const Expected<void>& r) {
-  s.last_error = r ? "" : r.error().message;
-}
+void report(PanelState& s, const Expected<void>& r) { s.last_error = r ? "" : r.error().message; }
 
 void cameras_panel(PanelState& s, PreviewNode& node) {
   if (!ImGui::Begin("Cameras", &s.cameras)) return ImGui::End();
@@ -73,7 +71,8 @@ void capture_panel(PanelState& s, PreviewNode& node) {
   ImGui::SameLine();
   if (ImGui::Button("Now + 2 s")) s.at_frame = (long long)now + 50;
   if (ImGui::BeginTable("cams", 5, ImGuiTableFlags_Borders)) {
-    for (const char* h : {"camera", "recording", "take", "fps", "drops"}) ImGui::TableSetupColumn(h);
+    for (const char* h : {"camera", "recording", "take", "fps", "drops"})
+      ImGui::TableSetupColumn(h);
     ImGui::TableHeadersRow();
     for (const auto& c : states) {
       ImGui::TableNextRow();
@@ -86,8 +85,10 @@ void capture_panel(PanelState& s, PreviewNode& node) {
       ImGui::TableNextColumn();
       ImGui::Text("%.1f", c.fps);
       ImGui::TableNextColumn();
-      if (c.drops) ImGui::TextColored(kRed, "%llu", (unsigned long long)c.drops);
-      else ImGui::Text("0");
+      if (c.drops)
+        ImGui::TextColored(kRed, "%llu", (unsigned long long)c.drops);
+      else
+        ImGui::Text("0");
     }
     ImGui::EndTable();
   }
@@ -126,17 +127,18 @@ void services_panel(PanelState& s, PreviewNode& node) {
       ImGui::TableSetupColumn(h);
     ImGui::TableHeadersRow();
     for (const ServiceView& v : node.services()) {
-      const bool missing = !v.alive || now - v.seen > std::chrono::seconds(3) ||
-                           v.state == studio_SERVICE_FAILED;
+      const bool missing =
+          !v.alive || now - v.seen > std::chrono::seconds(3) || v.state == studio_SERVICE_FAILED;
       const ImVec4 colour = missing ? kRed : ImGui::GetStyleColorVec4(ImGuiCol_Text);
       static const char* kStates[] = {"starting", "running", "degraded", "stopping", "failed"};
       ImGui::TableNextRow();
       ImGui::TableNextColumn();
       ImGui::TextColored(colour, "%s:%s", v.service.c_str(), v.instance.c_str());
       ImGui::TableNextColumn();
-      ImGui::TextColored(colour, "%s", missing && v.state != studio_SERVICE_FAILED
-                                           ? "MISSING"
-                                           : kStates[std::clamp(v.state, 0, 4)]);
+      ImGui::TextColored(colour, "%s",
+                         missing && v.state != studio_SERVICE_FAILED
+                             ? "MISSING"
+                             : kStates[std::clamp(v.state, 0, 4)]);
       ImGui::TableNextColumn();
       ImGui::TextColored(colour, "%.1f", v.input_hz);
       ImGui::TableNextColumn();

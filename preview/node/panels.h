@@ -28,8 +28,8 @@ struct ItemRect {
 
 struct PanelState {
   bool cameras = false, capture = false, animation = false, services = false, view = true;
-  std::map<std::string, double> edits;            // "cam/feature" → the slider's value
-  std::map<std::string, double> scripted;         // "cam/feature" → value to apply next frame
+  std::map<std::string, double> edits;     // "cam/feature" → the slider's value
+  std::map<std::string, double> scripted;  // "cam/feature" → value to apply next frame
   char take[64] = "take";
   long long at_frame = 0;
   double seek_s = 0, speed = 1;

@@ -16,13 +16,13 @@ struct PreviewConfig {
   std::string dds_config;
   std::string log;
   // The preview's own.
-  Viewpoint viewpoint;            // start view
+  Viewpoint viewpoint;             // start view
   int width = 1280, height = 720;  // window / screenshot size
-  bool blend = true;              // texturing: blend (true) or nearest
-  int blend_cameras = 3;          // 1..3
-  int wait_ms = 200;              // wait for a new mesh's images, then draw it untextured
-  std::string asset_root;         // relative asset paths of scene nodes resolve here
-  std::string take = "take";      // the capture panel's default take name
+  bool blend = true;               // texturing: blend (true) or nearest
+  int blend_cameras = 3;           // 1..3
+  int wait_ms = 200;               // wait for a new mesh's images, then draw it untextured
+  std::string asset_root;          // relative asset paths of scene nodes resolve here
+  std::string take = "take";       // the capture panel's default take name
   Expected<void> validate() const;
 };
 

@@ -50,11 +50,9 @@ struct PreviewNode::Impl {
         meshes_in(loop.counter("meshes_in")),
         images_in(loop.counter("images_in")),
         images_refused(loop.counter("image_replies_not_ok")) {
-    loop.input<studio_SceneNode>({.received = "scene_nodes_in", .rate = false,
-                                  .instance_changes = true, .batch = 1024},
-                                 [this](const studio_SceneNode& s, const wire::SampleMeta& m) {
-                                   return on_node(s, m);
-                                 });
+    loop.input<studio_SceneNode>(
+        {.received = "scene_nodes_in", .rate = false, .instance_changes = true, .batch = 1024},
+        [this](const studio_SceneNode& s, const wire::SampleMeta& m) { return on_node(s, m); });
     loop.input<studio_ActorMesh>({.received = "meshes_received"},
                                  [this](const studio_ActorMesh& s, const wire::SampleMeta&) {
                                    std::lock_guard lock(mutex);

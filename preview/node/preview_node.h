@@ -19,8 +19,8 @@
 
 #include <chrono>
 #include <condition_variable>
-#include <expected>
 #include <cstdint>
+#include <expected>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -81,7 +81,7 @@ class PreviewNode : public runtime::Node {
   // Snapshots (copies) for the render and GUI thread.
   std::map<std::string, Camera> cameras() const;
   std::optional<LiveMesh> mesh_after(uint64_t sequence) const;  // newest, if newer than sequence
-  uint64_t mesh_sequence() const;  // of the newest mesh (0: none yet)
+  uint64_t mesh_sequence() const;                               // of the newest mesh (0: none yet)
   // The scene mirror, rebuilt when it changed since `version` (nullopt: unchanged).
   std::optional<scene::Scene> scene_after(uint64_t& version) const;
   std::vector<CameraStateView> camera_states() const;

@@ -99,12 +99,12 @@ struct ViewPipeline::Impl {
     const auto waited = std::chrono::steady_clock::now() - pending_since;
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(options.wait - waited);
     using Missing = PreviewNode::Missing;
-    const auto imgs = pending_cameras.empty()
-                          ? std::expected<std::vector<FrameImage>, Missing>(
-                                std::unexpected(Missing::refused))
-                          : node->images(pending->source_frame, pending_cameras,
-                                         block ? std::max(left, std::chrono::milliseconds(0))
-                                               : std::chrono::milliseconds(0));
+    const auto imgs =
+        pending_cameras.empty()
+            ? std::expected<std::vector<FrameImage>, Missing>(std::unexpected(Missing::refused))
+            : node->images(pending->source_frame, pending_cameras,
+                           block ? std::max(left, std::chrono::milliseconds(0))
+                                 : std::chrono::milliseconds(0));
     if (!imgs && imgs.error() == Missing::late && waited < options.wait) return false;
     if (auto ok = texturer.set_mesh(pending->mesh); !ok) {
       STUDIO_LOG(warn, "preview") << "mesh: " << ok.error().message;

@@ -24,16 +24,16 @@
 namespace studio::preview {
 
 struct PipelineOptions {
-  bool blend = true;            // false: the paper's nearest camera
-  BlendOptions blend_options;   // cameras: how many the blend uses (at most 3 here)
+  bool blend = true;           // false: the paper's nearest camera
+  BlendOptions blend_options;  // cameras: how many the blend uses (at most 3 here)
   std::chrono::milliseconds wait{200};
-  std::string asset_root;       // relative asset paths of scene nodes resolve here
+  std::string asset_root;  // relative asset paths of scene nodes resolve here
 };
 
 struct FrameReport {
-  bool new_mesh = false;        // this frame drew a mesh not drawn before
-  bool textured = false;        // the drawn mesh is textured
-  uint64_t source_frame = 0;    // frame of the masks that built the drawn mesh
+  bool new_mesh = false;             // this frame drew a mesh not drawn before
+  bool textured = false;             // the drawn mesh is textured
+  uint64_t source_frame = 0;         // frame of the masks that built the drawn mesh
   std::vector<std::string> cameras;  // texturing cameras (ids), with their weights
   std::vector<float> weights;
 };

@@ -157,8 +157,8 @@ Viewpoint CameraMove::at(double t) const {
   const auto& k3 = i + 2 < keys_.size() ? keys_[i + 2] : k2;
   const double s = (t - k1.time) / (k2.time - k1.time);
   // Uniform Catmull-Rom through p1..p2 with neighbours p0, p3.
-  auto spline = [s](const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
-                    const Eigen::Vector3d& p2, const Eigen::Vector3d& p3) {
+  auto spline = [s](const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+                    const Eigen::Vector3d& p3) {
     const double s2 = s * s, s3 = s2 * s;
     return Eigen::Vector3d(0.5 * ((2 * p1) + (-p0 + p2) * s + (2 * p0 - 5 * p1 + 4 * p2 - p3) * s2 +
                                   (-p0 + 3 * p1 - 3 * p2 + p3) * s3));

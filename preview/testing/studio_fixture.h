@@ -25,7 +25,8 @@ class PreviewStudioTest : public ::testing::Test {
 
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = studio::testing::make_test_dir(std::string(info->test_suite_name()) + "." + info->name());
+    dir_ =
+        studio::testing::make_test_dir(std::string(info->test_suite_name()) + "." + info->name());
     dds_ = studio::testing::DdsDomain::unique();
     dds_.apply_to_this_process();
   }
@@ -91,7 +92,8 @@ class PreviewStudioTest : public ::testing::Test {
         << "instance: hull\nhull:\n  rig: rig.yaml\n  box: [-1.5, 0.0, -1.5, 1.5, 2.4, 1.5]\n"
            "  grid: 96\n  deadline_ms: 40\n  min_cameras: 4\n  threads: 1\n  mesh: true\n"
            "  refine: true\n";
-    Process& c = spawn("capture", "capture/studio-capture", {"--config", (dir_ / "capture.yaml").string()});
+    Process& c =
+        spawn("capture", "capture/studio-capture", {"--config", (dir_ / "capture.yaml").string()});
     Process& h = spawn("hull", "hull/studio-hull", {"--config", (dir_ / "hull.yaml").string()});
     ASSERT_TRUE(c.wait_ready(60s)) << c.log();
     ASSERT_TRUE(h.wait_ready(60s)) << h.log();
@@ -99,7 +101,8 @@ class PreviewStudioTest : public ::testing::Test {
       std::ofstream(dir_ / "scene.yaml")
           << "instance: scene0\nclock: {fps: 25, epoch_ns: 0, source: studio}\nscene: "
           << STUDIO_SCENE_DEFAULT_DIR << "/scene.yaml\n";
-      Process& s = spawn("scene", "scene/studio-scene", {"--config", (dir_ / "scene.yaml").string()});
+      Process& s =
+          spawn("scene", "scene/studio-scene", {"--config", (dir_ / "scene.yaml").string()});
       ASSERT_TRUE(s.wait_ready(60s)) << s.log();
     }
   }

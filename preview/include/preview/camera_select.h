@@ -27,9 +27,9 @@ struct StudioCameraPose {
 };
 
 struct CameraWeight {
-  int index = -1;        // into the cameras given
-  double angle = 0;      // radians, at the target
-  double weight = 0;     // sums to 1 over the result
+  int index = -1;     // into the cameras given
+  double angle = 0;   // radians, at the target
+  double weight = 0;  // sums to 1 over the result
 };
 
 struct BlendOptions {

@@ -24,7 +24,8 @@ struct Viewpoint {
   Eigen::Vector3d eye{0, 1.6, 5};
   Eigen::Vector3d at{0, 1, 0};
   double fov_deg = 50;
-  Expected<void> validate() const;  // finite, eye != at, fov in (1, 179), not looking straight up/down
+  Expected<void> validate()
+      const;  // finite, eye != at, fov in (1, 179), not looking straight up/down
 };
 
 // "eye=X,Y,Z,at=X,Y,Z[,fov=DEG]" → Viewpoint; errors are one line naming the problem.
