@@ -76,6 +76,11 @@ ALLOWED = {
         "pure type: the tracker node reads studio/actor/segments as hull::SegmentSet",
     ("tracker/cli", "hull"):
         "pure type: studio-tracker locate cuts masks into a hull::SegmentSet",
+    ("preview", "scene"):
+        "pure type: the preview's textured actor draws scene::ActorMesh (scene/actor_mesh.h)",
+    ("preview/node", "scene"):
+        "the director's preview mirrors the scene graph (scene library) and draws it with the "
+        "project's one renderer (scene_render), as DESIGN §2 places it in scene/",
     ("deploy/demo", "sim"):
         "the demo's probe (studio-demo-probe, a measuring tool, not a service) scores the live "
         "studio against the simulated studio's truth for the same frame",

@@ -72,6 +72,8 @@ TEST_F(WireTest, EveryTopicTypeRoundTripsThroughAnotherProcess) {
   round_trip<studio_SceneState>(p, 14);
   round_trip<studio_ProjectorMask>(p, 15);
   round_trip<studio_ProjectorFrame>(p, 16);
+  round_trip<studio_ImageRequest>(p, 17);
+  round_trip<studio_ImageReply>(p, 18);
   EXPECT_TRUE(peer.running());
   EXPECT_EQ(peer.stop(), 0) << "peer did not exit cleanly on SIGTERM";
 }

@@ -114,6 +114,8 @@ int run_echo(runtime::SignalWatcher& signals) {
   owned.push_back(echo_of<studio_SceneState>(p));
   owned.push_back(echo_of<studio_ProjectorMask>(p));
   owned.push_back(echo_of<studio_ProjectorFrame>(p));
+  owned.push_back(echo_of<studio_ImageRequest>(p));
+  owned.push_back(echo_of<studio_ImageReply>(p));
   std::vector<Pump*> pumps;
   for (auto& e : owned) pumps.push_back(e.get());
   return serve(p, pumps, signals);

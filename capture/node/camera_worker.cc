@@ -84,6 +84,7 @@ void CameraWorker::on_source_error(const Error& error) {
 void CameraWorker::on_frame(Frame& frame, Clock::time_point now) {
   source_failed_ = false;
   io_.frames_captured.add();
+  ring_.push(frame.frame, frame.capture_ns, frame.image);  // before its mask goes out
   bool send = false, raw = false;
   {
     std::lock_guard lock(mutex_);

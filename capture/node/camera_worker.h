@@ -19,6 +19,7 @@
 #include "capture/recorder.h"
 #include "capture/take_schedule.h"
 #include "capture_node.h"
+#include "image_ring.h"
 #include "wire/capture_convert.h"
 #include "keyer/config/kept_plates.h"
 #include "keyer/plate_keyer.h"
@@ -55,6 +56,8 @@ class CameraWorker {
 
   const std::string& id() const { return id_; }
   const std::optional<studio::Camera>& calibration() const { return calibration_; }
+  // The last second of frames, for frame-exact image requests (image_ring.h).
+  const ImageRing& ring() const { return ring_; }
 
   // Creates the keyer (with a plate kept from before a restart) and starts the source.
   Expected<void> start();
@@ -111,6 +114,7 @@ class CameraWorker {
   TrackedSource* tracked_ = nullptr;
   bool report_tracker_ = false;
   std::optional<LensTableOptions> lens_table_;
+  ImageRing ring_{25};
   // Grab thread only.
   wire::Owned<studio_CameraCalibration> calibration_sample_;
   FreeDListenerStats reported_{};

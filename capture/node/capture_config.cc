@@ -32,7 +32,8 @@ const char kConfigHelp[] =
     "  state_period: S                   seconds between CameraState samples (default 1)\n"
     "  cameras:                          one entry per camera:\n"
     "    - id: cam0\n"
-    "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true}\n"
+    "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true,\n"
+    "               frame_code: false}   (frame_code: the actor wears the frame number)\n"
     "      source: {type: files, path: DIR, fps: 25, loop: false, paced: true}\n"
     "      source: {type: aravis, device: ID, pixel_format: BayerRG8, width: W, height: H,\n"
     "               fps: 25, trigger: free_run|software|line, line: Line0, buffers: 8,\n"
@@ -68,6 +69,7 @@ struct RecorderKeys {
 struct SimKeys {
   int ring = 6, index = 0, width = 704, height = 576;
   bool paced = true;
+  bool frame_code = false;  // sim/frame_code.h
   Expected<void> validate() const {
     if (index >= ring) return fail("index: must be below ring");
     return {};
@@ -107,6 +109,7 @@ const yaml::Schema<SimKeys> kSim{
     yaml::field("width", &SimKeys::width).range(16, 8192),
     yaml::field("height", &SimKeys::height).range(16, 8192),
     yaml::field("paced", &SimKeys::paced),
+    yaml::field("frame_code", &SimKeys::frame_code),
 };
 const yaml::Schema<FileSourceOptions> kFiles{
     yaml::field("path", &FileSourceOptions::path).required().relative_path(),
@@ -212,6 +215,7 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
     ring.focal_px *= double(ring.width) / 704.0;  // keep the field of view at any size
     SimSourceOptions so;
     so.paced = c.sim.paced;
+    so.studio.frame_code = c.sim.frame_code;
     so.camera = sim::ring_cameras(ring)[std::size_t(c.sim.index)];
     so.camera.id = c.id;
     so.clock = clock;

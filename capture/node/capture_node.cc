@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "camera_worker.h"
+#include "image_ring.h"
 #include "core/clock.h"
 #include "core/log.h"
 
@@ -58,6 +59,9 @@ class CaptureNode : public runtime::Node {
       loop_.thread(
           w.id(), [&w] { w.run(); }, [&w] { w.interrupt(); });
     }
+    std::vector<ImageRequests::Camera> rings;
+    for (auto& w : workers_) rings.push_back({w->id(), &w->ring()});
+    image_requests_ = std::make_unique<ImageRequests>(loop_, std::move(rings));
     loop_.at_stop([this] {
       for (auto& w : workers_) w->finish();
     });
@@ -124,6 +128,7 @@ class CaptureNode : public runtime::Node {
   const keyer::KeptPlates kept_plates_;
   std::vector<std::unique_ptr<CameraWorker>> workers_;
   runtime::Input<studio_CaptureCommand>* commands_ = nullptr;
+  std::unique_ptr<ImageRequests> image_requests_;
   runtime::ServiceLoop loop_;  // stopped (destroyed) before the workers: declared after them
   CaptureIo io_;
 };

@@ -38,6 +38,8 @@ constexpr std::array<TopicRow, kTopicCount> kTopicTable{{
 {R(scene_state, SceneState),                     "studio/scene/state",           kRel, kTL,  1,  0},
 {R(projector_mask, ProjectorMask),               "studio/projector/mask",        kBE,  kVol, 1,  0},
 {R(projector_frame, ProjectorFrame),             "studio/projector/frame",       kRel, kVol, 1,  0},
+{R(image_request, ImageRequest),                 "studio/camera/image_request",  kRel, kVol, 32, 0},
+{R(image_reply, ImageReply),                     "studio/camera/image_reply",    kRel, kVol, 4,  0},
 }};
 // clang-format on
 #undef R

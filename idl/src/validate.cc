@@ -136,23 +136,27 @@ Verdict validate(const studio_AlphaMask& s) {
   return Reject::out_of_range;
 }
 
-Verdict validate(const studio_CameraImage& s) {
-  if (!id_ok(s.camera_id)) return Reject::bad_id;
-  if (!side_ok(s.width, s.height)) return Reject::bad_size;
-  const uint64_t n = view(s.data).size(), pixels = uint64_t(s.width) * s.height;
-  switch (raw(s.format)) {
+// The image payload of CameraImage and ImageReply: its length against the size and format.
+static Verdict check_image(uint32_t width, uint32_t height, uint32_t format, std::span<const uint8_t> d) {
+  if (!side_ok(width, height)) return Reject::bad_size;
+  const uint64_t n = d.size(), pixels = uint64_t(width) * height;
+  switch (format) {
     case studio_IMAGE_RGB8:
       return n == 3 * pixels ? Verdict{} : Reject::bad_size;
     case studio_IMAGE_MONO8:
       return n == pixels ? Verdict{} : Reject::bad_size;
     case studio_IMAGE_JPEG: {
-      auto d = view(s.data);
       if (n < 4 || n > 3 * pixels + 65536) return Reject::bad_size;
       if (d[0] != 0xFF || d[1] != 0xD8) return Reject::out_of_range;  // SOI marker
       return std::nullopt;
     }
   }
   return Reject::out_of_range;
+}
+
+Verdict validate(const studio_CameraImage& s) {
+  if (!id_ok(s.camera_id)) return Reject::bad_id;
+  return check_image(s.width, s.height, raw(s.format), view(s.data));
 }
 
 Verdict validate(const studio_CameraState& s) {
@@ -259,6 +263,24 @@ Verdict validate(const studio_ProjectorMask& s) {
   if (!side_ok(s.width, s.height)) return Reject::bad_size;
   if (s.step < 1 || s.step > 64) return Reject::out_of_range;
   return check_runs(view(s.row_start), view(s.runs), s.width, s.height);
+}
+
+Verdict validate(const studio_ImageRequest& s) {
+  if (!id_ok(s.requester) || !id_ok(s.camera_id)) return Reject::bad_id;
+  return std::nullopt;
+}
+
+// OK carries an image of exactly its size and format; the other statuses carry none.
+Verdict validate(const studio_ImageReply& s) {
+  if (!id_ok(s.requester) || !id_ok(s.camera_id)) return Reject::bad_id;
+  switch (raw(s.status)) {
+    case studio_IMAGE_REPLY_OK:
+      return check_image(s.width, s.height, raw(s.format), view(s.data));
+    case studio_IMAGE_REPLY_EVICTED:
+    case studio_IMAGE_REPLY_NOT_YET:
+      return view(s.data).empty() ? Verdict{} : Reject::bad_size;
+  }
+  return Reject::out_of_range;
 }
 
 }  // namespace studio::wire

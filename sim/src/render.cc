@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "sim/frame_code.h"
 #include "studio_impl.h"
 
 namespace studio::sim::detail {
@@ -28,6 +29,7 @@ struct CamPart {
   double o2c = 0;
   Rect rect;
   std::array<float, 3> albedo{};
+  bool coded = false;  // wears the frame code (sim/frame_code.h): the torso
 
   // Ray parameter of the first hit of t * d (t > 0), or +inf.
   double hit(const Eigen::Vector3d& d) const {
@@ -68,7 +70,8 @@ struct CamPart {
   }
 };
 
-std::vector<CamPart> to_camera(const CameraCache& cam, const ActorBody& body, int margin) {
+std::vector<CamPart> to_camera(const CameraCache& cam, const ActorBody& body, int margin,
+                               bool frame_code = false) {
   std::vector<CamPart> out;
   out.reserve(body.parts.size());
   for (const Part& p : body.parts) {
@@ -106,6 +109,7 @@ std::vector<CamPart> to_camera(const CameraCache& cam, const ActorBody& body, in
     }
     c.rect = cam.project_hull(corners, 8, margin);
     c.albedo = {p.albedo.r, p.albedo.g, p.albedo.b};
+    c.coded = frame_code && p.id == PartId::torso;
     out.push_back(c);
   }
   return out;
@@ -125,6 +129,7 @@ struct Shader {
   Eigen::Vector3d key, fill;  // camera frame
   double spill, ring;
   double exposure = 1;  // relative exposure (sim/projector_light.h)
+  std::array<std::array<float, 3>, frame_code::kBands> code{};  // albedo of each band
   // Display colour of the hit on `part` along d at t, given the background colour behind it.
   std::array<float, 3> operator()(const CamPart& part, const Eigen::Vector3d& d, double t,
                                   const Rgb8& bg) const {
@@ -138,9 +143,12 @@ struct Shader {
     constexpr float kRing[3] = {0.25f, 0.45f, 1.0f};
     const float s = static_cast<float>(spill * (1 - ndv) * (1 - ndv));
     const float back[3] = {float(bg.r), float(bg.g), float(bg.b)};
+    const std::array<float, 3>* albedo = &part.albedo;
+    if (part.coded)
+      if (const int b = frame_code::band_of((part.M * (p - part.c)).y()); b >= 0) albedo = &code[b];
     std::array<float, 3> out;
     for (int k = 0; k < 3; ++k) {
-      const float lin = static_cast<float>(exposure) * part.albedo[k] * (light + ring_w * kRing[k]);
+      const float lin = static_cast<float>(exposure) * (*albedo)[k] * (light + ring_w * kRing[k]);
       out[k] = kGamma(lin) * (1 - s) + back[k] * s;
     }
     return out;
@@ -368,14 +376,18 @@ void render_actor(const StudioOptions& options, const CameraCache& cam, const Pr
                   Image<Rgb8>* image, Mask* mask, Image<uint8_t>* matte) {
   apply_shadow(cam, frame.shadow, image);
   const int width = cam.camera.width, height = cam.camera.height;
-  const std::vector<CamPart> parts = to_camera(cam, frame.truth.body, 1);
-  const Shader shader{cam.R * kKeyLight, cam.R * kFillLight, options.spill,
-                      options.ring_light * options.projector_light.ring_level,
-                      options.projector_light.exposure};
+  const std::vector<CamPart> parts = to_camera(cam, frame.truth.body, 1, options.frame_code);
+  Shader shader{cam.R * kKeyLight, cam.R * kFillLight, options.spill,
+                options.ring_light * options.projector_light.ring_level,
+                options.projector_light.exposure};
+  for (int b = 0; b < frame_code::kBands; ++b) {
+    const Albedo a = frame_code::albedo(frame_code::digit(frame.truth.frame, b));
+    shader.code[b] = {a.r, a.g, a.b};
+  }
   Rect U = union_rect(parts);
   std::vector<std::vector<CamPart>> blur;
   for (const ActorBody& b : frame.blur_bodies) {
-    blur.push_back(to_camera(cam, b, 1));
+    blur.push_back(to_camera(cam, b, 1, options.frame_code));
     U = U.united(union_rect(blur.back()));
   }
   if (U.empty()) return;

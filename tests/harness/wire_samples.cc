@@ -265,6 +265,27 @@ void fill(studio_ProjectorMask& s, int seed) {
   assign(s.runs, runs);
 }
 
+void fill(studio_ImageRequest& s, int seed) {
+  set(s.requester, id("preview", seed));
+  stamp(s.frame, s.capture_ns, seed);
+  set(s.camera_id, id("cam", seed));
+  s.request_id = 40 + uint64_t(seed);
+}
+
+void fill(studio_ImageReply& s, int seed) {
+  set(s.requester, id("preview", seed));
+  set(s.camera_id, id("cam", seed));
+  stamp(s.frame, s.capture_ns, seed);
+  s.request_id = 40 + uint64_t(seed);
+  s.status = studio_IMAGE_REPLY_OK;
+  s.width = 16;
+  s.height = 12;
+  s.format = studio_IMAGE_RGB8;
+  std::vector<uint8_t> px(size_t(s.width) * s.height * 3);
+  for (size_t i = 0; i < px.size(); ++i) px[i] = uint8_t(i * 5 + seed);
+  assign(s.data, px);
+}
+
 bool same(const studio_CameraCalibration& a, const studio_CameraCalibration& b) {
   return str_same(a.camera_id, b.camera_id) && a.frame == b.frame && a.capture_ns == b.capture_ns &&
          a.width == b.width && a.height == b.height && arr_same(a.K, b.K) && a.rd3 == b.rd3 &&
@@ -397,6 +418,19 @@ bool same(const studio_ProjectorFrame& a, const studio_ProjectorFrame& b) {
          a.height == b.height && seq_same(a.mask_row_start, b.mask_row_start) &&
          seq_same(a.mask_runs, b.mask_runs) && a.thumb_width == b.thumb_width &&
          a.thumb_height == b.thumb_height && seq_same(a.thumbnail, b.thumbnail);
+}
+
+bool same(const studio_ImageRequest& a, const studio_ImageRequest& b) {
+  return str_same(a.requester, b.requester) && a.frame == b.frame &&
+         a.capture_ns == b.capture_ns && str_same(a.camera_id, b.camera_id) &&
+         a.request_id == b.request_id;
+}
+
+bool same(const studio_ImageReply& a, const studio_ImageReply& b) {
+  return str_same(a.requester, b.requester) && str_same(a.camera_id, b.camera_id) &&
+         a.frame == b.frame && a.capture_ns == b.capture_ns && a.request_id == b.request_id &&
+         a.status == b.status && a.width == b.width && a.height == b.height &&
+         a.format == b.format && seq_same(a.data, b.data);
 }
 
 }  // namespace studio::testing

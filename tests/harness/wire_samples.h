@@ -23,6 +23,8 @@ void fill(studio_ServiceStatus& s, int seed);
 void fill(studio_SceneState& s, int seed);
 void fill(studio_ProjectorMask& s, int seed);
 void fill(studio_ProjectorFrame& s, int seed);
+void fill(studio_ImageRequest& s, int seed);
+void fill(studio_ImageReply& s, int seed);
 
 bool same(const studio_CameraCalibration& a, const studio_CameraCalibration& b);
 bool same(const studio_AlphaMask& a, const studio_AlphaMask& b);
@@ -40,6 +42,8 @@ bool same(const studio_ServiceStatus& a, const studio_ServiceStatus& b);
 bool same(const studio_SceneState& a, const studio_SceneState& b);
 bool same(const studio_ProjectorMask& a, const studio_ProjectorMask& b);
 bool same(const studio_ProjectorFrame& a, const studio_ProjectorFrame& b);
+bool same(const studio_ImageRequest& a, const studio_ImageRequest& b);
+bool same(const studio_ImageReply& a, const studio_ImageReply& b);
 
 template <wire::WireType T>
 wire::Owned<T> make(int seed) {

@@ -75,7 +75,8 @@ int main(int argc, char** argv) {
                         studio_CameraState, studio_CameraControl, studio_CaptureCommand,
                         studio_SegmentSet, studio_ActorMesh, studio_HeadPose, studio_SceneNode,
                         studio_SceneCommand, studio_SceneState, studio_ProjectorCalibration,
-                        studio_ServiceStatus, studio_ProjectorMask, studio_ProjectorFrame>(*p);
+                        studio_ServiceStatus, studio_ProjectorMask, studio_ProjectorFrame,
+                        studio_ImageRequest, studio_ImageReply>(*p);
   // A topic of the table this program does not publish would make studioctl's coverage test
   // fail for the wrong reason: say so here.
   for (const auto& row : wire::topic_table()) {

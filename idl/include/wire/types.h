@@ -31,8 +31,10 @@ enum class TopicId : uint8_t {
   scene_state,
   projector_mask,
   projector_frame,
+  image_request,
+  image_reply,
 };
-inline constexpr std::size_t kTopicCount = 16;
+inline constexpr std::size_t kTopicCount = 18;
 
 // Why a received sample was rejected (counted per reason by every Reader).
 enum class Reject : uint8_t {
@@ -81,6 +83,8 @@ Verdict validate(const studio_ServiceStatus& s);
 Verdict validate(const studio_SceneState& s);
 Verdict validate(const studio_ProjectorMask& s);
 Verdict validate(const studio_ProjectorFrame& s);
+Verdict validate(const studio_ImageRequest& s);
+Verdict validate(const studio_ImageReply& s);
 
 template <class T>
 struct TopicTraits;  // specialised below for every topic type only
@@ -109,6 +113,8 @@ STUDIO_WIRE_TOPIC(ServiceStatus, service_status)
 STUDIO_WIRE_TOPIC(SceneState, scene_state)
 STUDIO_WIRE_TOPIC(ProjectorMask, projector_mask)
 STUDIO_WIRE_TOPIC(ProjectorFrame, projector_frame)
+STUDIO_WIRE_TOPIC(ImageRequest, image_request)
+STUDIO_WIRE_TOPIC(ImageReply, image_reply)
 #undef STUDIO_WIRE_TOPIC
 
 template <class T>

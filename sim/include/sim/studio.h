@@ -74,6 +74,8 @@ struct StudioOptions {
   // level and exposure (sim/projector_light.h (c)); the default changes nothing.
   ProjectorLight projector_light;
 
+  bool frame_code = false;  // the actor wears the frame number (sim/frame_code.h)
+
   int threads = 2;  // render_all() threads over cameras
 
   Expected<void> validate() const;

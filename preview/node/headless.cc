@@ -1,0 +1,137 @@
+#include "headless.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <thread>
+
+#include "preview_node.h"
+#include "runtime/metrics.h"
+#include "scene_render/egl_context.h"
+#include "scene_render/render_target.h"
+#include "view_pipeline.h"
+#include "wire/entity.h"
+
+namespace studio::preview {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool write_png(const std::string& path, const std::vector<uint8_t>& rgba, int w, int h) {
+  cv::Mat image(h, w, CV_8UC4, const_cast<uint8_t*>(rgba.data())), bgr;
+  cv::cvtColor(image, bgr, cv::COLOR_RGBA2BGR);
+  try {
+    return cv::imwrite(path, bgr);
+  } catch (const cv::Exception&) {
+    return false;
+  }
+}
+
+int error(const std::string& message, int status) {
+  std::fprintf(stderr, "studio-preview: %s\n", message.c_str());
+  return status;
+}
+
+}  // namespace
+
+int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
+  if (!options.record.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(options.record, ec);
+    if (ec) return error("--record: cannot create '" + options.record + "'", 2);
+  }
+  auto context = scene_render::HeadlessContext::create();
+  if (!context) return error(context.error().message, 1);
+  auto participant = wire::Participant::create(
+      config.domain >= 0 ? dds_domainid_t(config.domain) : wire::default_domain(),
+      config.dds_config);
+  if (!participant) return error(participant.error().message, 1);
+  runtime::Metrics metrics;
+  runtime::NodeContext node_context{*participant, metrics, config.instance};
+  const std::string requester = config.instance + "-" + std::to_string(::getpid());
+  PreviewNode node(node_context, requester);
+  if (auto ok = node.start(); !ok) return error(ok.error().message, 1);
+  PipelineOptions po;
+  po.blend = config.blend;
+  po.blend_options.cameras = config.blend_cameras;
+  po.wait = std::chrono::milliseconds(config.wait_ms);
+  po.asset_root = config.asset_root;
+  auto pipeline = ViewPipeline::create(node, po);
+  if (!pipeline) return error(pipeline.error().message, 1);
+  auto target = scene_render::RenderTarget::create(config.width, config.height);
+  if (!target) return error(target.error().message, 1);
+
+  std::ofstream log;
+  if (!options.record.empty()) log.open(options.record + "/frames.jsonl");
+  std::vector<uint8_t> rgba;
+  const auto start = Clock::now();
+  const double limit_s = options.duration_s > 0 ? options.duration_s : options.timeout_s;
+  const auto deadline = start + std::chrono::duration<double>(limit_s);
+  int drawn = 0;
+  while (Clock::now() < deadline) {
+    if (options.frames > 0 && !(*pipeline)->has_work()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(3));
+      continue;
+    }
+    target->bind();
+    const FrameReport r = (*pipeline)->render(config.viewpoint, config.width, config.height, true);
+    if (options.frames == 0) {
+      if (Clock::now() - start >= std::chrono::duration<double>(options.settle_s)) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      continue;
+    }
+    if (!r.new_mesh) continue;
+    ++drawn;
+    if (!options.record.empty()) {
+      target->read_rgba(rgba);
+      const std::string name = std::to_string(drawn) + ".png";
+      if (!write_png(options.record + "/" + name, rgba, config.width, config.height))
+        return error("--record: cannot write " + name, 1);
+      log << "{\"image\":\"" << name << "\",\"source_frame\":" << r.source_frame
+          << ",\"textured\":" << (r.textured ? "true" : "false") << ",\"cameras\":[";
+      for (std::size_t i = 0; i < r.cameras.size(); ++i)
+        log << (i ? "," : "") << "\"" << r.cameras[i] << "\"";
+      log << "]}\n";
+      log.flush();
+    }
+    if (options.duration_s <= 0 && drawn >= options.frames) break;
+  }
+  target->bind();
+  target->read_rgba(rgba);
+  const bool written = write_png(options.screenshot, rgba, config.width, config.height);
+  const PipelineCounts& c = (*pipeline)->counts();
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (options.json)
+    std::printf(
+        "{\"screenshot\":\"%s\",\"width\":%d,\"height\":%d,\"meshes\":%llu,"
+        "\"textured\":%llu,\"untextured\":%llu,\"late\":%llu,\"refused\":%llu,"
+        "\"skipped\":%llu,\"seconds\":%.3f,\"renderer\":\"%s\"}\n",
+        options.screenshot.c_str(), config.width, config.height, (unsigned long long)c.meshes,
+        (unsigned long long)c.textured, (unsigned long long)c.untextured,
+        (unsigned long long)c.late, (unsigned long long)c.refused, (unsigned long long)c.skipped,
+        seconds, context->renderer().c_str());
+  else
+    std::printf(
+        "%s: %dx%d, %d meshes drawn (%llu textured, %llu untextured: %llu late, %llu refused; "
+        "%llu skipped) in %.1f s, %s\n",
+        options.screenshot.c_str(), config.width, config.height, drawn,
+        (unsigned long long)c.textured, (unsigned long long)c.untextured,
+        (unsigned long long)c.late, (unsigned long long)c.refused, (unsigned long long)c.skipped,
+        seconds, context->renderer().c_str());
+  for (const auto& p : (*pipeline)->asset_problems())
+    std::fprintf(stderr, "asset: %s\n", p.c_str());
+  node.stop();
+  if (!written) return error("cannot write '" + options.screenshot + "'", 1);
+  if (options.duration_s <= 0 && drawn < options.frames)
+    return error("only " + std::to_string(drawn) + " of " + std::to_string(options.frames) +
+                     " meshes within " + std::to_string(int(options.timeout_s)) + " s",
+                 1);
+  return 0;
+}
+
+}  // namespace studio::preview

@@ -1,0 +1,24 @@
+#pragma once
+// studio-preview --headless: renders through EGL (no display) for tests, the demo report and
+// render farms. Options from the command line (main.cc).
+#include <string>
+
+#include "preview_config.h"
+
+namespace studio::preview {
+
+struct HeadlessOptions {
+  std::string screenshot;  // PNG of the last frame
+  int frames = 1;          // meshes to draw (each a new mesh); 0 = the scene only
+  double timeout_s = 30;   // give up waiting for meshes after this long
+  double duration_s = 0;   // > 0: draw every mesh for this long (frames ignored), then stop
+  double settle_s = 1.0;   // --frames 0: wait this long for the scene before the screenshot
+  std::string record;      // folder: every drawn mesh's frame as <n>.png + frames.jsonl
+  bool json = false;       // summary as one JSON line
+};
+
+// Exit status: 0 done; 1 runtime failure (no EGL, DDS, fewer meshes than asked in time; the
+// screenshot is still written); 2 bad input.
+int run_headless(const PreviewConfig& config, const HeadlessOptions& options);
+
+}  // namespace studio::preview

@@ -1,0 +1,146 @@
+// studio-preview: the director's preview and control panel (issue 16). GUI (GLFW + Dear ImGui,
+// OpenGL 3.3) by default; --headless renders through EGL with no display.
+#include <charconv>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+#include "core/log.h"
+#include "gui.h"
+#include "headless.h"
+#include "preview_config.h"
+
+using namespace studio;
+
+namespace {
+
+constexpr const char* kUsage =
+    R"(usage: studio-preview [--config preview.yaml] [--viewpoint V] [--texturing blend|nearest]
+                      [--size WxH]
+       studio-preview --headless --screenshot PNG [--frames N | --duration S] [--record DIR]
+                      [--timeout S]
+                      [--json] [same options]
+
+The director's preview and control panel: the virtual scene (studio/scene/node) and the live
+actor mesh (studio/actor/mesh) from any viewpoint, the actor textured from the studio cameras
+with the images of exactly the frame that built the mesh (requested from the capture servers'
+rings: studio/camera/image_request -> image_reply); panels for the cameras (CameraControl and
+read-back), capture (takes at a frame), animation (play, pause, seek, speed) and services.
+
+Options:
+  --config FILE     preview.yaml (keys below); without it, the defaults and the environment
+  --viewpoint V     eye=X,Y,Z,at=X,Y,Z[,fov=DEG] (studio frame, metres, y up)
+  --texturing T     blend (up to three cameras, visibility, ULR weights) or nearest (the paper's)
+  --size WxH        window or screenshot size
+  --headless        no window: EGL surfaceless rendering (Mesa llvmpipe without a GPU)
+  --screenshot PNG  headless: the last frame
+  --frames N        headless: draw N new meshes, then stop (default 1; 0 = the scene only)
+  --record DIR      headless: every drawn mesh's frame as DIR/<n>.png plus DIR/frames.jsonl
+                    ({"image", "source_frame", "textured", "cameras"} per line)
+  --timeout S       headless: give up after S seconds (default 30)
+  --duration S      headless: draw every mesh that arrives for S seconds, then stop (instead
+                    of --frames)
+  --json            headless: the summary as one JSON line
+  --test-script F   GUI: scripted input for tests (gui.h: one action per line)
+
+Exit status: 0 done; 1 runtime failure (no display / EGL, DDS, fewer meshes than asked within
+the timeout: the screenshot is still written); 2 bad arguments or config.
+)";
+
+[[noreturn]] void die(const std::string& message, int status = 2) {
+  std::fprintf(stderr, "studio-preview: %s\n", message.c_str());
+  std::exit(status);
+}
+
+template <class T>
+T number(const std::string& flag, const std::string& text, T lo, T hi) {
+  T v{};
+  auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || p != text.data() + text.size() || !(v >= lo && v <= hi))
+    die(flag + ": expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+        "], got '" + text + "'");
+  return v;
+}
+
+int run(int argc, char** argv) {
+  std::string config_path, viewpoint, texturing, size, script;
+  bool headless = false;
+  preview::HeadlessOptions h;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) die(a + ": missing value (see --help)");
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      std::fputs(preview::kConfigHelp, stdout);
+      return 0;
+    } else if (a == "--config") {
+      config_path = value();
+    } else if (a == "--viewpoint") {
+      viewpoint = value();
+    } else if (a == "--texturing") {
+      texturing = value();
+    } else if (a == "--size") {
+      size = value();
+    } else if (a == "--headless") {
+      headless = true;
+    } else if (a == "--screenshot") {
+      h.screenshot = value();
+    } else if (a == "--frames") {
+      h.frames = number<int>(a, value(), 0, 1000000);
+    } else if (a == "--record") {
+      h.record = value();
+    } else if (a == "--timeout") {
+      h.timeout_s = number<double>(a, value(), 0.1, 86400);
+    } else if (a == "--duration") {
+      h.duration_s = number<double>(a, value(), 0.1, 86400);
+    } else if (a == "--json") {
+      h.json = true;
+    } else if (a == "--test-script") {
+      script = value();
+    } else {
+      die("unknown option '" + a + "' (see --help)");
+    }
+  }
+  auto config = preview::read_preview_config(config_path);
+  if (!config) die(config.error().message);
+  if (!viewpoint.empty()) {
+    auto v = preview::parse_viewpoint(viewpoint);
+    if (!v) die("--viewpoint: " + v.error().message);
+    config->viewpoint = *v;
+  }
+  if (!texturing.empty()) {
+    if (texturing != "blend" && texturing != "nearest")
+      die("--texturing: expected blend or nearest, got '" + texturing + "'");
+    config->blend = texturing == "blend";
+  }
+  if (!size.empty()) {
+    const auto x = size.find('x');
+    if (x == std::string::npos) die("--size: expected WxH, got '" + size + "'");
+    config->width = number<int>("--size", size.substr(0, x), 16, 8192);
+    config->height = number<int>("--size", size.substr(x + 1), 16, 8192);
+  }
+  if (!config->log.empty() && !log::configure(config->log))
+    die("log: bad spec '" + config->log + "'");
+  if (headless) {
+    if (h.screenshot.empty()) die("--headless needs --screenshot PNG (see --help)");
+    return preview::run_headless(*config, h);
+  }
+  if (!h.screenshot.empty() || !h.record.empty())
+    die("--screenshot and --record are headless options (add --headless)");
+  return preview::run_gui(*config, script);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "studio-preview: %s\n", e.what());
+    return 1;
+  }
+}

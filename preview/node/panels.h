@@ -1,0 +1,52 @@
+#pragma once
+// The control panel's windows (TCSVT 2004 §II), drawn with Dear ImGui over the 3D view:
+//   Cameras    per camera the allow-listed features (Gain, ExposureTime, Focus, Zoom, Iris) as
+//              sliders over their published ranges; a released slider sends CameraControl; the
+//              read-back value (studio/camera/state) beside it.
+//   Capture    take name, start / stop at a frame (CaptureCommand), per camera recording, take,
+//              fps and drops.
+//   Animation  play, pause, seek, speed (SceneCommand), move a node.
+//   Services   every service seen on studio/service/status: state, rates, latency; one that
+//              stopped reporting (lease expired or silent for 3 s) or failed is drawn in red.
+//   View       texturing (blend / nearest), counts of textured and untextured meshes,
+//              bookmarks, a keyframed camera move.
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "preview/viewpoint.h"
+#include "preview_node.h"
+#include "view_pipeline.h"
+
+namespace studio::preview {
+
+struct ItemRect {
+  float x = 0, y = 0, w = 0, h = 0;
+  double value = 0;
+};
+
+struct PanelState {
+  bool cameras = false, capture = false, animation = false, services = false, view = true;
+  std::map<std::string, double> edits;     // "cam/feature" → the slider's value
+  std::map<std::string, double> scripted;  // "cam/feature" → value to apply next frame
+  char take[64] = "take";
+  long long at_frame = 0;
+  double seek_s = 0, speed = 1;
+  char node[64] = "";
+  float move[3] = {0, 0, 0};
+  char bookmark[64] = "a";
+  Bookmarks bookmarks;
+  std::vector<MoveKey> keys;
+  std::optional<CameraMove> move_playing;
+  double move_start_s = 0;
+  std::string last_error;
+  // Filled while drawing, for the test hook's layout file.
+  std::map<std::string, ItemRect> windows, items;
+};
+
+// Draws the open panels; may change `view` (bookmarks, camera moves). now_s: seconds since start.
+void draw_panels(PanelState& state, PreviewNode& node, ViewPipeline& pipeline, Viewpoint& view,
+                 double now_s);
+
+}  // namespace studio::preview

@@ -1,0 +1,63 @@
+#include "preview_config.h"
+
+#include "yaml_io/options.h"
+
+namespace studio::preview {
+namespace {
+
+struct Keys {
+  std::string instance = "preview";
+  int64_t domain = -1;
+  std::string dds_config, log, viewpoint, texturing = "blend", asset_root, take = "take";
+  std::vector<int> size{1280, 720};
+  int blend_cameras = 3, wait_ms = 200;
+};
+
+const yaml::Schema<Keys> kSchema{
+    yaml::field("instance", &Keys::instance),
+    yaml::field("domain", &Keys::domain).range(0, 232),
+    yaml::field("dds_config", &Keys::dds_config).relative_path(),
+    yaml::field("log", &Keys::log),
+    yaml::field("viewpoint", &Keys::viewpoint),
+    yaml::field("size", &Keys::size).size(2).range(16, 8192),
+    yaml::field("texturing", &Keys::texturing).one_of({"blend", "nearest"}),
+    yaml::field("blend_cameras", &Keys::blend_cameras).range(1, 3),
+    yaml::field("wait_ms", &Keys::wait_ms).range(0, 10000),
+    yaml::field("asset_root", &Keys::asset_root).relative_path(),
+    yaml::field("take", &Keys::take),
+};
+
+}  // namespace
+
+Expected<void> PreviewConfig::validate() const {
+  if (instance.empty() || instance.size() > 40) return fail("instance: 1..40 characters");
+  if (auto ok = viewpoint.validate(); !ok) return ok;
+  return {};
+}
+
+Expected<PreviewConfig> read_preview_config(const std::string& path) {
+  PreviewConfig c;
+  if (path.empty()) return c;
+  auto k = kSchema.read_file(path);
+  if (!k) return std::unexpected(k.error());
+  c.instance = k->instance;
+  c.domain = k->domain;
+  c.dds_config = k->dds_config;
+  c.log = k->log;
+  if (!k->viewpoint.empty()) {
+    auto v = parse_viewpoint(k->viewpoint);
+    if (!v) return fail(path + ": viewpoint: " + v.error().message);
+    c.viewpoint = *v;
+  }
+  c.width = k->size[0];
+  c.height = k->size[1];
+  c.blend = k->texturing == "blend";
+  c.blend_cameras = k->blend_cameras;
+  c.wait_ms = k->wait_ms;
+  c.asset_root = k->asset_root;
+  c.take = k->take;
+  if (auto ok = c.validate(); !ok) return fail(path + ": " + ok.error().message);
+  return c;
+}
+
+}  // namespace studio::preview

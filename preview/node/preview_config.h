@@ -1,0 +1,47 @@
+#pragma once
+// preview.yaml (studio-preview --config): the keys, their defaults and the reader.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "preview/viewpoint.h"
+
+namespace studio::preview {
+
+struct PreviewConfig {
+  // Common keys (as every service reads them, runtime/service.h).
+  std::string instance = "preview";
+  int64_t domain = -1;  // -1: $STUDIO_DDS_DOMAIN, else Cyclone's default
+  std::string dds_config;
+  std::string log;
+  // The preview's own.
+  Viewpoint viewpoint;             // start view
+  int width = 1280, height = 720;  // window / screenshot size
+  bool blend = true;               // texturing: blend (true) or nearest
+  int blend_cameras = 3;           // 1..3
+  int wait_ms = 200;               // wait for a new mesh's images, then draw it untextured
+  std::string asset_root;          // relative asset paths of scene nodes resolve here
+  std::string take = "take";       // the capture panel's default take name
+  Expected<void> validate() const;
+};
+
+inline constexpr const char* kConfigHelp =
+    "preview.yaml keys (all optional):\n"
+    "  instance: director            name of this preview (image requests carry it)\n"
+    "  domain: 0                     DDS domain (default $STUDIO_DDS_DOMAIN)\n"
+    "  dds_config: FILE              Cyclone XML profile (default $CYCLONEDDS_URI)\n"
+    "  log: info                     log levels, e.g. info,preview=debug\n"
+    "  viewpoint: \"eye=0,1.6,5,at=0,1,0,fov=50\"   start view (studio frame, metres)\n"
+    "  size: [1280, 720]             window / screenshot size in pixels\n"
+    "  texturing: blend              blend (up to 3 cameras, visibility) or nearest (the paper's)\n"
+    "  blend_cameras: 3              cameras the blend uses, 1..3\n"
+    "  wait_ms: 200                  wait this long for a new mesh's frame-exact images, then\n"
+    "                                draw it untextured (counted)\n"
+    "  asset_root: DIR               relative asset paths of scene nodes resolve here\n"
+    "  take: take                    the capture panel's default take name\n";
+
+// Defaults when path is empty. Errors: "file:line: field: problem".
+Expected<PreviewConfig> read_preview_config(const std::string& path);
+
+}  // namespace studio::preview

@@ -1,0 +1,337 @@
+#include "preview_node.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "core/clock.h"
+#include "wire/convert.h"
+#include "wire/sample.h"
+#include "wire/scene_convert.h"
+
+namespace studio::preview {
+namespace {
+
+constexpr const char* kLog = "preview";
+constexpr std::size_t kKeptImages = 24;  // (camera, frame) images kept for the renderer
+
+scene::ActorMesh mesh_from_wire(const studio_ActorMesh& s) {
+  scene::ActorMesh m;
+  m.actor_id = wire::str(s.actor_id);
+  m.frame = int64_t(s.source_frame);
+  const auto v = wire::view(s.vertices);
+  const auto n = wire::view(s.normals);
+  const auto t = wire::view(s.triangles);
+  m.vertices.resize(v.size() / 3);
+  for (std::size_t i = 0; i < m.vertices.size(); ++i)
+    m.vertices[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+  if (n.size() == v.size()) {
+    m.normals.resize(m.vertices.size());
+    for (std::size_t i = 0; i < m.normals.size(); ++i)
+      m.normals[i] = {n[3 * i], n[3 * i + 1], n[3 * i + 2]};
+  }
+  m.triangles.resize(t.size() / 3);
+  for (std::size_t i = 0; i < m.triangles.size(); ++i)
+    m.triangles[i] = {t[3 * i], t[3 * i + 1], t[3 * i + 2]};
+  if (m.normals.empty()) m.compute_normals();
+  return m;
+}
+
+}  // namespace
+
+struct PreviewNode::Impl {
+  Impl(runtime::NodeContext& context, std::string requester_id)
+      : loop(context, kLog),
+        requester(std::move(requester_id)),
+        requests(loop.output<studio_ImageRequest>({.counter = "image_requests", .rate = false})),
+        controls(loop.output<studio_CameraControl>({.counter = "controls_sent", .rate = false})),
+        captures(loop.output<studio_CaptureCommand>({.counter = "captures_sent", .rate = false})),
+        scene_commands(
+            loop.output<studio_SceneCommand>({.counter = "scene_commands_sent", .rate = false})),
+        meshes_in(loop.counter("meshes_in")),
+        images_in(loop.counter("images_in")),
+        images_refused(loop.counter("image_replies_not_ok")) {
+    loop.input<studio_SceneNode>(
+        {.received = "scene_nodes_in", .rate = false, .instance_changes = true, .batch = 1024},
+        [this](const studio_SceneNode& s, const wire::SampleMeta& m) { return on_node(s, m); });
+    loop.input<studio_ActorMesh>({.received = "meshes_received"},
+                                 [this](const studio_ActorMesh& s, const wire::SampleMeta&) {
+                                   std::lock_guard lock(mutex);
+                                   auto& live = meshes[std::string(wire::str(s.actor_id))];
+                                   live.mesh = mesh_from_wire(s);
+                                   live.source_frame = s.source_frame;
+                                   live.capture_ns = s.capture_ns;
+                                   live.sequence = ++mesh_sequence;
+                                   meshes_in.add();
+                                   loop.completed(s.source_frame, s.capture_ns);
+                                   return runtime::Outcome{};
+                                 });
+    loop.input<studio_CameraCalibration>(
+        {.received = "calibrations_in", .rate = false},
+        [this](const studio_CameraCalibration& s, const wire::SampleMeta&) -> runtime::Outcome {
+          auto c = wire::to_core(s);
+          if (!c) return runtime::reject("calibration", c.error().message);
+          std::lock_guard lock(mutex);
+          calibrations[c->id] = *c;
+          return {};
+        });
+    loop.input<studio_CameraState>({.received = "states_in", .rate = false},
+                                   [this](const studio_CameraState& s, const wire::SampleMeta&) {
+                                     on_state(s);
+                                     return runtime::Outcome{};
+                                   });
+    loop.input<studio_ImageReply>({.received = "image_replies_in", .rate = false},
+                                  [this](const studio_ImageReply& s, const wire::SampleMeta&) {
+                                    on_reply(s);
+                                    return runtime::Outcome{};
+                                  });
+    loop.input<studio_ServiceStatus>(
+        {.received = "statuses_in", .rate = false, .instance_changes = true},
+        [this](const studio_ServiceStatus& s, const wire::SampleMeta& m) {
+          std::lock_guard lock(mutex);
+          ServiceView& v = services[std::string(wire::str(s.service)) + ":" +
+                                    std::string(wire::str(s.instance))];
+          v.service = wire::str(s.service);
+          v.instance = wire::str(s.instance);
+          v.alive = m.alive;
+          if (!m.valid_data) return runtime::Outcome{};
+          v.state = int(s.state);
+          v.input_hz = s.input_hz;
+          v.output_hz = s.output_hz;
+          v.latency_ms = s.latency_ms;
+          v.seen = std::chrono::steady_clock::now();
+          return runtime::Outcome{};
+        });
+  }
+
+  runtime::Outcome on_node(const studio_SceneNode& s, const wire::SampleMeta& m) {
+    std::lock_guard lock(mutex);
+    const std::string id(wire::str(s.node_id));
+    if (!m.valid_data || m.disposed) {
+      if (!m.valid_data && !m.disposed && m.alive) return {};
+      nodes.erase(id);
+      ++scene_version;
+      return {};
+    }
+    auto n = wire::to_core(s);
+    if (!n) return runtime::reject("scene_node", n.error().message);
+    nodes[id] = std::move(*n);
+    ++scene_version;
+    return {};
+  }
+
+  void on_state(const studio_CameraState& s) {
+    CameraStateView v;
+    v.camera_id = wire::str(s.camera_id);
+    v.frame = s.frame;
+    v.fps = s.fps;
+    v.drops = s.drops;
+    v.recording = s.recording;
+    v.take = wire::str(s.take);
+    v.error = wire::str(s.error);
+    v.state = int(s.state);
+    for (const auto& f : wire::view(s.features))
+      v.features.push_back({std::string(wire::str(f.name)), f.value, f.min, f.max});
+    std::lock_guard lock(mutex);
+    states[v.camera_id] = std::move(v);
+  }
+
+  void on_reply(const studio_ImageReply& s) {
+    if (wire::str(s.requester) != requester) return;  // another preview's
+    std::lock_guard lock(mutex);
+    const std::string camera(wire::str(s.camera_id));
+    if (s.status != studio_IMAGE_REPLY_OK || s.format != studio_IMAGE_RGB8) {
+      images_refused.add();
+      refused[{camera, s.frame}] = true;
+      changed.notify_all();
+      return;
+    }
+    FrameImage& img = images[{camera, s.frame}];
+    img.width = int(s.width);
+    img.height = int(s.height);
+    img.frame = s.frame;
+    const auto d = wire::view(s.data);
+    img.rgb.assign(d.begin(), d.end());
+    images_in.add();
+    while (images.size() > kKeptImages) images.erase(oldest(images));
+    while (refused.size() > kKeptImages) refused.erase(oldest(refused));
+    changed.notify_all();
+  }
+
+  template <class Map>
+  static typename Map::iterator oldest(Map& m) {
+    return std::min_element(m.begin(), m.end(), [](const auto& a, const auto& b) {
+      return a.first.second < b.first.second;
+    });
+  }
+
+  runtime::ServiceLoop loop;
+  std::string requester;
+  runtime::Output<studio_ImageRequest>& requests;
+  runtime::Output<studio_CameraControl>& controls;
+  runtime::Output<studio_CaptureCommand>& captures;
+  runtime::Output<studio_SceneCommand>& scene_commands;
+  runtime::Counter& meshes_in;
+  runtime::Counter& images_in;
+  runtime::Counter& images_refused;
+
+  mutable std::mutex mutex;
+  std::condition_variable changed;
+  std::map<std::string, Camera> calibrations;
+  std::map<std::string, LiveMesh> meshes;
+  uint64_t mesh_sequence = 0;
+  std::map<std::string, scene::Node> nodes;
+  uint64_t scene_version = 0;
+  std::map<std::string, CameraStateView> states;
+  std::map<std::string, ServiceView> services;
+  std::map<std::pair<std::string, uint64_t>, FrameImage> images;
+  std::map<std::pair<std::string, uint64_t>, bool> refused;
+  std::map<std::pair<std::string, uint64_t>, bool> asked;
+  uint64_t request_id = 0;
+  uint64_t command_id = 0;
+};
+
+PreviewNode::PreviewNode(runtime::NodeContext& context, std::string requester)
+    : impl_(std::make_unique<Impl>(context, std::move(requester))) {}
+PreviewNode::~PreviewNode() { stop(); }
+Expected<void> PreviewNode::start() { return impl_->loop.start(); }
+void PreviewNode::stop() { impl_->loop.stop(); }
+runtime::NodeHealth PreviewNode::health() { return impl_->loop.health(); }
+
+std::map<std::string, Camera> PreviewNode::cameras() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->calibrations;
+}
+
+std::optional<LiveMesh> PreviewNode::mesh_after(uint64_t sequence) const {
+  std::lock_guard lock(impl_->mutex);
+  const LiveMesh* best = nullptr;
+  for (const auto& [id, m] : impl_->meshes)
+    if (m.sequence > sequence && (!best || m.sequence > best->sequence)) best = &m;
+  if (!best) return std::nullopt;
+  return *best;
+}
+
+uint64_t PreviewNode::mesh_sequence() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->mesh_sequence;
+}
+
+std::optional<scene::Scene> PreviewNode::scene_after(uint64_t& version) const {
+  std::lock_guard lock(impl_->mutex);
+  if (impl_->scene_version == version) return std::nullopt;
+  version = impl_->scene_version;
+  // Parents before children; a node whose parent has not arrived (yet) waits for it.
+  scene::Scene s;
+  std::vector<const scene::Node*> pending;
+  for (const auto& [id, n] : impl_->nodes) pending.push_back(&n);
+  for (bool progress = true; progress && !pending.empty();) {
+    progress = false;
+    for (auto it = pending.begin(); it != pending.end();) {
+      const scene::Node& n = **it;
+      if (!n.parent.empty() && !s.find(n.parent)) {
+        ++it;
+        continue;
+      }
+      (void)s.apply({n.frame, scene::AddNode{n}});  // an invalid node is left out
+      it = pending.erase(it);
+      progress = true;
+    }
+  }
+  return s;
+}
+
+std::vector<CameraStateView> PreviewNode::camera_states() const {
+  std::lock_guard lock(impl_->mutex);
+  std::vector<CameraStateView> out;
+  for (const auto& [id, s] : impl_->states) out.push_back(s);
+  return out;
+}
+
+std::vector<ServiceView> PreviewNode::services() const {
+  std::lock_guard lock(impl_->mutex);
+  std::vector<ServiceView> out;
+  for (const auto& [id, s] : impl_->services) out.push_back(s);
+  return out;
+}
+
+void PreviewNode::request_images(uint64_t frame, const std::vector<std::string>& cameras) {
+  std::vector<std::string> wanted;
+  {
+    std::lock_guard lock(impl_->mutex);
+    for (const auto& c : cameras)
+      if (!impl_->images.count({c, frame}) && !impl_->asked.count({c, frame})) {
+        impl_->asked[{c, frame}] = true;
+        wanted.push_back(c);
+      }
+    while (impl_->asked.size() > 4 * kKeptImages) impl_->asked.erase(Impl::oldest(impl_->asked));
+  }
+  for (const auto& c : wanted) {
+    wire::Owned<studio_ImageRequest> r;
+    wire::set(r->requester, impl_->requester);
+    wire::set(r->camera_id, c);
+    r->frame = frame;
+    r->capture_ns = realtime_ns();
+    r->request_id = ++impl_->request_id;
+    (void)impl_->requests.write(*r);
+  }
+}
+
+std::expected<std::vector<FrameImage>, PreviewNode::Missing> PreviewNode::images(
+    uint64_t frame, const std::vector<std::string>& cameras, std::chrono::milliseconds wait) {
+  std::unique_lock lock(impl_->mutex);
+  auto ready = [&] {
+    for (const auto& c : cameras)
+      if (!impl_->images.count({c, frame})) return false;
+    return true;
+  };
+  auto refused = [&] {
+    for (const auto& c : cameras)
+      if (impl_->refused.count({c, frame})) return true;
+    return false;
+  };
+  impl_->changed.wait_for(lock, wait, [&] { return ready() || refused(); });
+  if (!ready()) return std::unexpected(refused() ? Missing::refused : Missing::late);
+  std::vector<FrameImage> out;
+  for (const auto& c : cameras) out.push_back(impl_->images.at({c, frame}));
+  return out;
+}
+
+Expected<void> PreviewNode::send_control(const std::string& camera, const std::string& feature,
+                                         double value) {
+  wire::Owned<studio_CameraControl> c;
+  wire::set(c->camera_id, camera);
+  wire::set(c->feature, feature);
+  c->capture_ns = realtime_ns();
+  c->value = value;
+  return impl_->controls.write(*c);
+}
+
+Expected<void> PreviewNode::send_capture(const std::string& take, bool start, uint64_t at_frame) {
+  wire::Owned<studio_CaptureCommand> c;
+  wire::set(c->take, take);
+  c->capture_ns = realtime_ns();
+  c->action = start ? studio_CAPTURE_START : studio_CAPTURE_STOP;
+  c->at_frame = at_frame;
+  return impl_->captures.write(*c);
+}
+
+Expected<void> PreviewNode::send_scene(int verb, const std::string& target, double value,
+                                       const Eigen::Vector3d& translation) {
+  wire::Owned<studio_SceneCommand> c;
+  c->capture_ns = realtime_ns();
+  c->verb = static_cast<studio_SceneVerb>(verb);
+  wire::set(c->target, target);
+  c->value = value;
+  c->has_value = verb == studio_SCENE_SEEK || verb == studio_SCENE_SPEED;
+  for (int i = 0; i < 4; ++i) c->transform[5 * i] = 1;
+  for (int i = 0; i < 3; ++i) c->transform[4 * i + 3] = translation[i];
+  c->node.rotation[3] = 1;
+  for (int i = 0; i < 3; ++i) c->node.scale[i] = 1;
+  wire::set(c->sender, impl_->requester);
+  c->command_id = ++impl_->command_id;
+  c->at_frame = studio_SCENE_AT_NOW;
+  c->mode = studio_SCENE_MODE_KEEP;
+  return impl_->scene_commands.write(*c);
+}
+
+}  // namespace studio::preview

@@ -1,0 +1,184 @@
+#include "view_pipeline.h"
+
+#include <filesystem>
+#include <numbers>
+#include <set>
+
+#include "actor_texturer.h"
+#include "core/log.h"
+#include "scene/view.h"
+#include "scene_assets/asset.h"
+#include "scene_render/renderer.h"
+
+namespace studio::preview {
+
+struct ViewPipeline::Impl {
+  PreviewNode* node = nullptr;
+  PipelineOptions options;
+  scene_render::Renderer renderer;
+  ActorTexturer texturer;
+  scene::Scene scene;
+  uint64_t scene_version = 0;
+  std::set<std::string> uploaded, failed;
+  std::vector<std::string> problems;
+  uint64_t mesh_sequence = 0;
+  // The mesh waiting for its images, and what is drawn now.
+  std::optional<LiveMesh> pending;
+  std::chrono::steady_clock::time_point pending_since;
+  std::vector<std::string> pending_cameras;
+  std::vector<float> pending_weights;
+  bool have_current = false, current_textured = false;
+  FrameReport current;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  PipelineCounts counts;
+
+  Impl(PreviewNode& n, const PipelineOptions& o, scene_render::Renderer r, ActorTexturer t)
+      : node(&n), options(o), renderer(std::move(r)), texturer(std::move(t)) {}
+
+  void refresh_scene() {
+    auto s = node->scene_after(scene_version);
+    if (!s) return;
+    scene = std::move(*s);
+    for (const auto& [id, n] : scene.nodes()) {
+      if (n.kind != scene::NodeKind::model || uploaded.count(n.asset.path) ||
+          failed.count(n.asset.path))
+        continue;
+      std::filesystem::path p = n.asset.path;
+      if (p.is_relative() && !options.asset_root.empty()) p = options.asset_root / p;
+      auto a = scene_assets::load_asset(p.string());
+      if (a) {
+        a->path = n.asset.path;  // the renderer matches nodes by the path they name
+        if (auto ok = renderer.upload(*a); ok) {
+          uploaded.insert(n.asset.path);
+          continue;
+        }
+      }
+      failed.insert(n.asset.path);
+      problems.push_back(n.asset.path + ": " + (a ? "upload failed" : a.error().message));
+      STUDIO_LOG(warn, "preview") << problems.back();
+    }
+  }
+
+  // Chooses the cameras for a new mesh seen from `eye` and asks for their images.
+  void take_new_mesh(const Viewpoint& view) {
+    auto m = node->mesh_after(mesh_sequence);
+    if (!m) return;
+    if (pending) ++counts.skipped;  // superseded before its images came: never drawn
+    mesh_sequence = m->sequence;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+    for (const auto& v : m->mesh.vertices) {
+      lo = lo.cwiseMin(v.cast<double>());
+      hi = hi.cwiseMax(v.cast<double>());
+    }
+    if (!m->mesh.vertices.empty()) centre = 0.5 * (lo + hi);
+    const auto cams = node->cameras();
+    std::vector<StudioCameraPose> poses;
+    std::vector<std::string> ids;
+    for (const auto& [id, c] : cams) {
+      poses.push_back({id, c.centre_in_world()});
+      ids.push_back(id);
+    }
+    BlendOptions bo = options.blend_options;
+    bo.cameras = std::min(bo.cameras, ActorTexturer::kMaxCameras);
+    const auto chosen = options.blend ? preview::blend(poses, view.eye, centre, bo)
+                                      : preview::nearest(poses, view.eye, centre);
+    pending = std::move(*m);
+    pending_since = std::chrono::steady_clock::now();
+    pending_cameras.clear();
+    pending_weights.clear();
+    for (const auto& w : chosen) {
+      pending_cameras.push_back(ids[w.index]);
+      pending_weights.push_back(float(w.weight));
+    }
+    node->request_images(pending->source_frame, pending_cameras);
+  }
+
+  // Promotes the pending mesh when its images are here (textured) or it waited too long.
+  bool promote(bool block) {
+    if (!pending) return false;
+    const auto waited = std::chrono::steady_clock::now() - pending_since;
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(options.wait - waited);
+    using Missing = PreviewNode::Missing;
+    const auto imgs =
+        pending_cameras.empty()
+            ? std::expected<std::vector<FrameImage>, Missing>(std::unexpected(Missing::refused))
+            : node->images(pending->source_frame, pending_cameras,
+                           block ? std::max(left, std::chrono::milliseconds(0))
+                                 : std::chrono::milliseconds(0));
+    if (!imgs && imgs.error() == Missing::late && waited < options.wait) return false;
+    if (auto ok = texturer.set_mesh(pending->mesh); !ok) {
+      STUDIO_LOG(warn, "preview") << "mesh: " << ok.error().message;
+      pending.reset();
+      return false;
+    }
+    bool textured = imgs.has_value();
+    if (textured) {
+      const auto cams = node->cameras();
+      for (std::size_t i = 0; i < imgs->size() && textured; ++i) {
+        const FrameImage& img = (*imgs)[i];
+        const auto c = cams.find(pending_cameras[i]);
+        textured = c != cams.end() && c->second.width == img.width &&
+                   c->second.height == img.height &&
+                   texturer.set_camera(int(i), c->second, img.rgb.data()).has_value();
+      }
+    }
+    current = {};
+    current.new_mesh = true;
+    current.textured = textured;
+    current.source_frame = pending->source_frame;
+    current.cameras = pending_cameras;
+    current.weights = pending_weights;
+    have_current = true;
+    ++counts.meshes;
+    ++(textured ? counts.textured : counts.untextured);
+    if (!imgs) ++(imgs.error() == Missing::late ? counts.late : counts.refused);
+    pending.reset();
+    return true;
+  }
+};
+
+ViewPipeline::ViewPipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ViewPipeline::~ViewPipeline() = default;
+
+Expected<std::unique_ptr<ViewPipeline>> ViewPipeline::create(PreviewNode& node,
+                                                             const PipelineOptions& options) {
+  if (auto ok = options.blend_options.validate(); !ok) return std::unexpected(ok.error());
+  auto r = scene_render::Renderer::create();
+  if (!r) return std::unexpected(r.error());
+  auto t = ActorTexturer::create();
+  if (!t) return std::unexpected(t.error());
+  return std::unique_ptr<ViewPipeline>(
+      new ViewPipeline(std::make_unique<Impl>(node, options, std::move(*r), std::move(*t))));
+}
+
+FrameReport ViewPipeline::render(const Viewpoint& view, int width, int height, bool block) {
+  Impl& r = *impl_;
+  r.refresh_scene();
+  r.take_new_mesh(view);
+  const bool fresh = r.promote(block);
+  scene_render::View v;
+  v.cam_from_world = scene::look_at(view.eye, view.at);
+  v.clip_from_cam = scene::perspective(view.fov_deg * std::numbers::pi / 180,
+                                       double(width) / height, 0.05, 200.0);
+  r.renderer.draw(r.scene, v);
+  FrameReport report = r.current;
+  report.new_mesh = fresh;
+  if (r.have_current) {
+    std::array<float, ActorTexturer::kMaxCameras> w{};
+    for (std::size_t i = 0; i < r.current.weights.size() && i < w.size(); ++i)
+      w[i] = r.current.weights[i];
+    r.texturer.draw(v.clip_from_cam * v.cam_from_world, w, r.current.textured, width, height);
+  }
+  return report;
+}
+
+const PipelineCounts& ViewPipeline::counts() const { return impl_->counts; }
+bool ViewPipeline::has_work() const {
+  return impl_->pending || impl_->node->mesh_sequence() > impl_->mesh_sequence;
+}
+std::vector<std::string> ViewPipeline::asset_problems() const { return impl_->problems; }
+Eigen::Vector3d ViewPipeline::actor_centre() const { return impl_->centre; }
+void ViewPipeline::set_blend(bool blend) { impl_->options.blend = blend; }
+bool ViewPipeline::blend() const { return impl_->options.blend; }
+
+}  // namespace studio::preview

@@ -1,0 +1,73 @@
+#pragma once
+// One preview view (issue 16): the scene mirror drawn by the project's renderer
+// (scene_render::Renderer), then the live actor textured frame-exactly (gl/actor_texturer.h).
+//
+// Frame-exact rule: a mesh built from the masks of frame F is drawn textured only with the
+// images of frame F of the cameras chosen for it (preview/camera_select.h: nearest, or the blend
+// of up to three). When a new mesh arrives the pipeline requests those images and keeps drawing
+// the previous (mesh, images) pair until they are all here; if they do not arrive within `wait`
+// (late, evicted from the capture ring) the new mesh is drawn untextured and counted. A mesh is
+// never drawn with another frame's image.
+// Needs a current OpenGL 3.3 context (EGL headless or the GLFW window's).
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "preview/camera_select.h"
+#include "preview/viewpoint.h"
+#include "preview_node.h"
+
+namespace studio::preview {
+
+struct PipelineOptions {
+  bool blend = true;           // false: the paper's nearest camera
+  BlendOptions blend_options;  // cameras: how many the blend uses (at most 3 here)
+  std::chrono::milliseconds wait{200};
+  std::string asset_root;  // relative asset paths of scene nodes resolve here
+};
+
+struct FrameReport {
+  bool new_mesh = false;             // this frame drew a mesh not drawn before
+  bool textured = false;             // the drawn mesh is textured
+  uint64_t source_frame = 0;         // frame of the masks that built the drawn mesh
+  std::vector<std::string> cameras;  // texturing cameras (ids), with their weights
+  std::vector<float> weights;
+};
+
+// meshes = drawn meshes = textured + untextured; untextured = late (no reply within `wait`) +
+// refused (a capture server no longer or not yet had the frame); skipped: meshes superseded by
+// a newer one while their images were on the way (never drawn).
+struct PipelineCounts {
+  uint64_t meshes = 0, textured = 0, untextured = 0, late = 0, refused = 0, skipped = 0;
+};
+
+class ViewPipeline {
+ public:
+  static Expected<std::unique_ptr<ViewPipeline>> create(PreviewNode& node,
+                                                        const PipelineOptions& options);
+  ~ViewPipeline();
+
+  // Draws into the bound framebuffer (width x height). block: wait up to options.wait for the
+  // images of a new mesh here (headless); else return at once and look again next frame (GUI).
+  FrameReport render(const Viewpoint& view, int width, int height, bool block);
+  const PipelineCounts& counts() const;
+  // A mesh is waiting for its images or a newer one has arrived (render() has work).
+  bool has_work() const;
+  // Assets the scene names that could not be loaded, one line each.
+  std::vector<std::string> asset_problems() const;
+  // The newest mesh's centre (for orbiting), or the origin.
+  Eigen::Vector3d actor_centre() const;
+  void set_blend(bool blend);
+  bool blend() const;
+
+ private:
+  struct Impl;
+  explicit ViewPipeline(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace studio::preview

@@ -1,0 +1,158 @@
+// The director's preview on Mesa llvmpipe (EGL surfaceless), 1280x720, the default museum scene
+// plus the live actor: frame time of the scene alone (baseline, the renderer's own cost), the
+// actor textured from the nearest camera (the paper's), and the blend of three cameras with
+// visibility; and per new mesh, the upload of the mesh, the camera images and their visibility
+// depth maps. Samples: the simulated studio's actor (its tessellated true surface, ~the hull
+// mesh's size) and the five ring cameras' images of the same frame (352x288 and 704x576), made
+// once before timing. Each timed frame ends with glFinish (llvmpipe renders on the CPU).
+#include <benchmark/benchmark.h>
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/gl.h>
+
+#include <numbers>
+
+#include "actor_texturer.h"
+#include "scene/view.h"
+#include "scene_assets/scene_description.h"
+#include "scene_config/scene_yaml.h"
+#include "scene_render/egl_context.h"
+#include "scene_render/render_target.h"
+#include "scene_render/renderer.h"
+#include "sim/cameras.h"
+#include "sim/studio.h"
+
+using namespace studio;
+
+namespace {
+
+constexpr int kW = 1280, kH = 720;
+
+struct Samples {
+  std::vector<Camera> cameras;
+  std::vector<Image<Rgb8>> images;
+  scene::ActorMesh mesh;
+};
+
+struct Fixture {
+  scene_render::HeadlessContext context;
+  scene::Scene scene;
+  scene_render::Renderer renderer;
+  preview::ActorTexturer texturer;
+  scene_render::RenderTarget target;
+  std::map<int, Samples> samples;  // by camera image width
+};
+
+Samples make_samples(int width) {
+  sim::RingOptions ring;
+  ring.count = 5;
+  ring.width = width;
+  ring.height = width * 576 / 704;
+  ring.focal_px *= width / 704.0;
+  Samples s;
+  s.cameras = sim::ring_cameras(ring);
+  sim::StudioOptions o;
+  o.threads = 2;
+  auto studio = sim::SimulatedStudio::create(s.cameras, o).value();
+  const sim::FrameTruth truth = studio.render_all(100, &s.images, nullptr);
+  const sim::TriangleMesh m = truth.body.mesh(24);
+  s.mesh.actor_id = "actor0";
+  s.mesh.vertices = m.vertices;
+  for (const auto& t : m.triangles) s.mesh.triangles.push_back(t);
+  s.mesh.compute_normals();
+  return s;
+}
+
+Fixture& fixture() {
+  static Fixture* f = [] {
+    auto ctx = scene_render::HeadlessContext::create();
+    if (!ctx) throw std::runtime_error(ctx.error().message);
+    auto d = scene_config::read_scene_file(std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml");
+    if (!d) throw std::runtime_error(d.error().message);
+    scene_assets::AssetCache cache;
+    auto s = scene_assets::build_scene(*d, cache);
+    if (!s) throw std::runtime_error(s.error().message);
+    auto r = scene_render::Renderer::create().value();
+    for (const auto& [p, a] : cache.all()) (void)r.upload(*a);
+    auto t = preview::ActorTexturer::create().value();
+    auto target = scene_render::RenderTarget::create(kW, kH).value();
+    auto* out = new Fixture{std::move(*ctx), std::move(*s),     std::move(r),
+                            std::move(t),    std::move(target), {}};
+    out->samples[352] = make_samples(352);
+    out->samples[704] = make_samples(704);
+    return out;
+  }();
+  return *f;
+}
+
+// The view between cam0 and cam1, 4.5 m out.
+scene_render::View view() {
+  scene_render::View v;
+  v.cam_from_world = scene::look_at({1.6, 1.7, 4.2}, {0, 1.0, 0});
+  v.clip_from_cam = scene::perspective(50 * std::numbers::pi / 180, double(kW) / kH, 0.05, 200);
+  return v;
+}
+
+void upload(Fixture& f, const Samples& s, int cameras) {
+  (void)f.texturer.set_mesh(s.mesh);
+  // cam0, cam1, cam4: the three nearest of the view (camera_select.h's choice for it).
+  const int order[3] = {0, 1, 4};
+  for (int i = 0; i < cameras; ++i)
+    (void)f.texturer.set_camera(i, s.cameras[order[i]],
+                                reinterpret_cast<const uint8_t*>(s.images[order[i]].data()));
+}
+
+// cameras 0: the scene alone; 1: nearest; 3: the blend.
+void BM_PreviewFrame(benchmark::State& state) {
+  Fixture& f = fixture();
+  const int cameras = int(state.range(0));
+  const Samples& s = f.samples.at(int(state.range(1)));
+  f.target.bind();
+  upload(f, s, std::max(cameras, 1));
+  const scene_render::View v = view();
+  std::array<float, 3> w{};
+  if (cameras == 1) w = {1, 0, 0};
+  if (cameras == 3) w = {0.5f, 0.3f, 0.2f};
+  for (auto _ : state) {
+    f.target.bind();
+    f.renderer.draw(f.scene, v);
+    if (cameras > 0) f.texturer.draw(v.clip_from_cam * v.cam_from_world, w, true, kW, kH);
+    glFinish();
+  }
+  state.counters["fps"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["triangles"] = double(s.mesh.triangles.size());
+}
+BENCHMARK(BM_PreviewFrame)
+    ->ArgNames({"cameras", "image_w"})
+    ->Args({0, 352})
+    ->Args({1, 352})
+    ->Args({3, 352})
+    ->Args({1, 704})
+    ->Args({3, 704})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Per new mesh: mesh upload, camera images and their depth maps (1 or 3 cameras).
+void BM_PreviewNewMesh(benchmark::State& state) {
+  Fixture& f = fixture();
+  const int cameras = int(state.range(0));
+  const Samples& s = f.samples.at(int(state.range(1)));
+  for (auto _ : state) {
+    f.target.bind();
+    upload(f, s, cameras);
+    glFinish();
+  }
+}
+BENCHMARK(BM_PreviewNewMesh)
+    ->ArgNames({"cameras", "image_w"})
+    ->Args({1, 352})
+    ->Args({3, 352})
+    ->Args({1, 704})
+    ->Args({3, 704})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

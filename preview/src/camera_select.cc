@@ -1,0 +1,76 @@
+#include "preview/camera_select.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace studio::preview {
+
+Expected<void> BlendOptions::validate() const {
+  if (cameras < 1 || cameras > 8) return fail("blend cameras: expected 1..8");
+  return {};
+}
+
+double view_angle(const Eigen::Vector3d& eye, const Eigen::Vector3d& centre,
+                  const Eigen::Vector3d& target) {
+  const Eigen::Vector3d a = eye - target, b = centre - target;
+  if (a.norm() < 1e-12 || b.norm() < 1e-12) return std::numbers::pi;
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+namespace {
+
+std::vector<CameraWeight> by_angle(const std::vector<StudioCameraPose>& cameras,
+                                   const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  std::vector<CameraWeight> out;
+  for (int i = 0; i < static_cast<int>(cameras.size()); ++i)
+    out.push_back({i, view_angle(eye, cameras[i].centre, target), 0});
+  std::stable_sort(out.begin(), out.end(),
+                   [](const CameraWeight& a, const CameraWeight& b) { return a.angle < b.angle; });
+  return out;
+}
+
+}  // namespace
+
+std::vector<CameraWeight> nearest(const std::vector<StudioCameraPose>& cameras,
+                                  const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  auto all = by_angle(cameras, eye, target);
+  if (all.empty()) return all;
+  all.resize(1);
+  all[0].weight = 1;
+  return all;
+}
+
+std::vector<CameraWeight> blend(const std::vector<StudioCameraPose>& cameras,
+                                const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                                const BlendOptions& options) {
+  auto all = by_angle(cameras, eye, target);
+  if (all.empty()) return all;
+  const std::size_t k = std::min<std::size_t>(options.cameras, all.size());
+  constexpr double kExact = 1e-9;  // a camera exactly at the eye's direction
+  if (all[0].angle < kExact) {
+    all.resize(1);
+    all[0].weight = 1;
+    return all;
+  }
+  // The (k+1)-th camera's angle is the threshold; with only k cameras, pi (behind the actor).
+  const double thr = all.size() > k ? all[k].angle : std::numbers::pi;
+  std::vector<CameraWeight> out;
+  double sum = 0;
+  for (std::size_t i = 0; i < k; ++i) {
+    CameraWeight w = all[i];
+    w.weight = thr > w.angle ? (1 - w.angle / thr) / w.angle : 0;
+    if (w.weight <= 0) continue;
+    sum += w.weight;
+    out.push_back(w);
+  }
+  if (out.empty()) {  // k cameras all at the threshold: the nearest alone
+    all.resize(1);
+    all[0].weight = 1;
+    return all;
+  }
+  for (auto& w : out) w.weight /= sum;
+  return out;
+}
+
+}  // namespace studio::preview
