@@ -110,6 +110,49 @@ void BM_RecorderTake(benchmark::State& state) {
     state.counters["x_plain"] = benchmark::Counter(n / g_plain_fps, benchmark::Counter::kIsRate);
 }
 
+// Sustained recording (issue 17 item 5): one long take (250 frames = 10 s of one camera) through
+// the recorder with its periodic fdatasync every state.range(0) ms, frames pushed as fast as the
+// writer takes them: the disk rate a capture server can count on while takes are durable.
+void BM_RecorderSustained(benchmark::State& state) {
+  const auto img = frame_image();
+  const fs::path dir = bench_dir();
+  constexpr int kFrames = 250;
+  uint64_t written = 0, syncs = 0;
+  int take = 0;
+  for (auto _ : state) {
+    TakeInfo info;
+    info.take = "sustained" + std::to_string(take++);
+    info.camera_id = "cam0";
+    info.width = kW;
+    info.height = kH;
+    info.period_ns = 40'000'000;
+    auto rec = Recorder::start({.dir = (dir / info.take / "cam0").string(),
+                                .queue_frames = 8,
+                                .sync_interval_ms = int(state.range(0))},
+                               info);
+    if (!rec) {
+      state.SkipWithError(rec.error().message.c_str());
+      return;
+    }
+    for (int i = 0; i < kFrames; ++i)
+      while (!(*rec)->push(uint64_t(i), 0, img.view())) ::usleep(200);
+    (*rec)->stop();
+    if (auto r = (*rec)->wait(); !r) state.SkipWithError(r.error().message.c_str());
+    written += (*rec)->stats().frames_written;
+    syncs += (*rec)->stats().syncs;
+    fs::remove_all(dir / info.take);
+  }
+  fs::remove_all(dir);
+  const double n = double(written);
+  state.counters["fps"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
+  state.counters["MBps"] = benchmark::Counter(n * (double(kW) * kH * 3 + kFrameHeaderSize) / 1e6,
+                                              benchmark::Counter::kIsRate);
+  state.counters["cameras_at_25fps"] = benchmark::Counter(n / 25.0, benchmark::Counter::kIsRate);
+  state.counters["syncs_per_take"] = double(syncs) / double(std::max<int>(take, 1));
+  if (g_plain_fps > 0)
+    state.counters["x_plain"] = benchmark::Counter(n / g_plain_fps, benchmark::Counter::kIsRate);
+}
+
 void BM_Crc32(benchmark::State& state) {
   const auto img = frame_image();
   const std::size_t bytes = img.pixels().size() * 3;
@@ -124,6 +167,12 @@ void BM_Crc32(benchmark::State& state) {
 
 BENCHMARK(BM_PlainWrite)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 BENCHMARK(BM_RecorderTake)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK(BM_RecorderSustained)
+    ->Arg(1000)
+    ->Arg(200)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
 BENCHMARK(BM_Crc32)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {

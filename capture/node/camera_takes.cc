@@ -49,7 +49,10 @@ void CameraWorker::begin_take(const Frame& frame, const TakeSchedule::Decision& 
   const auto& calib = frame.calibration ? frame.calibration : calibration_;
   if (calib) info.calibration_yaml = yaml::format_camera(*calib, 2);
   const std::string dir = io_.options.takes_dir + "/" + d.take.name + "/" + id_;
-  auto r = Recorder::start({.dir = dir, .queue_frames = io_.options.queue_frames}, info);
+  auto r = Recorder::start({.dir = dir,
+                            .queue_frames = io_.options.queue_frames,
+                            .sync_interval_ms = io_.options.sync_interval_ms},
+                           info);
   if (r) {
     recorder_ = std::move(*r);
     recorder_->add_drops(d.missed);

@@ -58,6 +58,13 @@ class CameraWorker {
   const std::optional<studio::Camera>& calibration() const { return calibration_; }
   // The last second of frames, for frame-exact image requests (image_ring.h).
   const ImageRing& ring() const { return ring_; }
+  // The camera's image size when known before the first frame (calibration, lens table); 0, 0
+  // otherwise.
+  std::pair<int, int> image_size() const {
+    if (calibration_) return {calibration_->width, calibration_->height};
+    if (tracked_) return {tracked_->options().camera.width, tracked_->options().camera.height};
+    return {0, 0};
+  }
 
   // Creates the keyer (with a plate kept from before a restart) and starts the source.
   Expected<void> start();

@@ -28,12 +28,20 @@ const char kConfigHelp[] =
     "true})\n"
     "  plate_dir: DIR                    difference key: keep plates captured on command\n"
     "                                    (KeyerPlate) as DIR/<camera>.png, load them at start\n"
-    "  recorder: {queue_frames: N}       frames buffered before the disk (default 50)\n"
+    "  recorder: {queue_frames: N, sync_interval_ms: 1000, disk_mb_s: 0}\n"
+    "                                    frames buffered before the disk (default 50);\n"
+    "                                    frames.raw fdatasync'ed at least this often (a power\n"
+    "                                    cut loses at most that; verify-take rebuilds the rest);\n"
+    "                                    the disk's sustained MB/s (BENCHMARKS.md, 0: measured\n"
+    "                                    at start): a warning when the cameras need more\n"
     "  state_period: S                   seconds between CameraState samples (default 1)\n"
     "  cameras:                          one entry per camera:\n"
     "    - id: cam0\n"
     "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true,\n"
-    "               frame_code: false}   (frame_code: the actor wears the frame number)\n"
+    "               frame_code: false, stamp: false, offset_us: 0, jitter_us: 0, drop_every: 0}\n"
+    "                                    stamp: frame number as a corner code in the pixels;\n"
+    "                                    offset/jitter/drop_every: a real camera's imperfections\n"
+    "                                    frame_code: the actor wears the frame number (preview tests)\n"
     "      source: {type: files, path: DIR, fps: 25, loop: false, paced: true}\n"
     "      source: {type: aravis, device: ID, pixel_format: BayerRG8, width: W, height: H,\n"
     "               fps: 25, trigger: free_run|software|line, line: Line0, buffers: 8,\n"
@@ -65,11 +73,16 @@ struct ImageKeys {
 };
 struct RecorderKeys {
   int queue_frames = 50;
+  int sync_interval_ms = 1000;
+  double disk_mb_s = 0;
 };
 struct SimKeys {
   int ring = 6, index = 0, width = 704, height = 576;
   bool paced = true;
   bool frame_code = false;  // sim/frame_code.h
+  bool stamp = false;
+  double offset_us = 0, jitter_us = 0;
+  int drop_every = 0;
   Expected<void> validate() const {
     if (index >= ring) return fail("index: must be below ring");
     return {};
@@ -110,6 +123,10 @@ const yaml::Schema<SimKeys> kSim{
     yaml::field("height", &SimKeys::height).range(16, 8192),
     yaml::field("paced", &SimKeys::paced),
     yaml::field("frame_code", &SimKeys::frame_code),
+    yaml::field("stamp", &SimKeys::stamp),
+    yaml::field("offset_us", &SimKeys::offset_us).range(-5e5, 5e5),
+    yaml::field("jitter_us", &SimKeys::jitter_us).range(0, 1e6),
+    yaml::field("drop_every", &SimKeys::drop_every).range(0, 1e9),
 };
 const yaml::Schema<FileSourceOptions> kFiles{
     yaml::field("path", &FileSourceOptions::path).required().relative_path(),
@@ -216,6 +233,10 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
     SimSourceOptions so;
     so.paced = c.sim.paced;
     so.studio.frame_code = c.sim.frame_code;
+    so.stamp = c.sim.stamp;
+    so.offset_ns = int64_t(c.sim.offset_us * 1000);
+    so.jitter_ns = int64_t(c.sim.jitter_us * 1000);
+    so.drop_every = uint64_t(c.sim.drop_every);
     so.camera = sim::ring_cameras(ring)[std::size_t(c.sim.index)];
     so.camera.id = c.id;
     so.clock = clock;
@@ -282,6 +303,9 @@ Expected<CaptureNodeOptions> read_capture_config(yaml::MapReader& config) {
       yaml::field("recorder", &CaptureKeys::recorder,
                   yaml::Schema<RecorderKeys>{
                       yaml::field("queue_frames", &RecorderKeys::queue_frames).range(1, 10000),
+                      yaml::field("sync_interval_ms", &RecorderKeys::sync_interval_ms)
+                          .range(1, 60000),
+                      yaml::field("disk_mb_s", &RecorderKeys::disk_mb_s).range(0, 1e6),
                   }),
       yaml::field("state_period", &CaptureKeys::state_period).range(0.05, 60),
       yaml::field("cameras", &CaptureKeys::cameras, read_cameras).required(),
@@ -293,6 +317,8 @@ Expected<CaptureNodeOptions> read_capture_config(yaml::MapReader& config) {
   o.takes_dir =
       yaml::resolve_path(config.node(), keys->takes_dir.empty() ? "takes" : keys->takes_dir);
   o.queue_frames = std::size_t(keys->recorder.queue_frames);
+  o.sync_interval_ms = keys->recorder.sync_interval_ms;
+  o.disk_mb_s = keys->recorder.disk_mb_s;
   o.keyer = keys->keyer;
   o.image_rate = keys->image.rate;
   o.jpeg_quality = keys->image.quality;

@@ -4,6 +4,7 @@
 
 #include "camera_worker.h"
 #include "image_ring.h"
+#include "capture/disk_rate.h"
 #include "core/clock.h"
 #include "core/log.h"
 
@@ -77,6 +78,7 @@ class CaptureNode : public runtime::Node {
       if (auto r = w->publish_fixed_calibration(); !r) return r;
       w->publish_state();
     }
+    check_disk_rate();
     return {};
   }
   void stop() override { loop_.stop(); }
@@ -101,6 +103,34 @@ class CaptureNode : public runtime::Node {
     for (auto& w : workers_)
       if (w->id() == id) return w.get();
     return nullptr;
+  }
+
+  // Warns when recording every camera at the studio rate would need more than the takes disk
+  // sustains (recorder: disk_mb_s, else measured now).
+  void check_disk_rate() {
+    const double fps = 1e9 / double(options_.clock.period_ns);
+    double need = 0;
+    std::string unknown;
+    for (auto& w : workers_) {
+      if (const auto size = w->image_size(); size.first > 0)
+        need += take_bytes_per_second(size.first, size.second, fps) / 1e6;
+      else
+        unknown += " " + w->id();
+    }
+    double have = options_.disk_mb_s;
+    if (have <= 0) {
+      auto measured = measure_write_rate(options_.takes_dir);
+      if (!measured) {
+        STUDIO_LOG(warn, kLog) << measured.error().message;
+        return;
+      }
+      have = *measured;
+    }
+    STUDIO_LOG(info, kLog) << "takes need " << need << " MB/s" << (unknown.empty() ? "" : " (not counted:" + unknown + ")")
+                           << ", the disk sustains " << have << " MB/s";
+    if (need > have)
+      STUDIO_LOG(warn, kLog) << "the cameras need " << need << " MB/s to record, more than the "
+                             << have << " MB/s the takes disk sustains: takes will drop frames";
   }
 
   runtime::Outcome on_control(const studio_CameraControl& sample) {

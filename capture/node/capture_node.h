@@ -51,6 +51,8 @@ struct CaptureNodeOptions {
   FrameClock clock;
   std::string takes_dir = "takes";
   std::size_t queue_frames = 50;
+  int sync_interval_ms = 1000;  // recorder: fdatasync at least this often
+  double disk_mb_s = 0;         // the takes disk's sustained write rate; 0 = measure at start
   keyer::KeyerOptions keyer;
   MaskCoding coding = MaskCoding::kRowDelta;
   double image_rate = 5;  // Hz, 0 = no images

@@ -413,5 +413,78 @@ TEST_F(TrackedCameraTest, EveryFrameCarriesItsOwnTrackedPose) {
   EXPECT_EQ(p.stop(), 0) << p.log();
 }
 
+// Remote focus on fixed cameras: cam1 has a lens table (Focus x 1000 = counts; fx 100 at 0,
+// 200 at 1000) and republishes its calibration with the table's intrinsics; cam0 has none and
+// marks its calibration invalid until Focus returns to its calibrated value.
+TEST_F(TrackedCameraTest, FocusMovesIntrinsicsWithALensTableElseInvalidates) {
+  std::ofstream(dir_ / "lens.yaml")
+      << "width: 176\nheight: 144\nfeature_scale: 1000\nsamples:\n"
+         "  - {zoom: 0, focus: 0, fx: 100, fy: 100, cx: 88, cy: 72, rd3: 0.01}\n"
+         "  - {zoom: 0, focus: 1000, fx: 200, fy: 200, cx: 88, cy: 72, rd3: 0.03}\n";
+  std::ofstream(dir_ / "capture.yaml")
+      << "clock: {fps: 10}\nstate_period: 0.2\nimage: {rate: 0}\ncameras:\n"
+         "  - id: cam0\n    source: {type: sim, ring: 6, index: 0, width: 176, height: 144}\n"
+         "  - id: cam1\n    source: {type: sim, ring: 6, index: 1, width: 176, height: 144}\n"
+         "    lens_table: lens.yaml\n";
+  auto calib_topic = wire::Topic<studio_CameraCalibration>::create(*participant_).value();
+  auto calibrations =
+      wire::Reader<studio_CameraCalibration>::create(*participant_, calib_topic, 100).value();
+  auto state_topic = wire::Topic<studio_CameraState>::create(*participant_).value();
+  auto states = wire::Reader<studio_CameraState>::create(*participant_, state_topic, 100).value();
+  auto control_topic = wire::Topic<studio_CameraControl>::create(*participant_).value();
+  auto control = wire::Writer<studio_CameraControl>::create(*participant_, control_topic).value();
+  auto& p = spawn("capture", "capture/studio-capture", {"--config", (dir_ / "capture.yaml").string()});
+  ASSERT_TRUE(p.wait_ready(30s)) << p.log();
+  ASSERT_TRUE(control.wait_for_readers(1, 10s));
+  std::map<std::string, wire::Owned<studio_CameraState>> latest;
+  auto wait_state = [&](auto pred) {
+    const auto deadline = std::chrono::steady_clock::now() + 10s;
+    while (std::chrono::steady_clock::now() < deadline) {
+      for (auto& s : states.take())
+        if (s.meta.valid_data) latest[std::string(wire::str(s.data->camera_id))] = std::move(s.data);
+      if (pred()) return true;
+      std::this_thread::sleep_for(20ms);
+    }
+    return false;
+  };
+  auto valid = [&](const char* id) { return latest.count(id) && latest[id]->calibration_valid; };
+  ASSERT_TRUE(wait_state([&] { return valid("cam0") && valid("cam1"); }));
+  EXPECT_EQ(latest["cam0"]->time_source, studio_TIME_STUDIO_CLOCK);
+  auto focus = [&](const char* id, double value) {
+    wire::Owned<studio_CameraControl> c;
+    wire::set(c->camera_id, id);
+    wire::set(c->feature, "Focus");
+    c->value = value;
+    ASSERT_TRUE(control.write(*c));
+  };
+  focus("cam0", 0.7);
+  focus("cam1", 0.7);
+  EXPECT_TRUE(wait_state([&] {
+    return latest.count("cam0") && !latest["cam0"]->calibration_valid &&
+           std::string(wire::str(latest["cam0"]->error)).find("Focus moved to 0.7") !=
+               std::string::npos;
+  }));
+  // cam1: a new calibration with the table's intrinsics at 700 counts (fx 170, rd3 0.024),
+  // still valid.
+  bool republished = false;
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while (!republished && std::chrono::steady_clock::now() < deadline) {
+    for (auto& c : calibrations.take())
+      if (c.meta.valid_data && wire::str(c.data->camera_id) == "cam1" &&
+          std::abs(c.data->K[0] - 170) < 1e-9) {
+        EXPECT_NEAR(c.data->K[4], 170, 1e-9);
+        EXPECT_NEAR(c.data->rd3, 0.024, 1e-12);
+        EXPECT_FALSE(c.data->tracked);
+        republished = true;
+      }
+    std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_TRUE(republished);
+  EXPECT_TRUE(valid("cam1"));
+  focus("cam0", 0.5);  // back to the calibrated focus
+  EXPECT_TRUE(wait_state([&] { return valid("cam0"); }));
+  EXPECT_EQ(p.stop(), 0) << p.log();
+}
+
 }  // namespace
 }  // namespace studio::capture

@@ -5,6 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <thread>
+
+#include "sim/frame_stamp.h"
 
 namespace studio::capture {
 namespace {
@@ -84,6 +88,10 @@ Expected<void> SimSourceOptions::validate() const {
     return fail("sim source " + camera.id + ": Focus must be in 0..1");
   if (buffer_frames < 1 || buffer_frames > 64)
     return fail("sim source " + camera.id + ": buffer_frames must be in 1..64");
+  if (2 * (offset_ns < 0 ? -offset_ns : offset_ns) >= clock.period_ns)
+    return fail("sim source " + camera.id + ": offset must be within half a frame period (" + std::to_string(offset_ns) + " ns, period " + std::to_string(clock.period_ns) + " ns)");
+  if (jitter_ns < 0 || jitter_ns > 10 * clock.period_ns)
+    return fail("sim source " + camera.id + ": jitter must be in 0..10 frame periods");
   if (max_blur_px < 0 || max_blur_px > 64)
     return fail("sim source " + camera.id + ": max_blur_px must be in 0..64");
   return {};
@@ -103,7 +111,8 @@ SimFrameSource::SimFrameSource(SimSourceOptions options, sim::SimulatedStudio st
       studio_(std::move(studio)),
       gain_db_(options_.gain_db),
       exposure_us_(options_.exposure_us),
-      focus_(options_.focus) {}
+      focus_(options_.focus),
+      jitter_state_(std::hash<std::string>{}(options_.camera.id)) {}
 
 Expected<void> SimFrameSource::start() {
   std::lock_guard lock(mutex_);
@@ -150,7 +159,11 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
       f = oldest_kept;
     }
   }
-  const int64_t capture_ns = clock.time_of(f) + half;
+  if (options_.drop_every > 0 && f % options_.drop_every == options_.drop_every - 1) {
+    ++skipped;  // the camera lost this frame: the next one is delivered instead
+    ++f;
+  }
+  const int64_t capture_ns = clock.time_of(f) + half + options_.offset_ns;
   if (options_.paced && !wait_until(capture_ns, deadline)) {
     std::lock_guard lock(mutex_);
     stats_.drops += skipped;  // consumed even when the wait ran out
@@ -172,6 +185,12 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
   frame.capture_ns = capture_ns;
   studio_.render(0, int64_t(f), &frame.image, nullptr);
   apply_features(frame.image);
+  if (options_.stamp) sim::stamp_frame(frame.image.view(), f);
+  if (options_.jitter_ns > 0) {  // late delivery: a driver/transport delay of its own
+    jitter_state_ = jitter_state_ * 6364136223846793005ull + 1442695040888963407ull;
+    std::this_thread::sleep_for(
+        std::chrono::nanoseconds(int64_t((jitter_state_ >> 11) % uint64_t(options_.jitter_ns))));
+  }
   last_frame_ = f;
   std::lock_guard lock(mutex_);
   stats_.frames += 1;

@@ -423,4 +423,86 @@ TEST_F(HullNodeTest, BadConfigIsOneLine) {
 }
 
 }  // namespace
+// A camera whose CameraState says its calibration is invalid (zoom/focus moved without a lens
+// table, or a silent tracker) is left out of the cut: with camera 0 invalid and an empty mask
+// from it, the hull is the other five cameras' cut; valid again, all six cut.
+TEST_F(HullNodeTest, CameraWithInvalidCalibrationIsLeftOut) {
+  auto p = wire::Participant::create().value();
+  auto mask_topic = wire::Topic<studio_AlphaMask>::create(p).value();
+  auto masks = wire::Writer<studio_AlphaMask>::create(p, mask_topic).value();
+  auto state_topic = wire::Topic<studio_CameraState>::create(p).value();
+  auto states = wire::Writer<studio_CameraState>::create(p, state_topic).value();
+  auto seg_topic = wire::Topic<studio_SegmentSet>::create(p).value();
+  auto segs = wire::Reader<studio_SegmentSet>::create(p, seg_topic).value();
+  auto& hull = spawn("hull", "hull/studio-hull",
+                     {"--config", write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 96\n"
+                                               "  deadline_ms: 300\n  refine: false\n")});
+  ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
+  ASSERT_TRUE(masks.wait_for_readers(1, 10s));
+  ASSERT_TRUE(states.wait_for_readers(1, 10s));
+  auto set_valid = [&](bool valid) {
+    wire::Owned<studio_CameraState> s;
+    wire::set(s->camera_id, cameras_[0].id);
+    s->state = studio_CAMERA_STREAMING;
+    s->calibration_valid = valid;
+    ASSERT_TRUE(states.write(*s).has_value());
+    std::this_thread::sleep_for(300ms);
+  };
+  // Camera 0's mask: empty when `empty` (a zoomed camera whose model no longer fits).
+  auto send = [&](int64_t f, bool empty) {
+    for (std::size_t c = 0; c < cameras_.size(); ++c) {
+      Mask m;
+      studio_->render(int(c), f, nullptr, &m);
+      if (c == 0 && empty) m = Mask(m.width(), m.height());
+      wire::Owned<studio_AlphaMask> s;
+      wire::set(s->camera_id, cameras_[c].id);
+      s->frame = uint64_t(f);
+      s->capture_ns = f;
+      wire::from_core(RunMask::from_mask(m.view()), studio_MASK_CODEC, *s);
+      ASSERT_TRUE(masks.write(*s).has_value());
+    }
+  };
+  auto local_volume = [&](int64_t f, std::size_t first_camera) {
+    std::vector<RunMask> runs(cameras_.size());
+    std::vector<View> views;
+    for (std::size_t c = first_camera; c < cameras_.size(); ++c) {
+      Mask m;
+      studio_->render(int(c), f, nullptr, &m);
+      runs[c] = RunMask::from_mask(m.view());
+      views.push_back({&cameras_[c], &runs[c]});
+    }
+    HullNodeOptions o;
+    o.box = {-1.5, 0, -1.5, 1.5, 2.2, 1.5};
+    o.grid = 96;
+    auto h = visual_hull(o.grid_spec(), views);
+    const auto actors = connected_components(*h, o.min_actor_volume);
+    return actors.empty() ? 0.0 : actors[0].volume();
+  };
+  auto volume_of = [&](int64_t f, bool empty) -> std::optional<double> {
+    for (int attempt = 0; attempt < 10; ++attempt, ++f) {
+      send(f, empty);
+      const auto until = std::chrono::steady_clock::now() + 1s;
+      while (std::chrono::steady_clock::now() < until) {
+        for (auto& s : segs.take())
+          if (s.meta.valid_data && std::string(s.data->actor_id) == "actor0" &&
+              s.data->frame == uint64_t(f)) {
+            const double v = wire::to_core(*s.data).value().volume();
+            EXPECT_NEAR(v, local_volume(f, empty ? 1 : 0), 1e-6 * v) << "frame " << f;
+            return v;
+          }
+        std::this_thread::sleep_for(20ms);
+      }
+    }
+    return std::nullopt;
+  };
+  set_valid(false);
+  const auto five = volume_of(60, true);
+  ASSERT_TRUE(five) << hull.log();
+  set_valid(true);
+  const auto six = volume_of(80, false);
+  ASSERT_TRUE(six) << hull.log();
+  EXPECT_GT(*five, *six);  // one camera fewer cuts less away
+  EXPECT_EQ(hull.stop(), 0) << hull.log();
+}
+
 }  // namespace studio::hull

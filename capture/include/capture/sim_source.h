@@ -20,6 +20,10 @@
 //   Focus         0..1                 box blur of radius round(|Focus - in_focus| * max_blur_px)
 // Tracked (follow_pose): before rendering frame f the source asks for its camera; a changed
 // camera rebuilds the simulated camera's cached rays and background (SimulatedStudio::set_camera).
+// Imperfections on request: `offset_ns` moves the exposure instant (capture_ns) within the
+// frame, `jitter_ns` delays each delivery by a pseudo-random amount (seeded by the camera id),
+// `drop_every` loses frames like a camera dropping packets (they count in stats().drops), and
+// `stamp` writes the frame number into the corner (sim/frame_stamp.h) after the features.
 // Brightness is applied through a 256-entry table (saturating), blur as two separable box passes.
 
 #include <atomic>
@@ -46,6 +50,11 @@ struct SimSourceOptions {
   double focus = 0.5;
   double in_focus = 0.5;  // the Focus value that gives a sharp image
   int max_blur_px = 8;
+  // Test knobs of a real camera's imperfections (issue 17 item 6):
+  bool stamp = false;         // the frame number as a corner code in the pixels (sim/frame_stamp.h)
+  int64_t offset_ns = 0;      // genlock offset of this camera's exposure, |offset| < period/2
+  int64_t jitter_ns = 0;      // delivery delayed by a uniform 0..jitter (driver/transport)
+  uint64_t drop_every = 0;    // frames f with f % drop_every == drop_every-1 are lost (counted)
   Expected<void> validate() const;
 };
 
@@ -84,6 +93,7 @@ class SimFrameSource : public FrameSource {
   double gain_db_, exposure_us_, focus_;
   SourceStats stats_;
   std::vector<uint16_t> blur_row_;
+  uint64_t jitter_state_ = 0;
 };
 
 }  // namespace studio::capture
