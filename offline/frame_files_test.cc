@@ -66,6 +66,11 @@ TEST(FrameFiles, FrameVerifiesAndDamageIsRefused) {
   ASSERT_FALSE(verify_frame_glb(flipped));
   EXPECT_NE(verify_frame_glb(flipped).error().message.find("hash"), std::string::npos);
   ASSERT_FALSE(verify_frame_glb(std::vector<uint8_t>(100, 7)));
+  // The settings' fingerprint travels with the frame.
+  auto tagged = verify_frame_glb(encode_frame_glb(m, &c, "a", 1, fingerprint("grid 256")));
+  ASSERT_TRUE(tagged);
+  EXPECT_EQ(tagged->options, fingerprint("grid 256"));
+  EXPECT_NE(fingerprint("grid 256"), fingerprint("grid 512"));
   // Untextured frames verify too.
   auto plain = verify_frame_glb(encode_frame_glb(m, nullptr, "a", 1));
   ASSERT_TRUE(plain);

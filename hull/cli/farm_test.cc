@@ -190,6 +190,12 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("\"computed\":1,\"skipped\":11"), std::string::npos) << r.out;
   EXPECT_EQ(files_of(whole), expected);
+
+  // Frames made with other settings are recomputed, not skipped.
+  r = run(hull() + " offline " + args(whole) + " --threshold 8 --frames 0:1 --threads 2 --json",
+          dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"computed\":2,\"skipped\":0"), std::string::npos) << r.out;
 }
 
 TEST_F(HullFarm, BadInputIsOneLine) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <mutex>
 #include <optional>
@@ -65,8 +66,8 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
   --progress        progress bar with rate and ETA on stderr even when it is not a terminal
                     (default: on a terminal only); --quiet: never
 Resumable and idempotent: a frame whose file exists and verifies (structure, counts, hash of its
-data) is skipped; files are written to a temporary name and renamed, so a killed job leaves no
-partial frame, and the bytes depend only on the take and the options (not on --threads or the
+data, and a fingerprint of the settings and cameras that made it) is skipped; files are written
+to a temporary name and renamed, so a killed job leaves no partial frame, and the bytes depend only on the take and the options (not on --threads or the
 sharding). Farm: hull/cli/studio-hull-farm.sh submits a take as a Slurm job array (--local runs
 the same shard commands here).
 Exit status: 0 done; 2 bad arguments or input; 1 a frame failed (frames before it stay written).
@@ -354,6 +355,40 @@ int run_refined(int argc, char** argv) {
     return 2;
   }
   remove_stale_temporaries(a.out);
+  // What makes a frame's bytes, besides its images: a frame file made with other settings or
+  // cameras is recomputed, not skipped.
+  std::string settings = "studio-hull offline v1";
+  {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  " grid %d box %.9g %.9g %.9g %.9g %.9g %.9g axis %d min_views %d refine %d "
+                  "texture %d threshold %.9g max_depth %d key %d",
+                  a.grid, a.box_min.x(), a.box_min.y(), a.box_min.z(), a.box_max.x(), a.box_max.y(),
+                  a.box_max.z(), int(a.axis), a.min_views, int(a.refine), int(a.texture),
+                  a.threshold, a.max_depth, int(key.mode));
+    settings += buf;
+    if (!a.keyer_file.empty()) {
+      std::ifstream in(a.keyer_file, std::ios::binary);
+      settings += " keyer " + std::string(std::istreambuf_iterator<char>(in), {});
+    }
+    for (const Camera& c : cameras) {
+      const Eigen::Quaterniond& q = c.cam_from_world.rotation;
+      const Eigen::Vector3d& t = c.cam_from_world.translation;
+      const auto& k = c.intrinsics;
+      std::snprintf(
+          buf, sizeof buf,
+          " cam %s %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
+          "%.17g",
+          c.id.c_str(), c.width, c.height, k.fx, k.fy, k.cx, k.cy, k.skew, q.w(), q.x(), q.y(),
+          q.z(), t.x(), t.y(), t.z());
+      settings += buf;
+      const auto d = polynomial(c.distortion);
+      std::snprintf(buf, sizeof buf, " d %.17g %.17g %.17g %.17g %.17g", d.k1, d.k2, d.k3, d.p1,
+                    d.p2);
+      settings += buf;
+    }
+  }
+  const std::string tag = offline::fingerprint(settings);
 
   const bool bar = a.progress.value_or(::isatty(2) != 0) && !a.json;
   const int workers = std::min<int>(a.threads, int(selected.size()));
@@ -407,7 +442,7 @@ int run_refined(int argc, char** argv) {
       const auto t_frame = std::chrono::steady_clock::now();
       if (fs::exists(path)) {
         if (auto ok = offline::verify_frame_file(path);
-            ok && ok->frame == int64_t(f) && ok->coloured == a.texture) {
+            ok && ok->frame == int64_t(f) && ok->options == tag) {
           std::lock_guard g(lock);
           report(f, true, ms_since(t_frame));
           continue;
@@ -454,7 +489,7 @@ int run_refined(int argc, char** argv) {
       s.texture = ms_since(t0);
       t0 = std::chrono::steady_clock::now();
       const auto bytes =
-          offline::encode_frame_glb(mesh, colours ? &*colours : nullptr, a.name, int64_t(f));
+          offline::encode_frame_glb(mesh, colours ? &*colours : nullptr, a.name, int64_t(f), tag);
       if (auto ok = offline::write_file_atomic(path, bytes); !ok)
         return give_up(ok.error().message);
       s.write = ms_since(t0);

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -126,9 +127,27 @@ std::string frame_file_name(const std::string& name, int64_t frame) {
 }
 std::string index_file_name(const std::string& name) { return name + ".gltf"; }
 
+std::string fingerprint(std::string_view text) {
+  char hash[20];
+  std::snprintf(hash, sizeof hash, "%016llx",
+                static_cast<unsigned long long>(
+                    fnv1a64({reinterpret_cast<const uint8_t*>(text.data()), text.size()})));
+  return hash;
+}
+
+// The option tag is kept to JSON-safe characters.
+std::string safe_tag(const std::string& t) {
+  std::string out;
+  for (char c : t) {
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.') out += c;
+  }
+  return out;
+}
+
 std::vector<uint8_t> encode_frame_glb(const hull::Mesh& mesh,
                                       const std::vector<Eigen::Vector3f>* colours,
-                                      const std::string& name, int64_t frame) {
+                                      const std::string& name, int64_t frame,
+                                      const std::string& options) {
   FrameFileInfo f;
   f.frame = frame;
   f.vertices = mesh.vertices.size();
@@ -169,8 +188,8 @@ std::vector<uint8_t> encode_frame_glb(const hull::Mesh& mesh,
       "],\"extras\":{\"studio_frame\":" + std::to_string(frame) +
       ",\"studio_vertices\":" + std::to_string(f.vertices) +
       ",\"studio_triangles\":" + std::to_string(f.triangles) +
-      ",\"studio_coloured\":" + (f.coloured ? "1" : "0") + ",\"studio_bin_fnv1a64\":\"" + hash +
-      "\"}}";
+      ",\"studio_coloured\":" + (f.coloured ? "1" : "0") + ",\"studio_options\":\"" +
+      safe_tag(options) + "\",\"studio_bin_fnv1a64\":\"" + hash + "\"}}";
   while (json.size() % 4) json += ' ';
   while (bin.size() % 4) bin.push_back(0);
   std::vector<uint8_t> out;
@@ -221,6 +240,12 @@ Expected<FrameFileInfo> verify_frame_glb(std::span<const uint8_t> b) {
                 static_cast<unsigned long long>(
                     fnv1a64(b.subspan(f.bin_offset, s.total + (bin_len - s.total)))));
   if (json.compare(at + key.size(), 16, hash) != 0) return fail("hash mismatch (damaged file)");
+  const std::string opt_key = "\"studio_options\":\"";
+  if (const auto o = json.find(opt_key); o != std::string::npos) {
+    const auto end = json.find('"', o + opt_key.size());
+    if (end == std::string::npos) return fail("malformed extras");
+    f.options = json.substr(o + opt_key.size(), end - o - opt_key.size());
+  }
   for (std::size_t n = 0; n < f.vertices; ++n) {
     Eigen::Vector3f v;
     std::memcpy(v.data(), b.data() + f.bin_offset + 12 * n, 12);

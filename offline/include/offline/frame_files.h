@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/error.h"
@@ -34,9 +35,15 @@ std::string frame_file_name(const std::string& name, int64_t frame);  // name_00
 std::string index_file_name(const std::string& name);                 // name.gltf
 
 // colours: display RGB 0..255 per vertex (texture.h), or null for an untextured mesh.
+// options: a fingerprint of what made the frame (fingerprint() of the settings), stored in the
+// extras so that a rerun with other settings recomputes the frame instead of skipping it.
 std::vector<uint8_t> encode_frame_glb(const hull::Mesh& mesh,
                                       const std::vector<Eigen::Vector3f>* colours,
-                                      const std::string& name, int64_t frame);
+                                      const std::string& name, int64_t frame,
+                                      const std::string& options = "");
+
+// 16 hex digits (FNV-1a 64) of a text.
+std::string fingerprint(std::string_view text);
 
 struct FrameFileInfo {
   int64_t frame = 0;
@@ -45,6 +52,7 @@ struct FrameFileInfo {
   std::size_t file_size = 0;
   std::size_t bin_offset = 0;  // file offset of the BIN chunk's data
   Eigen::Vector3f min = Eigen::Vector3f::Zero(), max = Eigen::Vector3f::Zero();
+  std::string options;  // as given to encode_frame_glb
 };
 
 // Checks a frame file's structure (header, chunk sizes, counts against the BIN size) and its
