@@ -148,7 +148,7 @@ Expected<RunMask> mask_from_runs(const std::string& what, uint32_t width, uint32
                                  std::span<const uint32_t> row_start, std::span<const uint32_t> runs) {
   if (row_start.size() != std::size_t(height) + 1 || runs.size() != std::size_t(row_start.back()) * 2)
     return fail(what + ": run table inconsistent with its height");
-  RunMask out(int(width), int(height));
+  RunMask out(static_cast<int>(width), static_cast<int>(height));
   for (uint32_t y = 0; y < height; ++y)
     for (uint32_t r = row_start[y]; r < row_start[y + 1]; ++r)
       out.push_run(int(y), int32_t(runs[2 * r]), int32_t(runs[2 * r + 1]));
