@@ -265,6 +265,18 @@ Verdict validate(const studio_ProjectorMask& s) {
   return check_runs(view(s.row_start), view(s.runs), s.width, s.height);
 }
 
+Verdict validate(const studio_ProjectorFrame& s) {
+  if (!id_ok(s.projector_id)) return Reject::bad_id;
+  if (!side_ok(s.width, s.height)) return Reject::bad_size;
+  if (!finite(s.eye) || !std::isfinite(s.latency_ms) || !std::isfinite(s.margin_m))
+    return Reject::non_finite;
+  if (s.latency_ms < 0 || s.margin_m < 0) return Reject::out_of_range;
+  if (s.thumb_width > kMaxSide || s.thumb_height > kMaxSide ||
+      view(s.thumbnail).size() != uint64_t(s.thumb_width) * s.thumb_height * 3)
+    return Reject::bad_size;
+  return check_runs(view(s.mask_row_start), view(s.mask_runs), s.width, s.height);
+}
+
 Verdict validate(const studio_ImageRequest& s) {
   if (!id_ok(s.requester) || !id_ok(s.camera_id)) return Reject::bad_id;
   return std::nullopt;
