@@ -48,7 +48,7 @@ struct ProjectorSample {
 // the blackout mask and the true actor at display time, at full resolution.
 struct ProjectorPicture {
   std::string projector_id;
-  uint64_t render_frame = 0, lit_actor_px = 0;
+  uint64_t render_frame = 0, lit_actor_px = 0, actor_px = 0;
   int thumb_width = 0, thumb_height = 0;
   std::vector<uint8_t> thumbnail;  // RGB8
   Mask actor;
