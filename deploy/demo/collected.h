@@ -40,7 +40,7 @@ struct ProjectorSample {
   double latency_ms = 0;       // as the projector published it
   double margin_m = 0;
   bool predicted = false;
-  bool scored = false;         // false: the scorer fell behind (or the calibration was missing)
+  bool scored = false;  // false: the scorer fell behind (or the calibration was missing)
   uint64_t actor_px = 0, lit_actor_px = 0, blackout_px = 0, wasted_px = 0;
 };
 
@@ -85,7 +85,7 @@ struct Collected {
   std::vector<ProjectorSample> projector;  // frames rendered in the window, every projector
   std::map<std::string, int> projector_calibrations;  // id -> width*height seen (0: none)
   uint64_t projector_frames_rejected = 0, projector_score_errors = 0;
-  std::string projector_score_error;  // the first one
+  std::string projector_score_error;                  // the first one
   std::optional<ProjectorPicture> projector_picture;  // the worst scored frame (most lit px)
   double display_lag_s = 0;
 };

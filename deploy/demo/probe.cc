@@ -102,10 +102,9 @@ class Recorder {
 
   void stop() {
     if (io_) {  // removing a listener waits for a running callback
-      for (wire::ReaderBase* r :
-           std::initializer_list<wire::ReaderBase*>{&*io_->cals, &*io_->masks, &*io_->segments,
-                                                    &*io_->meshes, &*io_->heads, &*io_->status,
-                                                    &*io_->proj_cals, &*io_->proj_frames})
+      for (wire::ReaderBase* r : std::initializer_list<wire::ReaderBase*>{
+               &*io_->cals, &*io_->masks, &*io_->segments, &*io_->meshes, &*io_->heads,
+               &*io_->status, &*io_->proj_cals, &*io_->proj_frames})
         (void)r->on_data_available({});
     }
     {
@@ -403,8 +402,8 @@ class Recorder {
         c_.projector.push_back(std::move(p));  // unscored
         return;
       }
-      ProjectorJob job{std::move(p), std::move(*blackout), int(s.thumb_width),
-                       int(s.thumb_height), {}};
+      ProjectorJob job{
+          std::move(p), std::move(*blackout), int(s.thumb_width), int(s.thumb_height), {}};
       job.thumbnail.assign(s.thumbnail._buffer, s.thumbnail._buffer + s.thumbnail._length);
       projector_jobs_.push_back(std::move(job));
       wake_.notify_all();
@@ -441,8 +440,8 @@ class Recorder {
       Expected<TruthScorer::Lit> lit = fail("no calibration of projector " + p.projector_id +
                                             " on studio/projector/calibration");
       if (projector)
-        lit = truth->projector_lit(*projector, studio_frame, o_.display_lag_s, job.blackout,
-                                   &actor);
+        lit =
+            truth->projector_lit(*projector, studio_frame, o_.display_lag_s, job.blackout, &actor);
       std::lock_guard lock(mutex_);
       if (!lit) {
         note_projector_error(lit.error().message);
@@ -456,9 +455,10 @@ class Recorder {
         auto& pic = c_.projector_picture;
         if (!pic || p.lit_actor_px > pic->lit_actor_px ||
             (p.lit_actor_px == pic->lit_actor_px && pic->actor_px == 0 && p.actor_px > 0)) {
-          pic = ProjectorPicture{p.projector_id, p.render_frame, p.lit_actor_px, p.actor_px,
-                                 job.thumb_width, job.thumb_height, std::move(job.thumbnail),
-                                 std::move(actor), std::move(job.blackout)};
+          pic = ProjectorPicture{
+              p.projector_id,         p.render_frame,   p.lit_actor_px,           p.actor_px,
+              job.thumb_width,        job.thumb_height, std::move(job.thumbnail), std::move(actor),
+              std::move(job.blackout)};
         }
       }
       c_.projector.push_back(std::move(p));

@@ -47,9 +47,9 @@ struct ProbeOptions {
   double seconds = 10;
   double score_rate_hz = 2;  // live meshes scored against the truth per second
   std::string head_id = "actor";
-  std::string histogram_png;  // latency histogram (OpenCV), optional
-  std::string projector_png;  // a scored projector frame (thumbnail, blackout, true actor)
-  double display_lag_s = 0.016;   // projector frame rendered → on the cloth (sim's default)
+  std::string histogram_png;         // latency histogram (OpenCV), optional
+  std::string projector_png;         // a scored projector frame (thumbnail, blackout, true actor)
+  double display_lag_s = 0.016;      // projector frame rendered → on the cloth (sim's default)
   std::size_t projector_queue = 64;  // frames waiting for scoring; beyond: counted unscored
   bool progress = true;
 

@@ -96,8 +96,10 @@ ProjectorFigures projector_figures(const Collected& c, double window_s) {
 
 void write_projector(JsonWriter& j, const ProjectorFigures& f, const Collected& c) {
   j.key("lit_actor_px");
-  if (f.scored) j.value(f.lit_sum);
-  else j.null();
+  if (f.scored)
+    j.value(f.lit_sum);
+  else
+    j.null();
   j.key("lit_actor_detail").begin_object();
   j.field("frames_rendered", f.rendered).field("frames_scored", f.scored);
   j.field("frames_unscored", f.unscored).field("frames_with_lit", f.frames_with_lit);
@@ -147,8 +149,7 @@ bool draw_projector_png(const Collected& c, const std::string& path) {
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(0, 0, 0));
   if (p.thumb_width > 0 && p.thumb_height > 0 &&
       p.thumbnail.size() == std::size_t(p.thumb_width) * p.thumb_height * 3) {
-    cv::Mat thumb(p.thumb_height, p.thumb_width, CV_8UC3,
-                  const_cast<uint8_t*>(p.thumbnail.data()));
+    cv::Mat thumb(p.thumb_height, p.thumb_width, CV_8UC3, const_cast<uint8_t*>(p.thumbnail.data()));
     cv::Mat bgr;
     cv::cvtColor(thumb, bgr, cv::COLOR_RGB2BGR);
     cv::resize(bgr, img, cv::Size(W, H), 0, 0, cv::INTER_LINEAR);

@@ -142,8 +142,8 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   const bool have_proj = !cap_proj.v.empty();
   const Stats& headline = have_proj ? cap_proj : have_heads ? cap_both : cap_mesh;
   const char* headline_stage =
-      have_proj ? "capture -> first projector frame rendered with that mesh (motion to photon: "
-                  "the mesh's capture_ns -> studio/projector/frame render_done_ns)"
+      have_proj    ? "capture -> first projector frame rendered with that mesh (motion to photon: "
+                     "the mesh's capture_ns -> studio/projector/frame render_done_ns)"
       : have_heads ? "capture -> actor mesh and head both delivered to a subscriber (no projector "
                      "frames arrived)"
                    : "capture -> actor mesh delivered to a subscriber (no head updates arrived)";

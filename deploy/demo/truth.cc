@@ -64,9 +64,8 @@ double TruthScorer::head_error(uint64_t frame, const Eigen::Vector3d& position) 
   return (position - true_head(frame)).norm();
 }
 
-Expected<TruthScorer::Lit> TruthScorer::projector_lit(const Camera& projector,
-                                                      double studio_frame, double display_lag_s,
-                                                      const RunMask& blackout,
+Expected<TruthScorer::Lit> TruthScorer::projector_lit(const Camera& projector, double studio_frame,
+                                                      double display_lag_s, const RunMask& blackout,
                                                       Mask* actor_out) const {
   if (blackout.width() != projector.width || blackout.height() != projector.height)
     return fail("projector frame " + std::to_string(blackout.width()) + "x" +
