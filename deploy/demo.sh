@@ -4,7 +4,9 @@
 # (deploy/examples/studio/, the ones the systemd units use), on loopback in a private DDS domain;
 # measures it live with studio-demo-probe (one line per second); records a take and reconstructs
 # it offline at high resolution; stops everything (SIGTERM, exit codes checked); and writes
-# OUT/report.json, report.md, latency.png and the offline meshes. Builds nothing itself.
+# OUT/report.json, report.md, latency.png, projector.png (a scored projector frame: its thumbnail,
+# blackout mask and the true actor), preview.png (the headless preview's picture) and the offline
+# meshes. Builds nothing itself.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
@@ -17,9 +19,11 @@ usage: deploy/demo.sh [--seconds S] [--cameras N] [--projectors N] [--gui] [--ou
 Runs the studio end to end from deploy/examples/studio/ (usually through ./studio demo).
   --seconds S        measurement window (default 20), after the pipeline is up and 3 s warm-up
   --cameras N        simulated cameras 1..6 (default 6: cam0..cam5 at 704x576, 25 fps)
-  --projectors N     projectors to run (default 1) — the projector service is not built yet;
-                     the report says so
-  --gui              open the preview window — the preview is not built yet; the report says so
+  --projectors N     projectors to run, 0..N (default 1): projector-proj1.yaml .. projN.yaml of
+                     deploy/examples/studio/ (the example studio has proj1; a projector without
+                     an example config is listed as missing in the report)
+  --gui              open the preview window (default: the preview runs headless and takes
+                     one picture, OUT/preview.png, of the first actor mesh it draws)
   --out DIR          where the report goes (default out/demo)
   --keyer K          inprocess (default: capture servers key) or separate (studio-keyer services,
                      deploy/examples/studio/separate-keyer/)
@@ -28,7 +32,9 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
   --keep-take        keep the take's raw frames (6 x 1.2 MB per frame) in OUT/takes
   --scheduling S     realtime (default when permitted): the services run SCHED_FIFO at the
                      priorities of their systemd units, in pipeline order (capture 52, keyer
-                     54, hull 56, tracker 58; the probe's receive path 45), as installed;
+                     54, hull 56, tracker 58, scene 50; the probe's receive path 45), as
+                     installed; the projector (nice 5) and the preview time-sharing, as their
+                     units run them;
                      normal: time-sharing
   --build DIR        build tree with the binaries (default build/release)
 Environment: STUDIO_DDS_DOMAIN / STUDIO_DDS_TAG choose the DDS domain (default: a random private
@@ -111,6 +117,11 @@ if [ -f "$cfg/scene.yaml" ]; then
   sed -i -e "s|^scene: .*|scene: $build/scene/default/scene.yaml|" \
     -e "s|^state_dir: .*|state_dir: $out/scene|" "$cfg/scene.yaml"
 fi
+# The preview resolves the scene's relative asset paths in the same build-tree copy.
+if [ -f "$cfg/preview.yaml" ]; then
+  sed -i "s|^asset_root: .*|asset_root: $build/scene/default|" "$cfg/preview.yaml"
+fi
+rm -f "$out/preview.png" "$out/projector.png"
 cam_ids=() capture_cfgs=()
 for ((i = 0; i < cameras; i++)); do cam_ids+=("cam$i"); capture_cfgs+=("$cfg/capture-cam$i.yaml"); done
 if [ "$cameras" -lt 6 ]; then
@@ -125,7 +136,14 @@ hull_box=$(sed -n 's/^  box: *\[\(.*\)\].*/\1/p' "$cfg/hull.yaml" | tr -d ' ')
 # ---- processes --------------------------------------------------------------------------------
 names=() pids=()
 # As the systemd units run them: SCHED_FIFO at the unit's priority (deploy/systemd, issue 19).
-rt() { if [ "$scheduling" = realtime ]; then echo chrt -f "$1"; fi; }
+# PRIORITY nice:N: time-sharing at nice N in both modes (the projector's unit: llvmpipe's
+# rasteriser threads must not take whole cores from the real-time pipeline).
+rt() {
+  case "$1" in
+    nice:*) echo nice -n "${1#nice:}" ;;
+    *) if [ "$scheduling" = realtime ]; then echo chrt -f "$1"; fi ;;
+  esac
+}
 start() {  # start NAME PRIORITY BINARY ARGS...
   local name=$1 prio=$2 bin=$3; shift 3
   $(rt "$prio") "$build/$bin" "$@" >"$out/logs/$name.log" 2>&1 &
@@ -148,9 +166,16 @@ missing = []
 if not have("scene/studio-scene", "scene.yaml"):
     missing.append({"stage": "scene server (studio-scene --config scene.yaml)", "issue": 14,
                     "effect": "the live actor mesh and head are not placed in a scene graph"})
-if not have("projector/studio-projector", "projector-proj0.yaml"):
+if projectors > 0 and not have("projector/studio-projector", None):
     missing.append({"stage": "projector (studio-projector --config projector.yaml)", "issue": 15,
-                    "effect": f"no projector image for the {projectors} projector(s) asked; lit_actor_px, projector.png and actor_view.png are not measured"})
+                    "effect": f"no projector image for the {projectors} projector(s) asked; lit_actor_px and projector.png are not measured"})
+elif projectors > 0:
+    # The example studio's projectors: projector-proj1.yaml, projector-proj2.yaml, ...
+    absent = [f"projector-proj{p}.yaml" for p in range(1, projectors + 1)
+              if not os.path.exists(os.path.join(ex, f"projector-proj{p}.yaml"))]
+    if absent:
+        missing.append({"stage": f"example projector config(s) {', '.join(absent)} (deploy/examples/studio/)",
+                        "issue": 20, "effect": f"{len(absent)} of the {projectors} projector(s) asked not started (the example studio has {projectors - len(absent)})"})
 if not have("preview/studio-preview", "preview.yaml"):
     missing.append({"stage": "director's preview (studio-preview, headless or --gui)", "issue": 16,
                     "effect": "no preview.png" + ("; --gui asked, no window opened" if gui else "")})
@@ -171,22 +196,33 @@ if [ "$keyer" = separate ]; then
   start keyer1 54 "$keyer_bin" --config "$cfg/keyer-keyer1.yaml"
 fi
 for ((i = 0; i < cameras; i++)); do start "cam$i" 52 "$capture_bin" --config "$cfg/capture-cam$i.yaml"; done
-if have $scene_bin scene.yaml; then start scene 50 "$scene_bin" --config "$cfg/scene.yaml"; fi
-for ((p = 0; p < projectors; p++)); do
+if have $scene_bin scene.yaml; then
+  say "starting the scene server"
+  start scene 50 "$scene_bin" --config "$cfg/scene.yaml"
+fi
+for ((p = 1; p <= projectors; p++)); do  # the example studio's projectors are proj1, proj2, ...
   if have $projector_bin "projector-proj$p.yaml"; then
-    start "proj$p" 50 "$projector_bin" --config "$cfg/projector-proj$p.yaml"
+    say "starting projector proj$p (projector-proj$p.yaml)"
+    start "proj$p" nice:5 "$projector_bin" --config "$cfg/projector-proj$p.yaml"
   fi
 done
 if have $preview_bin preview.yaml; then
-  if [ "$gui" = 1 ]; then start preview 40 "$preview_bin" --config "$cfg/preview.yaml"
-  else start preview 40 "$preview_bin" --config "$cfg/preview.yaml" --headless --screenshot "$out/preview.png"; fi
+  say "starting the preview ($([ "$gui" = 1 ] && echo window || echo 'headless: one picture, preview.png'))"
+  if [ "$gui" = 1 ]; then start preview nice:0 "$preview_bin" --config "$cfg/preview.yaml"
+  else
+    # One picture of the first actor mesh it draws (textured from the capture servers' image
+    # rings), then it ends by itself (exit status checked with the others).
+    start preview nice:0 "$preview_bin" --config "$cfg/preview.yaml" --headless --frames 1 \
+      --timeout 90 --screenshot "$out/preview.png"
+  fi
 fi
 
 # ---- live measurement -------------------------------------------------------------------------
 say "measuring: ${seconds} s after the pipeline is up (3 s warm-up); one line per second"
 probe_rc=0
 $(rt 45) "$build/$probe_bin" watch --capture "${capture_cfgs[@]}" --rig "$cfg/rig.yaml" \
-  --seconds "$seconds" --warmup 3 --histogram "$out/latency.png" --out "$out/live.json" || probe_rc=$?
+  --seconds "$seconds" --warmup 3 --histogram "$out/latency.png" \
+  --projector-png "$out/projector.png" --out "$out/live.json" || probe_rc=$?
 
 # ---- a take, recorded frame-accurately on every camera ------------------------------------------
 say "recording a take of $take_frames frames on every camera"
@@ -240,5 +276,5 @@ fi
 
 # ---- the report ----------------------------------------------------------------------------------
 python3 "$root/deploy/demo/make_report.py" --out "$out" --cameras "$cameras" --keyer "$keyer" \
-  --scheduling "$scheduling" \
+  --scheduling "$scheduling" --projectors "$projectors" \
   --offline-grid "$offline_grid" --probe-rc "$probe_rc" --take-rc "$take_rc" --offline-rc "$offline_rc"

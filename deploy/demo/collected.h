@@ -29,6 +29,32 @@ struct HeadSample {
   double confidence = 0;
 };
 
+// One studio/projector/frame sample rendered in the window, scored against the simulator's true
+// actor at its display time (truth.h projector_lit).
+struct ProjectorSample {
+  std::string projector_id;
+  uint64_t render_frame = 0;
+  uint64_t mesh_frame = 0;     // studio frame of the newest mesh in the mask (0: none)
+  int64_t capture_ns = 0;      // of that mesh
+  int64_t render_done_ns = 0;  // CLOCK_REALTIME
+  double latency_ms = 0;       // as the projector published it
+  double margin_m = 0;
+  bool predicted = false;
+  bool scored = false;  // false: the scorer fell behind (or the calibration was missing)
+  uint64_t actor_px = 0, lit_actor_px = 0, blackout_px = 0, wasted_px = 0;
+};
+
+// The picture of one scored projector frame (OUT/projector.png): the thumbnail it published,
+// the blackout mask and the true actor at display time, at full resolution.
+struct ProjectorPicture {
+  std::string projector_id;
+  uint64_t render_frame = 0, lit_actor_px = 0, actor_px = 0;
+  int thumb_width = 0, thumb_height = 0;
+  std::vector<uint8_t> thumbnail;  // RGB8
+  Mask actor;
+  RunMask blackout;
+};
+
 struct ServiceSeen {
   std::string service, instance, host;
   int pid = 0;
@@ -56,6 +82,12 @@ struct Collected {
   std::string rig_detail;
   uint64_t masks_rejected = 0, meshes_rejected = 0;  // failed the wire validators at the probe
   std::optional<ProcSample> probe_start, probe_end;
+  std::vector<ProjectorSample> projector;  // frames rendered in the window, every projector
+  std::map<std::string, int> projector_calibrations;  // id -> width*height seen (0: none)
+  uint64_t projector_frames_rejected = 0, projector_score_errors = 0;
+  std::string projector_score_error;                  // the first one
+  std::optional<ProjectorPicture> projector_picture;  // the worst scored frame (most lit px)
+  double display_lag_s = 0;
 };
 
 }  // namespace studio::demo

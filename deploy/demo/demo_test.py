@@ -12,9 +12,13 @@ The machine is shared: the test runs alone (RUN_SERIAL), the other engineers' bu
 
 Bounds (issue 20's test, looser than its targets only in rate and latency, for a loaded CI
 machine): fps >= 20, latency p99 <= 60 ms on the last stage that exists (capture -> mesh and head
-delivered), hull_iou >= 0.95, head_error_m <= 0.03, masks_lost == 0. lit_actor_px must be null
-with a reason while the projector is not built. On failure the report's held_back_by names the
-stage that holds the figure back.
+delivered, or capture -> projector frame rendered once the projector runs), hull_iou >= 0.95,
+head_error_m <= 0.03, masks_lost == 0, and, when the projector ran (built, with the example
+studio's projector-proj1.yaml), lit_actor_px == 0: no projector pixel of any frame rendered in the
+window lands on the simulator's true actor at display time outside the blackout mask (the probe
+scores every frame; unscored frames are reported). lit_actor_px must be null with a reason while
+the projector is not built. On failure the report's held_back_by names the stage that holds the
+figure back.
 """
 import argparse
 import json
@@ -81,6 +85,16 @@ def main():
             check(issue in listed, f"issue {issue} ({binary}) not built but not listed as missing")
     if 15 in listed:
         check(r["lit_actor_px"] is None and r["lit_actor_px_reason"], "lit_actor_px without reason")
+    else:
+        # The projector ran: its light must not fall on the actor.
+        d = r.get("lit_actor_detail") or {}
+        check(r.get("lit_actor_px") is not None and (d.get("frames_scored") or 0) > 0,
+              f"projector ran but lit_actor_px not measured: {r.get('lit_actor_px_reason')}")
+        check(r.get("lit_actor_px") == 0,
+              f"lit_actor_px {r.get('lit_actor_px')} != 0 (max {d.get('max_per_frame')} per frame at "
+              f"{d.get('worst_at')}, {d.get('frames_with_lit')} of {d.get('frames_scored')} frames; "
+              f"margin {(r.get('projector') or {}).get('margin_m')}, motion to photon "
+              f"{(r.get('projector') or {}).get('motion_to_photon_ms')})")
 
     fps = r.get("fps") or 0
     p99 = (r.get("latency_ms") or {}).get("p99")
@@ -93,6 +107,7 @@ def main():
 
     print("load average start/end:", (r.get("machine") or {}).get("load_average"))
     print("held back by:", json.dumps(r.get("held_back_by")))
+    print("lit actor:", r.get("lit_actor_px"), json.dumps(r.get("lit_actor_detail")))
     print("slowest frame:", json.dumps((r.get("latency_ms") or {}).get("slowest_frame")))
     if failures:
         print(open(os.path.join(out, "report.md")).read())

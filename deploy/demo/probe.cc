@@ -29,6 +29,7 @@ Expected<void> ProbeOptions::validate() const {
   if (!(warmup_s >= 0 && warmup_s <= 600)) return fail("--warmup: expected 0..600");
   if (!(ready_timeout_s >= 1 && ready_timeout_s <= 600)) return fail("--ready-timeout: 1..600");
   if (!(score_rate_hz >= 0 && score_rate_hz <= 100)) return fail("--score-rate: expected 0..100");
+  if (!(display_lag_s > 0 && display_lag_s <= 1)) return fail("--display-lag: expected (0, 1] s");
   return {};
 }
 
@@ -79,26 +80,31 @@ class Recorder {
                            wire::Subscription<studio_SegmentSet>::create(p, {}, 8),
                            wire::Subscription<studio_ActorMesh>::create(p, {}, 8),
                            wire::Subscription<studio_HeadPose>::create(p, {}, 8),
-                           wire::Subscription<studio_ServiceStatus>::create(p, {}, 8));
+                           wire::Subscription<studio_ServiceStatus>::create(p, {}, 8),
+                           wire::Subscription<studio_ProjectorCalibration>::create(p),
+                           wire::Subscription<studio_ProjectorFrame>::create(p, {}, 8));
     if (!io) return std::unexpected(io.error());
     io_ = std::make_unique<Io>(std::move(*io));
     scorer_thread_ = std::thread([this] { score_loop(); });
+    projector_thread_ = std::thread([this] { projector_loop(); });
     auto ok = [](const Expected<void>& r) { return bool(r); };
     if (!ok(io_->cals->on_data_available([this] { on_calibration(); })) ||
         !ok(io_->masks->on_data_available([this] { on_mask(); })) ||
         !ok(io_->segments->on_data_available([this] { on_segments(); })) ||
         !ok(io_->meshes->on_data_available([this] { on_mesh(); })) ||
         !ok(io_->heads->on_data_available([this] { on_head(); })) ||
-        !ok(io_->status->on_data_available([this] { on_status(); })))
+        !ok(io_->status->on_data_available([this] { on_status(); })) ||
+        !ok(io_->proj_cals->on_data_available([this] { on_projector_calibration(); })) ||
+        !ok(io_->proj_frames->on_data_available([this] { on_projector_frame(); })))
       return fail("could not install the DDS listeners");
     return {};
   }
 
   void stop() {
     if (io_) {  // removing a listener waits for a running callback
-      for (wire::ReaderBase* r :
-           std::initializer_list<wire::ReaderBase*>{&*io_->cals, &*io_->masks, &*io_->segments,
-                                                    &*io_->meshes, &*io_->heads, &*io_->status})
+      for (wire::ReaderBase* r : std::initializer_list<wire::ReaderBase*>{
+               &*io_->cals, &*io_->masks, &*io_->segments, &*io_->meshes, &*io_->heads,
+               &*io_->status, &*io_->proj_cals, &*io_->proj_frames})
         (void)r->on_data_available({});
     }
     {
@@ -107,9 +113,11 @@ class Recorder {
     }
     wake_.notify_all();
     if (scorer_thread_.joinable()) scorer_thread_.join();
+    if (projector_thread_.joinable()) projector_thread_.join();
     if (io_) {
       c_.masks_rejected = io_->masks->rejected().total();
       c_.meshes_rejected = io_->meshes->rejected().total();
+      c_.projector_frames_rejected = io_->proj_frames->rejected().total();
     }
   }
 
@@ -203,6 +211,7 @@ class Recorder {
     c_.ready = ready;
     c_.not_ready_reason = why;
     c_.calibrations = int(cameras_.size());
+    c_.display_lag_s = o_.display_lag_s;
     for (auto& [key, s] : services_) c_.services.push_back(s);
     return std::move(c_);
   }
@@ -215,6 +224,14 @@ class Recorder {
     wire::Subscription<studio_ActorMesh> meshes;
     wire::Subscription<studio_HeadPose> heads;
     wire::Subscription<studio_ServiceStatus> status;
+    wire::Subscription<studio_ProjectorCalibration> proj_cals;
+    wire::Subscription<studio_ProjectorFrame> proj_frames;
+  };
+  struct ProjectorJob {
+    ProjectorSample sample;
+    RunMask blackout;
+    int thumb_width = 0, thumb_height = 0;
+    std::vector<uint8_t> thumbnail;
   };
   struct Job {
     bool is_head = false;
@@ -351,6 +368,103 @@ class Recorder {
     });
   }
 
+  void on_projector_calibration() {
+    io_->proj_cals->visit([&](const studio_ProjectorCalibration& s, const wire::SampleMeta& meta) {
+      if (!meta.valid_data) return;
+      auto p = wire::to_core(s);
+      if (!p) return;
+      std::lock_guard lock(mutex_);
+      projectors_.insert_or_assign(std::string(s.projector_id), p->camera);
+      c_.projector_calibrations[s.projector_id] = p->camera.width * p->camera.height;
+    });
+  }
+
+  // Copies the frame's run table (small) for the projector scorer; the truth is computed there.
+  void on_projector_frame() {
+    io_->proj_frames->visit([&](const studio_ProjectorFrame& s, const wire::SampleMeta& meta) {
+      if (!meta.valid_data) return;
+      std::lock_guard lock(mutex_);
+      if (!c_.window_start_ns || s.render_done_ns < c_.window_start_ns ||
+          s.render_done_ns >= c_.window_end_ns)
+        return;
+      ProjectorSample p;
+      p.projector_id = s.projector_id;
+      p.render_frame = s.render_frame;
+      p.mesh_frame = s.frame;
+      p.capture_ns = s.capture_ns;
+      p.render_done_ns = s.render_done_ns;
+      p.latency_ms = s.latency_ms;
+      p.margin_m = s.margin_m;
+      p.predicted = s.predicted;
+      auto blackout = wire::to_core(s);
+      if (!blackout || !truth_ || projector_jobs_.size() >= o_.projector_queue) {
+        if (!blackout) note_projector_error(blackout.error().message);
+        c_.projector.push_back(std::move(p));  // unscored
+        return;
+      }
+      ProjectorJob job{
+          std::move(p), std::move(*blackout), int(s.thumb_width), int(s.thumb_height), {}};
+      job.thumbnail.assign(s.thumbnail._buffer, s.thumbnail._buffer + s.thumbnail._length);
+      projector_jobs_.push_back(std::move(job));
+      wake_.notify_all();
+    });
+  }
+
+  void note_projector_error(const std::string& message) {  // with mutex_ held
+    if (c_.projector_score_errors++ == 0) c_.projector_score_error = message;
+  }
+
+  // Scores every queued projector frame: the true actor at display time against its blackout.
+  void projector_loop() {
+    sched_param normal{};
+    pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
+    while (true) {
+      ProjectorJob job;
+      const TruthScorer* truth = nullptr;
+      std::optional<Camera> projector;
+      {
+        std::unique_lock lock(mutex_);
+        wake_.wait(lock, [&] { return stopping_ || !projector_jobs_.empty(); });
+        if (projector_jobs_.empty()) return;
+        job = std::move(projector_jobs_.front());
+        projector_jobs_.pop_front();
+        truth = truth_.get();
+        if (auto it = projectors_.find(job.sample.projector_id); it != projectors_.end())
+          projector = it->second;
+      }
+      ProjectorSample& p = job.sample;
+      // The simulator's clock: frame f (the actor at f / fps) is stamped capture_of(f).
+      const double studio_frame =
+          double(p.render_done_ns - capture_of(0)) / double(o_.studio.clock.period_ns);
+      Mask actor;
+      Expected<TruthScorer::Lit> lit = fail("no calibration of projector " + p.projector_id +
+                                            " on studio/projector/calibration");
+      if (projector)
+        lit =
+            truth->projector_lit(*projector, studio_frame, o_.display_lag_s, job.blackout, &actor);
+      std::lock_guard lock(mutex_);
+      if (!lit) {
+        note_projector_error(lit.error().message);
+      } else {
+        p.scored = true;
+        p.actor_px = lit->actor;
+        p.lit_actor_px = lit->lit_actor;
+        p.blackout_px = lit->blackout;
+        p.wasted_px = lit->wasted;
+        // The picture: the frame with the most lit actor pixels, else one with the actor in view.
+        auto& pic = c_.projector_picture;
+        if (!pic || p.lit_actor_px > pic->lit_actor_px ||
+            (p.lit_actor_px == pic->lit_actor_px && pic->actor_px == 0 && p.actor_px > 0)) {
+          pic = ProjectorPicture{
+              p.projector_id,         p.render_frame,   p.lit_actor_px,           p.actor_px,
+              job.thumb_width,        job.thumb_height, std::move(job.thumbnail), std::move(actor),
+              std::move(job.blackout)};
+        }
+      }
+      c_.projector.push_back(std::move(p));
+    }
+  }
+
   void score_loop() {
     // Scoring (truth rendering) is the probe's heavy work and not latency-critical: when the
     // probe runs real-time (deploy/demo.sh), only its receive path keeps that priority.
@@ -415,6 +529,9 @@ class Recorder {
   bool stopping_ = false, scoring_ = false, first_mesh_ = false;
   int64_t last_pick_ns_ = 0;
   std::map<std::string, Camera> cameras_;
+  std::map<std::string, Camera> projectors_;  // studio/projector/calibration
+  std::deque<ProjectorJob> projector_jobs_;
+  std::thread projector_thread_;
   std::map<std::string, ServiceSeen> services_;
   std::unique_ptr<TruthScorer> truth_;
   std::optional<Job> collecting_;

@@ -20,7 +20,15 @@
 //   segments→mesh     last actor mesh of the frame after its first SegmentSet
 //   segments→head     head update after the first SegmentSet
 // and end to end capture→mesh, capture→head, capture→mesh+head (both delivered: what the
-// projector needs to draw that frame; the headline figure).
+// projector needs to draw that frame).
+//
+// Projectors (studio/projector/frame, one sample per rendered frame with its full-resolution
+// blackout mask as runs): every frame rendered in the window is scored against the simulator's
+// true actor at its display time (render_done_ns on the studio clock + display_lag_s,
+// sim/projector_light.h): lit_actor_px = projector pixels on the true actor the mask leaves lit.
+// When projector frames arrive, the headline latency is the projector's motion to photon
+// (a mesh's capture_ns → the first projector frame rendered with it) and fps counts the meshes
+// that reached a projector.
 
 #include <string>
 #include <vector>
@@ -39,7 +47,10 @@ struct ProbeOptions {
   double seconds = 10;
   double score_rate_hz = 2;  // live meshes scored against the truth per second
   std::string head_id = "actor";
-  std::string histogram_png;  // latency histogram (OpenCV), optional
+  std::string histogram_png;         // latency histogram (OpenCV), optional
+  std::string projector_png;         // a scored projector frame (thumbnail, blackout, true actor)
+  double display_lag_s = 0.016;      // projector frame rendered → on the cloth (sim's default)
+  std::size_t projector_queue = 64;  // frames waiting for scoring; beyond: counted unscored
   bool progress = true;
 
   Expected<void> validate() const;

@@ -1,6 +1,7 @@
 // studio-demo-probe: the demo's measuring instrument (a demo/test tool, not a service).
 //   studio-demo-probe watch --capture FILE... [--rig FILE] [--seconds S] [--warmup S]
 //                           [--ready-timeout S] [--score-rate HZ] [--histogram PNG] [--out FILE]
+//                           [--projector-png PNG] [--display-lag S]
 //   studio-demo-probe take  --capture FILE... [--name TAKE] [--frames N] [--lead S] [--timeout S]
 //   studio-demo-probe rig   (--from RIG | --published --capture FILE...) [--cameras ID,...] --out
 //   FILE studio-demo-probe score --rig RIG --meshes DIR [--out FILE]
@@ -46,8 +47,11 @@ watch   records masks, segments, meshes, heads and service status for a bounded 
         with per-stage timings (capture->mask, mask->segments, segments->mesh, segments->head),
         hull_iou (live meshes re-projected vs the simulator's true masks of the same frame),
         head_error_m (RMS vs the simulator's true head), masks_lost, per_service (rate from
-        studio/service/status, CPU % and RSS from /proc) and held_back_by. One progress line per
-        second on stderr.
+        studio/service/status, CPU % and RSS from /proc) and held_back_by. With projectors
+        running (studio/projector/frame): lit_actor_px (projector pixels on the simulator's true
+        actor at display time that the frame's blackout mask leaves lit, every frame of the
+        window), the projector's motion-to-photon latency (then the headline latency_ms) and fps
+        (meshes reaching the projector). One progress line per second on stderr.
   --capture FILE...   the capture configs the cameras run with (clock, camera ids); the truth
                       cameras are the calibrations those servers publish
   --rig FILE          the hull's rig.yaml: checked against the published calibrations
@@ -56,6 +60,9 @@ watch   records masks, segments, meshes, heads and service status for a bounded 
   --ready-timeout S   wait for every calibration and a first mesh (default 60)
   --score-rate HZ     live meshes scored against the truth per second (default 2; 0 = none)
   --histogram PNG     latency histogram of the window
+  --projector-png PNG the scored projector frame with the most lit actor pixels (thumbnail,
+                      blackout, true actor)
+  --display-lag S     projector frame rendered -> on the cloth, for the truth (default 0.016)
   --out FILE          write the JSON there instead of stdout
   --quiet             no progress lines
 take    records a take on every capture server, frame-accurate: START at a future frame, STOP
@@ -150,18 +157,22 @@ int watch(const Args& a) {
   o.rig = opt(a, "rig");
   auto seconds = number(a, "seconds", o.seconds), warmup = number(a, "warmup", o.warmup_s),
        ready = number(a, "ready-timeout", o.ready_timeout_s),
-       rate = number(a, "score-rate", o.score_rate_hz);
-  for (auto* v : {&seconds, &warmup, &ready, &rate})
+       rate = number(a, "score-rate", o.score_rate_hz),
+       lag = number(a, "display-lag", o.display_lag_s);
+  for (auto* v : {&seconds, &warmup, &ready, &rate, &lag})
     if (!*v) return usage_error(v->error().message);
   o.seconds = *seconds;
   o.warmup_s = *warmup;
   o.ready_timeout_s = *ready;
   o.score_rate_hz = *rate;
+  o.display_lag_s = *lag;
   o.histogram_png = opt(a, "histogram");
+  o.projector_png = opt(a, "projector-png");
   o.progress = !a.quiet;
   for (const auto& [k, v] : a.opts)
     if (k != "rig" && k != "seconds" && k != "warmup" && k != "ready-timeout" &&
-        k != "score-rate" && k != "histogram" && k != "out")
+        k != "score-rate" && k != "histogram" && k != "out" && k != "projector-png" &&
+        k != "display-lag")
       return usage_error("watch: unknown option --" + k);
   auto json = demo::run_probe(o);
   if (!json) return usage_error(json.error().message);

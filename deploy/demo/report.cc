@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "json_writer.h"
+#include "projector_report.h"
 
 namespace studio::demo {
 namespace {
@@ -134,11 +135,18 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   for (Stats* s : {&cap_mask, &mask_seg, &seg_mesh, &seg_head, &cap_mesh, &cap_head, &cap_both})
     std::sort(s->v.begin(), s->v.end());
   const bool have_heads = !cap_both.v.empty();
-  const Stats& headline = have_heads ? cap_both : cap_mesh;
+  // The projector (studio/projector/frame): when its frames arrived, the headline is its motion
+  // to photon and fps counts the meshes that reached it.
+  const ProjectorFigures proj = projector_figures(c, window_s);
+  const Stats cap_proj{proj.motion_to_photon_ms}, mesh_proj{proj.mesh_to_projector_ms};
+  const bool have_proj = !cap_proj.v.empty();
+  const Stats& headline = have_proj ? cap_proj : have_heads ? cap_both : cap_mesh;
   const char* headline_stage =
-      have_heads ? "capture -> actor mesh and head both delivered to a subscriber (where the "
-                   "projector will read them)"
-                 : "capture -> actor mesh delivered to a subscriber (no head updates arrived)";
+      have_proj    ? "capture -> first projector frame rendered with that mesh (motion to photon: "
+                     "the mesh's capture_ns -> studio/projector/frame render_done_ns)"
+      : have_heads ? "capture -> actor mesh and head both delivered to a subscriber (no projector "
+                     "frames arrived)"
+                   : "capture -> actor mesh delivered to a subscriber (no head updates arrived)";
 
   JsonWriter j;
   j.begin_object();
@@ -151,11 +159,14 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
       .field("with_all_masks", complete);
   j.field("with_mesh", meshes).field("with_head", heads);
   j.end_object();
-  const double fps = window_s > 0 ? double(meshes) / window_s : 0;
+  const double hull_fps = window_s > 0 ? double(meshes) / window_s : 0;
+  const double fps = proj.ran ? proj.mesh_fps : hull_fps;
   j.field("fps", fps);
-  j.field("fps_stage",
-          "studio/actor/mesh delivered (hull output; the scene server and projector "
-          "that will consume it are not built)");
+  j.field("fps_stage", proj.ran ? "actor meshes reaching the projector: distinct mesh frames in "
+                                  "studio/projector/frame per second (the slowest projector)"
+                                : "studio/actor/mesh delivered (hull output; no projector frames "
+                                  "arrived)");
+  j.field("hull_fps", hull_fps);
   j.field("heads_per_s", window_s > 0 ? double(heads) / window_s : 0);
   j.key("latency_ms");
   {
@@ -173,6 +184,8 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     seg_mesh.write(j);
     j.key("segments_to_head");
     seg_head.write(j);
+    j.key("mesh_to_projector_frame");
+    mesh_proj.write(j);
     j.end_object();
     j.key("end_to_end").begin_object();
     j.key("capture_to_mesh");
@@ -181,6 +194,8 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     cap_head.write(j);
     j.key("capture_to_mesh_and_head");
     cap_both.write(j);
+    j.key("capture_to_projector_frame");
+    cap_proj.write(j);
     j.end_object();
     // Where the slowest frame spent its time (a stall shows up in one stage).
     j.key("slowest_frame").begin_object();
@@ -239,6 +254,7 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   j.field("updates", uint64_t(c.heads.size())).field("max_m", worst_head);
   j.field("truth", "the simulated actor's head centre at the same frame number");
   j.end_object();
+  write_projector(j, proj, c);
   // Masks lost.
   j.field("masks_lost", expected - received);
   j.key("masks_detail").begin_object();
@@ -276,7 +292,9 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
         if (o.studio.camera_ids[i] == s.instance && window_s > 0)
           delivered = double(per_camera[i]) / window_s;
     } else if (s.service == "hull") {
-      delivered = fps;
+      delivered = hull_fps;
+    } else if (s.service == "projector" && proj.per_projector.contains(s.instance)) {
+      delivered = proj.per_projector.at(s.instance).first;
     } else if (s.service == "tracker" && window_s > 0) {
       delivered = double(heads) / window_s;
     }
@@ -339,11 +357,17 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
                     "transport: frames with every camera's mask %.1f/s of %.0f (masks lost on "
                     "the way)",
                     all_masks, rate);
-    } else if (fps < 0.95 * any) {
-      std::snprintf(buf, sizeof buf, "hull: %.1f meshes/s from %.1f frames/s of masks", fps, any);
+    } else if (hull_fps < 0.95 * any) {
+      std::snprintf(buf, sizeof buf, "hull: %.1f meshes/s from %.1f frames/s of masks", hull_fps,
+                    any);
     } else if (have_heads && double(heads) / window_s < 0.95 * fps) {
       std::snprintf(buf, sizeof buf, "tracker: %.1f head updates/s from %.1f meshes/s",
-                    double(heads) / window_s, fps);
+                    double(heads) / window_s, hull_fps);
+    } else if (proj.ran && proj.mesh_fps < 0.95 * hull_fps) {
+      std::snprintf(buf, sizeof buf,
+                    "projector: %.1f meshes/s reach a projector frame from %.1f meshes/s "
+                    "(rendering %.1f frames/s)",
+                    proj.mesh_fps, hull_fps, proj.rendered_fps);
     } else {
       std::snprintf(buf, sizeof buf, "none: every stage keeps the camera rate (%.1f fps)", fps);
     }
@@ -351,7 +375,8 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     const std::pair<const char*, const Stats*> stages[] = {{"capture_to_mask", &cap_mask},
                                                            {"mask_to_segments", &mask_seg},
                                                            {"segments_to_mesh", &seg_mesh},
-                                                           {"segments_to_head", &seg_head}};
+                                                           {"segments_to_head", &seg_head},
+                                                           {"mesh_to_projector_frame", &mesh_proj}};
     double worst = -1;
     for (const auto& [name, s] : stages)
       if (std::isfinite(s->pct(99)) && s->pct(99) > worst) {
@@ -377,10 +402,14 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   if (!o.histogram_png.empty()) {
     char title[200];
     std::snprintf(title, sizeof title, "%s, %zu frames, %d cameras",
-                  have_heads ? "capture -> mesh + head delivered" : "capture -> mesh delivered",
+                  have_proj    ? "capture -> projector frame rendered"
+                  : have_heads ? "capture -> mesh + head delivered"
+                               : "capture -> mesh delivered",
                   headline.v.size(), ncams);
     draw_histogram(headline, title, o.histogram_png);
   }
+  if (!o.projector_png.empty() && !draw_projector_png(c, o.projector_png))
+    std::fprintf(stderr, "[demo] could not write %s\n", o.projector_png.c_str());
   return j.str();
 }
 

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "capture/sim_source.h"
+#include "sim/projector_light.h"
 #include "sim/studio.h"
 #include "support/masks.h"
 #include "testing/raster.h"
@@ -61,6 +62,23 @@ Eigen::Vector3d TruthScorer::true_head(uint64_t frame) const {
 
 double TruthScorer::head_error(uint64_t frame, const Eigen::Vector3d& position) const {
   return (position - true_head(frame)).norm();
+}
+
+Expected<TruthScorer::Lit> TruthScorer::projector_lit(const Camera& projector, double studio_frame,
+                                                      double display_lag_s, const RunMask& blackout,
+                                                      Mask* actor_out) const {
+  if (blackout.width() != projector.width || blackout.height() != projector.height)
+    return fail("projector frame " + std::to_string(blackout.width()) + "x" +
+                std::to_string(blackout.height()) + " is not the projector's " +
+                std::to_string(projector.width) + "x" + std::to_string(projector.height));
+  sim::DisplayOptions display;
+  display.display_lag_s = display_lag_s;
+  if (auto ok = display.validate(); !ok) return std::unexpected(ok.error());
+  const double t = studio_frame / impl_->studio.options().fps;
+  Mask actor = sim::actor_at_display(impl_->studio.actor(), projector, t, display);
+  const sim::LitCount n = sim::count_lit(actor, blackout);
+  if (actor_out) *actor_out = std::move(actor);
+  return Lit{n.actor, n.lit_actor, n.blackout, n.wasted};
 }
 
 }  // namespace studio::demo

@@ -8,6 +8,9 @@
 //     hull/testing/raster.h) against that camera's TRUE mask of frame f (the geometric
 //     silhouette); IoU per camera, mean over cameras;
 //   - head error: distance between a published head position and the true head centre of f.
+//   - projector light (issue 15 item 5, sim/projector_light.h): the projector pixels whose ray
+//     meets the TRUE actor at the instant a projector frame is on the cloth (render time + the
+//     simulator's display lag), and of those the ones the frame's blackout mask leaves lit.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -17,6 +20,8 @@
 
 #include "core/camera.h"
 #include "core/error.h"
+#include "core/image.h"
+#include "core/run_mask.h"
 #include "hull/segment_mesh.h"
 
 namespace studio::demo {
@@ -41,6 +46,17 @@ class TruthScorer {
   // |position - true head centre of frame|, metres.
   double head_error(uint64_t frame, const Eigen::Vector3d& position) const;
   Eigen::Vector3d true_head(uint64_t frame) const;
+
+  // Projector light on the true actor. `studio_frame` is a fractional frame number of the
+  // simulator's clock (frame f is the actor at f / fps, sim/studio.h) for the frame's render
+  // time; the actor is taken at that time + display_lag_s (sim::actor_at_display). The blackout
+  // mask must be of the projector's size (else an error). `actor_out`, if given, receives the true
+  // actor mask (255 on the actor).
+  struct Lit {
+    uint64_t actor = 0, lit_actor = 0, blackout = 0, wasted = 0;
+  };
+  Expected<Lit> projector_lit(const Camera& projector, double studio_frame, double display_lag_s,
+                              const RunMask& blackout, Mask* actor_out = nullptr) const;
 
  private:
   struct Impl;
