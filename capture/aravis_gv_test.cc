@@ -4,20 +4,26 @@
 // leave the machine. Proves discovery and open by id, streaming with the requested format and
 // size, one frame per software trigger, and the disappear → retry with back-off → resume path.
 // Every test runs under a watchdog (55 s) besides ctest's timeout.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <net/if.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
 #include <thread>
 
 #include "capture/aravis_source.h"
+#include "capture/freed.h"
+#include "capture/freed_listener.h"
 #include "core/clock.h"
 
 namespace studio::capture {
@@ -294,4 +300,81 @@ TEST_F(AravisGv, DisappearsRetriesWithBackOffAndResumes) {
 }
 
 }  // namespace
+// A tracked GigE camera (Aravis's fake camera behind TrackedSource, as studio-capture wires a
+// `tracking: freed:` entry): before any Free-D packet the tracker is silent; while packets of its
+// id arrive every frame it is not, and the frames keep flowing; when the packets stop, the state
+// says silent within one second of the last one (the node copies this into CameraState).
+TEST_F(AravisGv, TrackerFallingSilentShowsInTheState) {
+  AravisOptions o = options();
+  FreeDListenerOptions lo{"127.0.0.1", 0, 64};
+  lo.clock = o.clock;
+  auto created = FreeDListener::create(lo);
+  ASSERT_TRUE(created) << created.error().message;
+  std::shared_ptr<FreeDListener> listener = std::move(*created);
+  TrackedSourceOptions to;
+  to.camera.camera_id = o.camera_id;
+  to.camera.freed_id = 5;
+  to.camera.width = o.width;
+  to.camera.height = o.height;
+  to.camera.lens = LensTable{{LensSample{0, 0, 400, 400, 160, 120, 0, 0}}};
+  to.clock = o.clock;
+  ASSERT_TRUE(to.validate());
+  auto inner = AravisSource::open(o);
+  ASSERT_TRUE(inner) << inner.error().message;
+  TrackedSource source(std::move(*inner), listener, to);
+  ASSERT_TRUE(source.start());
+  EXPECT_TRUE(source.status(realtime_ns()).silent) << "no packet yet";
+
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in to_addr{};
+  to_addr.sin_family = AF_INET;
+  to_addr.sin_port = htons(listener->port());
+  to_addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::atomic<bool> sending{true};
+  std::atomic<int64_t> last_sent_ns{0};
+  std::thread tracker([&] {
+    FreeDPacket p;
+    p.camera_id = 5;
+    while (sending) {
+      p.pan_deg += 0.5;
+      const auto bytes = encode_freed(p);
+      if (::sendto(fd, bytes.data(), bytes.size(), 0, reinterpret_cast<sockaddr*>(&to_addr),
+                   sizeof to_addr) == ssize_t(bytes.size()))
+        last_sent_ns = realtime_ns();
+      std::this_thread::sleep_for(milliseconds(40));
+    }
+  });
+  // Tracked: frames flow and the state is not silent.
+  int frames = 0;
+  bool tracked = false;
+  const auto until = Clock::now() + std::chrono::seconds(3);
+  while (Clock::now() < until && (frames < 25 || !tracked)) {
+    auto f = source.next(milliseconds(200));
+    ASSERT_TRUE(f) << f.error().message;
+    if (*f) ++frames;
+    tracked = tracked || !source.status(realtime_ns()).silent;
+  }
+  EXPECT_GE(frames, 25);
+  EXPECT_TRUE(tracked) << "packets arrived but the tracker stayed silent";
+  // Silent: stop the packets; the state follows within one second of the last one.
+  sending = false;
+  tracker.join();
+  ::close(fd);
+  int64_t silent_after_ns = -1;
+  while (realtime_ns() - last_sent_ns < 3'000'000'000) {
+    (void)source.next(milliseconds(50));  // the camera keeps streaming meanwhile
+    if (source.status(realtime_ns()).silent) {
+      silent_after_ns = realtime_ns() - last_sent_ns;
+      break;
+    }
+  }
+  source.stop();
+  ASSERT_GE(silent_after_ns, 0) << "still not silent 3 s after the last packet";
+  EXPECT_LE(silent_after_ns, 1'000'000'000);
+  std::printf(
+      "tracked GigE camera: %d frames while tracked; silent %.0f ms after the last packet\n",
+      frames, silent_after_ns / 1e6);
+}
+
 }  // namespace studio::capture
