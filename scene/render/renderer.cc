@@ -235,8 +235,8 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
   impl->options = options;
   const bool fast = options.shading == RendererOptions::Shading::fast;
   auto program =
-      fast ? build_program(shaders::kFastVertex, shaders::kFastFragment, "scene (fast)")
-           : build_program(shaders::kSceneVertex, shaders::kSceneFragment, "scene");
+      fast ? build_program(shaders::kFastVertex.c_str(), shaders::kFastFragment, "scene (fast)")
+           : build_program(shaders::kSceneVertex, shaders::kSceneFragment.c_str(), "scene");
   if (!program) return std::unexpected(program.error());
   impl->program = *program;
   auto quad = build_program(shaders::kQuadVertex, shaders::kQuadFragment, "texture quad");

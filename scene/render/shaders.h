@@ -1,7 +1,37 @@
 #pragma once
 // GLSL 3.30 core sources of the renderer.
 
+#include <string>
+
 namespace studio::scene_render::shaders {
+
+// The lights' uniforms and their geometry, shared by the reference (per-fragment) and the fast
+// (per-vertex) lit passes so both evaluate the same lights: light_towards(i, p, attenuation)
+// returns the unit direction from world point p towards light i and sets its attenuation
+// (inverse square past 1 m, the range window, the spot cone).
+inline constexpr const char* kLights = R"(uniform int u_light_count;
+uniform vec4 u_light_position[8];   // w = 0: xyz = unit direction towards the light
+uniform vec3 u_light_radiance[8];   // colour x intensity x exposure
+uniform vec4 u_light_spot[8];       // xyz = unit spot direction, w = cos(outer); w < -1: no cone
+uniform float u_light_spot_inner[8];
+uniform float u_light_range[8];
+vec3 light_towards(int i, vec3 p, out float attenuation) {
+  attenuation = 1.0;
+  if (u_light_position[i].w == 0.0) return u_light_position[i].xyz;
+  vec3 d = u_light_position[i].xyz - p;
+  float d2 = max(dot(d, d), 1e-4);
+  vec3 l = d * inversesqrt(d2);
+  attenuation = 1.0 / max(d2, 1.0);
+  if (u_light_range[i] > 0.0) {
+    float r = sqrt(d2) / u_light_range[i];
+    attenuation *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
+  }
+  if (u_light_spot[i].w >= -1.0)
+    attenuation *= smoothstep(u_light_spot[i].w, u_light_spot_inner[i], dot(-l, u_light_spot[i].xyz));
+  return l;
+}
+)";
+
 
 // Lit pass: per-fragment Blinn-Phong over up to 8 lights, base colour x texture x vertex colour.
 inline constexpr const char* kSceneVertex = R"(#version 330 core
@@ -29,7 +59,7 @@ void main() {
 }
 )";
 
-inline constexpr const char* kSceneFragment = R"(#version 330 core
+inline const std::string kSceneFragment = std::string(R"(#version 330 core
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;
@@ -43,13 +73,7 @@ uniform bool u_unlit;
 uniform float u_alpha;              // alpha written (1; the actor mask pass writes its colour's)
 uniform vec3 u_eye;
 uniform vec3 u_ambient;
-uniform int u_light_count;
-uniform vec4 u_light_position[8];   // w = 0: xyz = unit direction towards the light
-uniform vec3 u_light_radiance[8];   // colour x intensity x exposure
-uniform vec4 u_light_spot[8];       // xyz = unit spot direction, w = cos(outer); w < -1: no cone
-uniform float u_light_spot_inner[8];
-uniform float u_light_range[8];
-void main() {
+)") + kLights + R"(void main() {
   vec4 base = u_base * vec4(v_colour, 1.0);
   if (u_textured) base *= texture(u_texture, v_uv);
   if (u_unlit) { o_colour = vec4(base.rgb, u_alpha); return; }
@@ -58,24 +82,8 @@ void main() {
   if (dot(n, v) < 0.0) n = -n;  // two-sided
   vec3 c = u_ambient * base.rgb + u_emissive;
   for (int i = 0; i < u_light_count; ++i) {
-    vec3 l;
-    float attenuation = 1.0;
-    if (u_light_position[i].w == 0.0) {
-      l = u_light_position[i].xyz;
-    } else {
-      vec3 d = u_light_position[i].xyz - v_world;
-      float d2 = max(dot(d, d), 1e-4);
-      l = d * inversesqrt(d2);
-      attenuation = 1.0 / max(d2, 1.0);
-      if (u_light_range[i] > 0.0) {
-        float r = sqrt(d2) / u_light_range[i];
-        attenuation *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
-      }
-      if (u_light_spot[i].w >= -1.0) {
-        float cd = dot(-l, u_light_spot[i].xyz);
-        attenuation *= smoothstep(u_light_spot[i].w, u_light_spot_inner[i], cd);
-      }
-    }
+    float attenuation;
+    vec3 l = light_towards(i, v_world, attenuation);
     float ndl = max(dot(n, l), 0.0);
     if (ndl <= 0.0) continue;
     float spec = pow(max(dot(n, normalize(l + v)), 0.0), 32.0) * 0.15;
@@ -90,7 +98,7 @@ void main() {
 // 1080p frame affordable on a software rasteriser. Close to the reference where meshes are
 // tessellated finer than the light varies (the museum's floor and walls are grids of 0.5-1 m
 // cells under lights 4 m up); a specular highlight smaller than a triangle is smoothed out.
-inline constexpr const char* kFastVertex = R"(#version 330 core
+inline const std::string kFastVertex = std::string(R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
@@ -102,13 +110,7 @@ uniform float u_inflate;
 uniform vec4 u_clip_plane;
 uniform bool u_unlit;
 uniform vec3 u_eye;
-uniform int u_light_count;
-uniform vec4 u_light_position[8];
-uniform vec3 u_light_radiance[8];
-uniform vec4 u_light_spot[8];
-uniform float u_light_spot_inner[8];
-uniform float u_light_range[8];
-uniform vec3 u_ambient;
+)") + kLights + R"(uniform vec3 u_ambient;
 out vec2 v_uv;
 out vec3 v_light;     // vertex colour x (ambient + sum of radiance x attenuation x n.l)
 out vec3 v_specular;  // sum of the specular terms (added)
@@ -124,24 +126,8 @@ void main() {
   vec3 v = normalize(u_eye - world.xyz);
   if (dot(n, v) < 0.0) n = -n;  // two-sided
   for (int i = 0; i < u_light_count; ++i) {
-    vec3 l;
-    float attenuation = 1.0;
-    if (u_light_position[i].w == 0.0) {
-      l = u_light_position[i].xyz;
-    } else {
-      vec3 d = u_light_position[i].xyz - world.xyz;
-      float d2 = max(dot(d, d), 1e-4);
-      l = d * inversesqrt(d2);
-      attenuation = 1.0 / max(d2, 1.0);
-      if (u_light_range[i] > 0.0) {
-        float r = sqrt(d2) / u_light_range[i];
-        attenuation *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
-      }
-      if (u_light_spot[i].w >= -1.0) {
-        float cd = dot(-l, u_light_spot[i].xyz);
-        attenuation *= smoothstep(u_light_spot[i].w, u_light_spot_inner[i], cd);
-      }
-    }
+    float attenuation;
+    vec3 l = light_towards(i, world.xyz, attenuation);
     float ndl = max(dot(n, l), 0.0);
     if (ndl <= 0.0) continue;
     float spec = pow(max(dot(n, normalize(l + v)), 0.0), 32.0) * 0.15;
