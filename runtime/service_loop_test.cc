@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <condition_variable>
 #include <cstring>
@@ -277,6 +278,61 @@ TEST_F(ServiceLoopTest, StopEndsABlockedWaitAndInterruptsThreads) {
   ASSERT_TRUE(again.start().has_value());
   send("x", 1);
   EXPECT_TRUE(eventually([&] { return count("in2") == 1; }));
+}
+
+// Liveness (the watchdog's view, runtime/liveness.h): an idle loop comes round often enough to
+// stay alive without running its hooks; a handler that does not return makes the loop stalled,
+// named; it recovers when the handler returns, and stop() detaches it.
+TEST_F(ServiceLoopTest, AnIdleLoopStaysAliveAWedgedHandlerStallsIt) {
+  Liveness liveness(200ms);
+  NodeContext context{*participant_, metrics_, "test", &liveness};
+  ServiceLoop loop(context, "wedgeable");
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool wedged = false;
+  std::atomic<int> hooks{0}, handled{0};
+  loop.input<studio_CameraControl>(
+      {.received = "in"}, [&](const studio_CameraControl& c, const wire::SampleMeta&) -> Outcome {
+        std::unique_lock lock(mutex);
+        if (c.value > 0) {
+          wedged = true;
+          cv.wait(lock, [&] { return !wedged; });
+        }
+        ++handled;
+        return {};
+      });
+  loop.after_inputs([&](Clock::time_point) { ++hooks; });
+  ASSERT_TRUE(loop.start().has_value());
+  // Idle for 5 bounds: alive (heartbeat turns every 50 ms), and no hook ran.
+  for (int i = 0; i < 10; ++i) {
+    std::this_thread::sleep_for(100ms);
+    EXPECT_FALSE(liveness.stalled(Clock::now())) << "an idle loop must not count as stalled";
+  }
+  EXPECT_EQ(hooks, 0) << "a heartbeat turn runs no hooks";
+  // Positive control: a sample is handled, the hooks run, still alive.
+  send("gain", 0);
+  ASSERT_TRUE(eventually([&] { return handled == 1 && hooks >= 1; }));
+  EXPECT_FALSE(liveness.stalled(Clock::now()));
+  // A handler that does not return: stalled past the bound, the loop named.
+  send("gain", 1);
+  ASSERT_TRUE(eventually([&] {
+    std::lock_guard lock(mutex);
+    return wedged;
+  }));
+  std::this_thread::sleep_for(300ms);
+  auto stall = liveness.stalled(Clock::now());
+  ASSERT_TRUE(stall) << "a wedged handler must count as stalled";
+  EXPECT_EQ(stall->name, "wedgeable");
+  EXPECT_GT(stall->silent, 200ms);
+  {
+    std::lock_guard lock(mutex);
+    wedged = false;
+  }
+  cv.notify_all();
+  ASSERT_TRUE(eventually([&] { return handled == 2 && !liveness.stalled(Clock::now()); }));
+  loop.stop();
+  std::this_thread::sleep_for(300ms);
+  EXPECT_FALSE(liveness.stalled(Clock::now())) << "a stopped loop is detached";
 }
 
 }  // namespace

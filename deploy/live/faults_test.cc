@@ -10,7 +10,9 @@
 //  - the systemd protocol, the test playing systemd (NOTIFY_SOCKET, WATCHDOG_USEC): every service
 //    sends READY=1, pings WATCHDOG=1 at least every half interval and STOPPING=1 on SIGTERM; a
 //    stalled main loop (studio_stall_service: service_main with a health() that blocks on demand)
-//    stops the pings, they resume when it unstalls, and systemd's SIGABRT + restart brings it back.
+//    stops the pings, they resume when it unstalls, and systemd's SIGABRT + restart brings it back;
+//    a wedged service-loop thread (the main loop still running) stops them too: the runtime pings
+//    only while every ServiceLoop has turned within loop_stall (runtime/liveness.h).
 // Each test prints one FAULT/FLOOD line with its figures (BENCHMARKS.md, operations).
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -317,6 +319,57 @@ TEST_F(Systemd, AStalledMainLoopStopsThePingsAndARestartBringsItBack) {
       "WATCHDOG: pings every <= %.3f s running, %zu in 1.5 s stalled, %zu in 1 s after the "
       "stall ended; SIGABRT + restart: READY again\n",
       running.max_interval_s(), stalled.at.size(), resumed.at.size());
+}
+
+// The main loop keeps running but the node's ServiceLoop thread is stuck in one turn (a handler
+// that never returns): the pings must stop all the same, or systemd would never restart a
+// service that does nothing. Positive control: the same service, loop turning, keeps pinging.
+// (With `loop_stall: 600` in wedge.yaml this test fails: 16 pings in the wedged 1.5 s.)
+TEST_F(Systemd, AWedgedServiceLoopThreadStopsThePings) {
+  const auto stall = dir_ / "stall", wedge = dir_ / "wedge";
+  std::ofstream(etc_ / "wedge.yaml")
+      << "instance: wedge0\nstatus_period: 0.1\nstall_file: " << stall.string()
+      << "\nwedge_file: " << wedge.string() << "\n";
+  testing::Env env = dds_.env();
+  env.push_back({"WATCHDOG_USEC", "500000"});  // loop_stall defaults to 0.25 s
+  auto started =
+      testing::Process::start({.name = "wedge",
+                               .binary = testing::built_binary("deploy/live/studio_stall_service"),
+                               .args = {"--config", (etc_ / "wedge.yaml").string()},
+                               .env = env,
+                               .dir = dir_});
+  ASSERT_TRUE(started.has_value()) << started.error().message;
+  processes_.push_back(std::move(*started));
+  testing::Process& p = processes_.back();
+  ASSERT_TRUE(p.wait_ready(30s)) << p.log();
+  // Positive control: the loop turns (a 20 ms timer), the pings come.
+  const Pings healthy = collect(p, 1s);
+  EXPECT_GE(healthy.at.size(), 3u);
+  EXPECT_LE(healthy.max_interval_s(), 0.45);
+  // Wedge the loop thread. The main loop goes on (it says which loop stalled, in STATUS=), but
+  // sends no ping.
+  std::ofstream(wedge) << "wedge\n";
+  std::size_t wedged_pings = 0;
+  bool said_stalled = false;
+  const auto settle = Clock::now() + 500ms;  // loop_stall 0.25 s + a ping already on its way
+  for (auto end = settle + 1500ms; Clock::now() < end;) {
+    auto n = p.next_notification(100ms);
+    if (!n) continue;
+    if (n->find("STATUS=loop 'stall' stalled") != std::string::npos) said_stalled = true;
+    if (n->find("WATCHDOG=1") != std::string::npos && Clock::now() > settle) ++wedged_pings;
+  }
+  EXPECT_TRUE(said_stalled) << "the main loop must name the stalled loop (STATUS=)\n" << p.log();
+  EXPECT_EQ(wedged_pings, 0u) << "a wedged loop thread must not let the watchdog be pinged";
+  EXPECT_TRUE(p.running());
+  EXPECT_NE(p.log().find("loop 'stall' stalled"), std::string::npos) << p.log();
+  // Unwedged: the loop turns again and the pings resume.
+  std::filesystem::remove(wedge);
+  const Pings resumed = collect(p, 1s);
+  EXPECT_GE(resumed.at.size(), 2u) << "pings did not resume\n" << p.log();
+  std::printf(
+      "WATCHDOG wedged loop thread: pings every <= %.3f s healthy, %zu in 1.5 s wedged (main "
+      "loop running, STATUS= names the loop), %zu in 1 s after\n",
+      healthy.max_interval_s(), wedged_pings, resumed.at.size());
 }
 
 }  // namespace

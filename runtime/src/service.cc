@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <optional>
+#include <string>
 #include <string_view>
 
 #include "core/log.h"
@@ -30,7 +32,11 @@ void print_help(const ServiceDefinition& d) {
       "default)\n"
       "  dds_config: FILE       Cyclone DDS XML profile (default: $CYCLONEDDS_URI)\n"
       "  status_period: S       seconds between status samples, 0.1..60 (default 1)\n"
-      "  log: SPEC              log levels, e.g. info,%s=debug (default: $STUDIO_LOG or info)\n\n"
+      "  log: SPEC              log levels, e.g. info,%s=debug (default: $STUDIO_LOG or info)\n"
+      "  loop_stall: S          seconds one turn of the service loop may take before the\n"
+      "                         service counts as stalled: no more WATCHDOG=1 (systemd restarts\n"
+      "                         it), DEGRADED in its status, STATUS= names the loop; 0.05..600\n"
+      "                         (default: half of $WATCHDOG_USEC when set, else 10)\n\n"
       "%s keys:\n%s",
       d.name.c_str(), d.summary.c_str(), d.name.c_str(), d.name.c_str(), d.config_help.c_str());
 }
@@ -67,6 +73,8 @@ Expected<CommonOptions> read_common_options(yaml::MapReader& config) {
                   }),
       yaml::field("status_period", &CommonOptions::status_period_s,
                   yaml::number_in(0.1, 60, "seconds in 0.1..60")),
+      yaml::field("loop_stall", &CommonOptions::loop_stall_s,
+                  yaml::number_in(0.05, 600, "seconds in 0.05..600")),
       yaml::field("log", &CommonOptions::log_spec,
                   [](const yaml::Node& n) -> Expected<std::string> {
                     auto v = n.as_string();
@@ -127,8 +135,15 @@ int service_main(int argc, char** argv, const ServiceDefinition& definition) {
       common->dds_config);
   if (!participant) return fail(participant.error());
 
+  using namespace std::chrono;
+  const std::optional<microseconds> watchdog = watchdog_interval();
+  const auto stall_bound = duration_cast<SteadyClock::duration>(
+      common->loop_stall_s > 0 ? duration<double>(common->loop_stall_s)
+      : watchdog               ? duration<double>(*watchdog) / 2
+                               : duration<double>(10.0));
+  Liveness liveness(stall_bound);  // outlives the node, whose loops attach to it
   Metrics metrics;
-  NodeContext context{*participant, metrics, common->instance};
+  NodeContext context{*participant, metrics, common->instance, &liveness};
   auto node = definition.create(*reader, context);
   if (!node) return fail(node.error());
   if (auto done = reader->finish(); !done) return fail(done.error());
@@ -144,22 +159,38 @@ int service_main(int argc, char** argv, const ServiceDefinition& definition) {
   STUDIO_LOG(info, kCategory) << definition.name << " (" << common->instance << ") running, pid "
                               << ::getpid();
 
-  using namespace std::chrono;
   const auto status_period = duration_cast<milliseconds>(duration<double>(common->status_period_s));
   auto period = status_period;
-  const bool watchdog = watchdog_interval().has_value();
-  if (watchdog) period = std::min(period, duration_cast<milliseconds>(*watchdog_interval() / 2));
+  if (watchdog) period = std::min(period, duration_cast<milliseconds>(*watchdog / 2));
+  period =
+      std::max(milliseconds(1), std::min(period, duration_cast<milliseconds>(stall_bound / 2)));
   auto next_status = steady_clock::now();
+  bool was_stalled = false;
   int signo = 0;
   while (true) {
     const auto now = steady_clock::now();
+    // A loop stuck in one turn: no ping (systemd restarts the service), DEGRADED, say which.
+    const std::optional<Liveness::Stall> stall = liveness.stalled(now);
+    if (stall && !was_stalled) {
+      char what[160];
+      std::snprintf(what, sizeof what, "loop '%s' stalled: no turn for %.2f s (loop_stall %.2f s)",
+                    stall->name.c_str(), duration<double>(stall->silent).count(),
+                    duration<double>(stall_bound).count());
+      STUDIO_LOG(error, kCategory) << what << (watchdog ? "; watchdog pings stopped" : "");
+      notify(std::string("STATUS=") + what);
+    } else if (!stall && was_stalled) {
+      STUDIO_LOG(info, kCategory) << "service loops turning again";
+      notify("STATUS=running");
+    }
+    was_stalled = stall.has_value();
     if (now >= next_status) {
-      const NodeHealth health = (*node)->health();
+      NodeHealth health = (*node)->health();
+      health.degraded = health.degraded || stall.has_value();
       if (auto r = status->publish(state_of(health), health, metrics.snapshot()); !r)
         STUDIO_LOG(warn, kCategory) << "status: " << r.error().message;
       next_status = now + status_period;
     }
-    if (watchdog) notify("WATCHDOG=1");
+    if (watchdog && !stall) notify("WATCHDOG=1");
     const auto wait =
         std::min(period, duration_cast<milliseconds>(next_status - steady_clock::now()));
     if (auto s = signals.wait(std::max(wait, milliseconds(1)))) {

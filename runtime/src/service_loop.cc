@@ -122,6 +122,7 @@ Expected<void> ServiceLoop::start() {
   if (auto r = entities->waitset.attach(entities->stop, kStop); !r) return undo(r.error());
   if (auto r = entities->waitset.attach(entities->wake, kWake); !r) return undo(r.error());
   entities_ = std::move(entities);
+  if (context_.liveness) beat_ = context_.liveness->attach(log_);
   running_.store(true, std::memory_order_release);
   loop_thread_ = std::thread([this] { run(); });
   for (Thread& t : threads_) t.thread = std::thread(t.body);
@@ -136,6 +137,7 @@ void ServiceLoop::stop() {
   if (loop_thread_.joinable()) loop_thread_.join();
   for (Thread& t : threads_)
     if (t.thread.joinable()) t.thread.join();
+  if (beat_) context_.liveness->detach(std::exchange(beat_, nullptr));
   for (auto& hook : stop_hooks_) hook();
   for (auto& in : inputs_) in->release();
   for (auto& out : outputs_) out->release();
@@ -160,9 +162,14 @@ void ServiceLoop::fire_timers(SteadyClock::time_point now) {
 }
 
 void ServiceLoop::run() {
+  const auto heartbeat = beat_ ? context_.liveness->turn_period() : kMaxWait;
   while (running()) {
-    const auto woke = entities_->waitset.wait(wait_time());
+    const auto timers = wait_time();
+    const auto woke = entities_->waitset.wait(std::min<SteadyClock::duration>(timers, heartbeat));
+    if (beat_) beat_->turn(SteadyClock::now());
     if (std::find(woke.begin(), woke.end(), kStop) != woke.end() || !running()) break;
+    // Came round only to stamp the beat: nothing arrived and no timer is due yet.
+    if (woke.empty() && timers > heartbeat && wait_time() > SteadyClock::duration::zero()) continue;
     if (std::find(woke.begin(), woke.end(), kWake) != woke.end()) entities_->wake.take();
     for (auto& in : inputs_) {
       in->drain();

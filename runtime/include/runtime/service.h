@@ -14,6 +14,9 @@
 //   4. creates the DDS participant, the node (configure), starts it, sends READY=1 to
 //      $NOTIFY_SOCKET, then publishes studio/service/status every `status_period` and pings the
 //      systemd watchdog (WATCHDOG=1) from the main loop, so a wedged main loop is restarted;
+//      it pings only while every ServiceLoop of the node has come round within `loop_stall`
+//      (runtime/liveness.h), so a wedged loop thread stops the pings too (systemd restarts the
+//      service) and, meanwhile, the status says DEGRADED and STATUS= names the loop;
 //   5. on SIGINT/SIGTERM: STOPPING=1, node->stop(), a last status with state STOPPING, exit 0.
 //
 // Common config keys (all optional):
@@ -22,12 +25,16 @@
 //   dds_config: FILE        # Cyclone XML profile (default: $CYCLONEDDS_URI)
 //   status_period: 1.0      # seconds between ServiceStatus samples (0.1 .. 60)
 //   log: info               # log spec, e.g. "info,hull=debug" (default: $STUDIO_LOG or info)
+//   loop_stall: 5           # seconds a ServiceLoop may take for one turn before the service
+//                           # counts as stalled (0.05 .. 600; default: half of the watchdog
+//                           # interval, $WATCHDOG_USEC / 2, when systemd asks for pings, else 10)
 
 #include <functional>
 #include <memory>
 #include <string>
 
 #include "core/error.h"
+#include "runtime/liveness.h"
 #include "runtime/metrics.h"
 #include "wire/entity.h"
 #include "yaml_io/node.h"
@@ -58,6 +65,9 @@ struct NodeContext {
   const wire::Participant& participant;
   Metrics& metrics;  // counters and latency reported in ServiceStatus
   std::string instance;
+  // service_main's: every ServiceLoop of the node stamps it each turn, and a loop that stops
+  // turning stops the watchdog pings (runtime/liveness.h). nullptr: not monitored (tests).
+  Liveness* liveness = nullptr;
 };
 
 struct ServiceDefinition {
@@ -76,6 +86,7 @@ struct CommonOptions {
   std::string dds_config;
   double status_period_s = 1.0;
   std::string log_spec;
+  double loop_stall_s = 0;  // 0: the default (half the watchdog interval, else 10 s)
 };
 
 // Reads and consumes the common keys from `config`.

@@ -60,6 +60,10 @@
 // - Timers: every(period, fire) fires at most once per period; deadline(next, fire) asks next()
 //   after each wake and fires when the time it returns has come (nullopt: not armed). fire gets
 //   the current steady time. A timer cannot fire before the inputs of its wake were handled.
+// - Liveness (the systemd watchdog, runtime/liveness.h): when the context has a Liveness, the
+//   loop attaches a Beat (named after `log`) from start() to stop() and stamps it every turn;
+//   when idle it comes round at least every turn_period() to stamp it (such a heartbeat turn runs
+//   no hooks and no timer that is not due). A turn that never ends stops the watchdog pings.
 // - Threads: thread(name, body, interrupt) runs body() on its own thread from start() until it
 //   returns; body loops while running() is true. stop() calls interrupt() (e.g. stop a camera
 //   source, notify a condition variable) so a blocked body returns promptly.
@@ -84,14 +88,13 @@
 #include <vector>
 
 #include "core/error.h"
+#include "runtime/liveness.h"
 #include "runtime/metrics.h"
 #include "runtime/service.h"
 #include "wire/endpoint.h"
 #include "wire/pubsub.h"
 
 namespace studio::runtime {
-
-using SteadyClock = std::chrono::steady_clock;
 
 // Why a handler refused a sample: `reason` names the counter (short, snake_case: "to_core",
 // "size", "format"), `detail` is logged.
@@ -342,6 +345,7 @@ class ServiceLoop {
   std::deque<Thread> threads_;
   std::vector<Rate> rate_in_, rate_out_;
   std::unique_ptr<Entities> entities_;
+  std::shared_ptr<Liveness::Beat> beat_;  // attached to context_.liveness while running
   std::thread loop_thread_;
   std::atomic<bool> running_{false};
   std::atomic<uint64_t> frame_{0};
