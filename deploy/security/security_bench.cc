@@ -136,7 +136,7 @@ void BM_Mask4kPlainVsSecure(benchmark::State& state) {
                            "' --domains 0-230 --role 'bench:studio/bench/*:studio/bench/*' "
                            "--identity bench-ping --identity bench-echo >/dev/null 2>&1";
   if (std::system(make.c_str()) != 0) throw std::runtime_error("security_bench: make-pki failed");
-  const std::string secure_xml = "file://" + (src / "deploy/dds/secure.xml").string();
+  const std::string secure_xml = "file://" + (fs::path(STUDIO_BINARY_DIR) / "deploy/dds/secure.xml").string();
 
   const auto plain = testing::DdsDomain::unique();
   auto secure = testing::DdsDomain::unique();

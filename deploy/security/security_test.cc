@@ -118,7 +118,7 @@ class SecurityTest : public ::testing::Test {
   Env secure_env(const std::string& identity, const std::string& pki = "pki") const {
     Env env = dds_.env();
     for (auto& [k, v] : env)
-      if (k == "CYCLONEDDS_URI") v += ",file://" + source("deploy/dds/secure.xml").string();
+      if (k == "CYCLONEDDS_URI") v += ",file://" + (std::filesystem::path(STUDIO_BINARY_DIR) / "deploy/dds/secure.xml").string();
     env.emplace_back("STUDIO_SECURITY_DIR", (dir_ / pki).string());
     env.emplace_back("STUDIO_IDENTITY", identity);
     return env;
