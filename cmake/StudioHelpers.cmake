@@ -10,6 +10,9 @@ function(studio_test)
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 120)
   endif()
+  if(STUDIO_SANITIZE)
+    math(EXPR T_TIMEOUT "${T_TIMEOUT} * 3")  # ASan + UBSan at -O1 run the same work 2-4x slower
+  endif()
   add_executable(${T_NAME} ${T_SOURCES})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${T_NAME} PRIVATE
