@@ -2,7 +2,8 @@
 // the simulated studio, reconstructed unsharded and as 4 shards through the farm script's local
 // mode with one shard killed midway and restarted: exactly the same files, byte for byte (frames
 // and index); a rerun skips every verified frame and changes nothing; a damaged frame is
-// recomputed; Slurm (sbatch job array) when a single-node Slurm can start here.
+// recomputed; the same through Slurm (an sbatch job array on a single-node Slurm started for the
+// test).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -240,15 +241,22 @@ TEST_F(HullFarm, SlurmSubmission) {
   EXPECT_NE(r.out.find("SLURM_ARRAY_TASK_ID"), std::string::npos) << r.out;
 }
 
-// The same shards as a Slurm job array on the Slurm this machine reaches (sinfo answers): the
-// array and the index job write exactly the unsharded run's files. Skipped (allow-listed in
-// tests/skip-allowlist.txt) where Slurm is not installed or no controller answers: the local mode
-// above runs the same shard commands.
+// The same shards as a Slurm job array on a single-node Slurm started for the test
+// (cli/slurm-single-node.sh: munged, slurmctld and slurmd in a temporary folder, on ports of this
+// process's own): the array and the dependent index job write exactly the unsharded run's files.
+// Needs slurm-wlm and munge (deploy/debian-packages.txt) and root (slurmd starts the jobs).
 TEST_F(HullFarm, SlurmJobArray) {
-  if (std::system("command -v sbatch >/dev/null 2>&1 && sinfo -h >/dev/null 2>&1") != 0) {
-    GTEST_SKIP()
-        << "Slurm cannot start here (slurm-wlm not installed, no controller answers sinfo)";
-  }
+  const fs::path cluster = dir_ / "slurm_cluster";
+  const int port = 20000 + int(::getpid() % 20000) * 2;
+  auto started = run(std::string(STUDIO_SLURM_SINGLE_NODE) + " start " + cluster.string() + " " +
+                         std::to_string(port),
+                     dir_);
+  ASSERT_EQ(started.code, 0) << started.err;
+  struct Stop {
+    fs::path dir;
+    ~Stop() { (void)std::system((std::string(STUDIO_SLURM_SINGLE_NODE) + " stop " + dir.string()).c_str()); }
+  } stop{cluster};
+  ::setenv("SLURM_CONF", (cluster / "slurm.conf").c_str(), 1);
   const fs::path whole = dir_ / "slurm_whole", farm = dir_ / "slurm_farm";
   auto r = run(hull() + " offline " + args(whole) + " --threads 2", dir_);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -258,11 +266,28 @@ TEST_F(HullFarm, SlurmJobArray) {
           dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   const auto t0 = std::chrono::steady_clock::now();
-  while (!fs::exists(farm / "actor.gltf") &&
-         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(900)) {
+  // Until the array and the index job have left the queue.
+  while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(900)) {
+    const auto q = run("squeue -h -o '%i %r'", dir_);
+    if (q.code == 0 && q.out.empty()) break;
+    // A failed array task: the index job waits for ever.
+    ASSERT_EQ(q.out.find("DependencyNeverSatisfied"), std::string::npos)
+        << q.out << slurp(dir_ / "slurm_logs" / "task-1_0.err");
     std::this_thread::sleep_for(std::chrono::seconds(1));
   }
+  ASSERT_TRUE(fs::exists(farm / "actor.gltf"));
   EXPECT_EQ(files_of(farm), files_of(whole));
+  // Slurm ran the array: one log per task, each with its shard's JSON summary.
+  int task_logs = 0;
+  for (const auto& e : fs::directory_iterator(dir_ / "slurm_logs")) {
+    const std::string name = e.path().filename().string();
+    if (name.starts_with("task-") && name.ends_with(".json")) {
+      ++task_logs;
+      EXPECT_NE(slurp(e.path()).find("\"event\":\"summary\""), std::string::npos) << name;
+    }
+  }
+  EXPECT_EQ(task_logs, 4);
+  ::unsetenv("SLURM_CONF");
 }
 
 }  // namespace

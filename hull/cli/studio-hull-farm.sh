@@ -90,8 +90,8 @@ fi
 sb=(sbatch --parsable -c "$cpus" -J studio-hull-offline)
 [ -z "$partition" ] || sb+=(-p "$partition")
 [ -z "$time_limit" ] || sb+=(-t "$time_limit")
-# The array task picks its range by SLURM_ARRAY_TASK_ID.
-task_script="ranges=($(printf '%q ' "${range_list[@]}")); exec $quoted --frames \${ranges[\$SLURM_ARRAY_TASK_ID]} --json"
+# The array task picks its range by SLURM_ARRAY_TASK_ID (POSIX sh: sbatch --wrap runs /bin/sh).
+task_script="set -- ${range_list[*]}; shift \$SLURM_ARRAY_TASK_ID; exec $quoted --frames \$1 --json"
 array_cmd=("${sb[@]}" --array "0-$((${#range_list[@]} - 1))" -o "$log_dir/task-%A_%a.json" -e "$log_dir/task-%A_%a.err" --wrap "$task_script")
 if [ "$dry" -eq 1 ]; then printf '%q ' "${array_cmd[@]}"; echo; exit 0; fi
 command -v sbatch >/dev/null || { echo "studio-hull-farm: sbatch not found (install slurm-client, or use --local)" >&2; exit 2; }
