@@ -54,6 +54,17 @@ struct CarveOptions {
   double depth_tolerance = 1.5;  // cells: visibility slack of the depth buffers
   int max_depth_cells = 12;      // carving stops this many cells below the hull surface
   int max_iterations = 60;
+  // Shading structure (patches): a voxel is also carved when the zero-mean NCC of luminance
+  // patches on its tangent plane, averaged over the pairs of seeing cameras whose patches have
+  // structure (std >= patch_min_std), is below ncc_threshold while its colour spread exceeds
+  // ncc_min_spread. A phantom voxel in front of a uniformly coloured concavity sees different
+  // shading gradients in different cameras; on the true surface they agree. patch_half = 0: off.
+  int patch_half = 3;               // (2h+1)^2 samples
+  double patch_spacing_cells = 0.5; // sample spacing on the tangent plane
+  double patch_min_std = 2.0;       // grey levels
+  double ncc_threshold = 0.0;
+  double ncc_min_spread = 2.0;
+  double ncc_gain = 0.3;  // ... and a point 1..3 cells deeper matches better by this much
   int threads = 1;  // surface voxels are judged in parallel
   Expected<void> validate() const;
 };
