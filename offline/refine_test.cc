@@ -107,17 +107,17 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
           ++px[k];
         }
       const double total = se[0] + se[1] + se[2];
-      std::printf("  %s union: %zu px interior (%.0f %% of the squared error), %zu border (%.0f %%), "
-                  "%zu outside the true mask (%.0f %%)\n",
-                  m == &mesh ? "refined" : "hull", px[0], 100 * se[0] / total, px[1],
-                  100 * se[1] / total, px[2], 100 * se[2] / total);
+      std::printf(
+          "  %s union: %zu px interior (%.0f %% of the squared error), %zu border (%.0f %%), "
+          "%zu outside the true mask (%.0f %%)\n",
+          m == &mesh ? "refined" : "hull", px[0], 100 * se[0] / total, px[1], 100 * se[1] / total,
+          px[2], 100 * se[2] / total);
     }
   }
   std::printf("%s frame %lld, %d^2 columns: carved %zu of %zu voxels in %d iterations\n",
               sim::motion_name(motion), (long long)frame, kGrid, carved.carved, carved.voxels,
               carved.iterations);
-  const auto row = [](const char* what, const testing::SurfaceScore& s, double psnr,
-                       double full) {
+  const auto row = [](const char* what, const testing::SurfaceScore& s, double psnr, double full) {
     std::printf(
         "  %-8s surface distance mean / p95 (mm): both %.2f / %.2f, mesh->truth %.2f / %.2f, "
         "truth->mesh %.2f / %.2f; held-out PSNR %.2f dB (interior), %.2f dB (union)\n",
@@ -216,4 +216,3 @@ TEST(PhotoCarve, IndependentOfThreadsAndRefusesBadInput) {
 
 }  // namespace
 }  // namespace studio::offline
-

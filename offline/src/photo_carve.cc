@@ -219,7 +219,8 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         }
         if (options.patch_half == 0 || spread <= options.ncc_min_spread) continue;
         // Mean NCC over the seeing cameras' patch pairs at y (extra: depth slack, metres).
-        const auto patch_score = [&](const Eigen::Vector3d& y, double extra) -> std::optional<double> {
+        const auto patch_score = [&](const Eigen::Vector3d& y,
+                                     double extra) -> std::optional<double> {
           patches.clear();
           for (const std::size_t c : seen) {
             auto q = observe_patch(cams[c], buffers[c], y, normal, options.min_cos, tol + extra,

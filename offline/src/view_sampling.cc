@@ -153,8 +153,8 @@ std::optional<Observation> observe(const SampledView& v, const DepthBuffer& dept
 }
 
 std::vector<float> observe_patch(const SampledView& v, const DepthBuffer& depth,
-                                 const Eigen::Vector3d& x, const Eigen::Vector3d& n,
-                                 double min_cos, double tolerance, int h, double spacing) {
+                                 const Eigen::Vector3d& x, const Eigen::Vector3d& n, double min_cos,
+                                 double tolerance, int h, double spacing) {
   std::vector<float> out;
   if (!observe(v, depth, x, n, min_cos, tolerance)) return out;
   // Tangent basis: t1 horizontal where possible (stable between neighbouring voxels).

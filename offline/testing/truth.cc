@@ -130,11 +130,23 @@ int region_of(const sim::ActorBody& body, const Eigen::Vector3d& x) {
   }
   using P = sim::PartId;
   switch (P(best)) {
-    case P::pelvis: case P::torso: case P::shoulders: return 0;
-    case P::upper_arm_l: case P::lower_arm_l: case P::hand_l:
-    case P::upper_arm_r: case P::lower_arm_r: case P::hand_r: return 1;
-    case P::neck: case P::head: case P::hair: return 3;
-    default: return 2;
+    case P::pelvis:
+    case P::torso:
+    case P::shoulders:
+      return 0;
+    case P::upper_arm_l:
+    case P::lower_arm_l:
+    case P::hand_l:
+    case P::upper_arm_r:
+    case P::lower_arm_r:
+    case P::hand_r:
+      return 1;
+    case P::neck:
+    case P::head:
+    case P::hair:
+      return 3;
+    default:
+      return 2;
   }
 }
 
@@ -145,7 +157,10 @@ std::vector<ErrorBucket> error_breakdown(const hull::Mesh& mesh, const sim::Acto
   const std::vector<Eigen::Vector3d> on_truth = truth.surface_samples(samples, 3);
   const std::vector<Eigen::Vector3d> on_mesh = mesh_samples(mesh, samples);
   const PointIndex truth_index(on_truth, 0.01), mesh_index(on_mesh, 0.01);
-  struct S { double d; int region; };
+  struct S {
+    double d;
+    int region;
+  };
   std::vector<S> all;
   for (const auto& x : on_mesh) {
     // The region of the nearest body part (the sample itself may be off the body).

@@ -67,8 +67,8 @@ std::optional<Observation> observe(const SampledView& v, const DepthBuffer& dept
 // blue LED ring and the spill tint mostly blue). Empty when v does not see x (as observe()) or
 // any sample's footprint leaves the silhouette's interior.
 std::vector<float> observe_patch(const SampledView& v, const DepthBuffer& depth,
-                                 const Eigen::Vector3d& x, const Eigen::Vector3d& n,
-                                 double min_cos, double tolerance, int h, double spacing);
+                                 const Eigen::Vector3d& x, const Eigen::Vector3d& n, double min_cos,
+                                 double tolerance, int h, double spacing);
 
 // Zero-mean normalised cross-correlation of two patches of equal size; nullopt when either's
 // standard deviation is below min_std (no shading structure to compare: a uniform patch says
