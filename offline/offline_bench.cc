@@ -99,12 +99,14 @@ BENCHMARK(BM_Frame)
     ->UseRealTime()
     ->Iterations(2);
 
-// range(0): threshold (grey levels; 0 = the hull itself, the baseline).
+// range(0): threshold (grey levels; 0 = the hull itself, the baseline); range(1): patch_half
+// (0: the colour spread alone; 3: with the shading-patch NCC test).
 void BM_Quality(benchmark::State& state) {
   const Scene& s = Scene::get();
   const hull::SegmentSet set = hull::visual_hull(testing::studio_grid(256), s.cut_views).value();
   CarveOptions o;
   o.threshold = double(state.range(0));
+  o.patch_half = int(state.range(1));
   hull::Mesh mesh;
   for (auto _ : state) {
     if (state.range(0) == 0) {
@@ -121,11 +123,13 @@ void BM_Quality(benchmark::State& state) {
   state.counters["completeness_mean_mm"] = 1e3 * score.completeness.mean;
 }
 BENCHMARK(BM_Quality)
-    ->Arg(0)
-    ->Arg(4)
-    ->Arg(6)
-    ->Arg(9)
-    ->Arg(12)
+    ->Args({0, 0})
+    ->Args({4, 0})
+    ->Args({6, 0})
+    ->Args({6, 3})
+    ->Args({9, 3})
+    ->Args({12, 0})
+    ->ArgNames({"threshold", "patch"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);

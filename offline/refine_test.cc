@@ -6,8 +6,9 @@
 //   at the same resolution, pooled over both directions (mesh -> truth, truth -> mesh);
 // - no frame is worse than the hull by more than one cell (mean or 95th percentile);
 // - the textured refined mesh rendered from a held-out camera (between two ring cameras, lower)
-//   reaches the PSNR below over the actor (its true mask without the 2-pixel border, where the
-//   true image mixes the cloth in);
+//   reaches the PSNR below over the actor's interior (its true mask without the 2-pixel border)
+//   and, rendered anti-aliased over that camera's clean plate, over the union of the true and
+//   the rendered silhouettes (border and contour included: the measure);
 // - the result does not depend on the thread count; bad input is refused by reason.
 #include <gtest/gtest.h>
 
@@ -45,7 +46,8 @@ std::vector<Camera> rig() {
 
 struct Case {
   testing::SurfaceScore hull, refined;
-  double psnr_hull = 0, psnr_refined = 0;
+  double psnr_hull = 0, psnr_refined = 0;            // interior (2-px border excluded)
+  double psnr_full_hull = 0, psnr_full_refined = 0;  // union of the silhouettes
   std::size_t carved = 0;
 };
 
@@ -81,19 +83,59 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
     const auto colours = vertex_colours(*m, views, to).value();
     const Image<Rgb8> rendered = testing::render_coloured(*m, colours, f.cameras.back());
     (m == &mesh ? c.psnr_refined : c.psnr_hull) = testing::psnr(rendered, f.images.back(), actor);
+    Mask covered;
+    const Image<Rgb8> over = testing::render_over(
+        *m, colours, f.cameras.back(), studio.background(int(f.cameras.size()) - 1), 4, &covered);
+    Mask both = truth_mask;
+    for (int y = 0; y < both.height(); ++y)
+      for (int x = 0; x < both.width(); ++x)
+        both.view().row(y)[x] = std::max(both.view().row(y)[x], covered.view().row(y)[x]);
+    (m == &mesh ? c.psnr_full_refined : c.psnr_full_hull) =
+        testing::psnr(over, f.images.back(), both);
+    {
+      // Where the union's squared error is: the actor's interior (true mask without its 2-px
+      // border), the border band, and pixels the render covers but the truth does not.
+      double se[3] = {0, 0, 0};
+      std::size_t px[3] = {0, 0, 0};
+      for (int y = 0; y < both.height(); ++y)
+        for (int x = 0; x < both.width(); ++x) {
+          if (!both.view().row(y)[x]) continue;
+          const int k = actor.view().row(y)[x] ? 0 : truth_mask.view().row(y)[x] ? 1 : 2;
+          const Rgb8 a = over.view().row(y)[x], b = f.images.back().view().row(y)[x];
+          se[k] += double(a.r - b.r) * (a.r - b.r) + double(a.g - b.g) * (a.g - b.g) +
+                   double(a.b - b.b) * (a.b - b.b);
+          ++px[k];
+        }
+      const double total = se[0] + se[1] + se[2];
+      std::printf(
+          "  %s union: %zu px interior (%.0f %% of the squared error), %zu border (%.0f %%), "
+          "%zu outside the true mask (%.0f %%)\n",
+          m == &mesh ? "refined" : "hull", px[0], 100 * se[0] / total, px[1], 100 * se[1] / total,
+          px[2], 100 * se[2] / total);
+    }
   }
   std::printf("%s frame %lld, %d^2 columns: carved %zu of %zu voxels in %d iterations\n",
               sim::motion_name(motion), (long long)frame, kGrid, carved.carved, carved.voxels,
               carved.iterations);
-  const auto row = [](const char* what, const testing::SurfaceScore& s, double psnr) {
+  const auto row = [](const char* what, const testing::SurfaceScore& s, double psnr, double full) {
     std::printf(
         "  %-8s surface distance mean / p95 (mm): both %.2f / %.2f, mesh->truth %.2f / %.2f, "
-        "truth->mesh %.2f / %.2f; held-out PSNR %.2f dB\n",
+        "truth->mesh %.2f / %.2f; held-out PSNR %.2f dB (interior), %.2f dB (union)\n",
         what, 1e3 * s.both.mean, 1e3 * s.both.p95, 1e3 * s.accuracy.mean, 1e3 * s.accuracy.p95,
-        1e3 * s.completeness.mean, 1e3 * s.completeness.p95, psnr);
+        1e3 * s.completeness.mean, 1e3 * s.completeness.p95, psnr, full);
   };
-  row("hull", c.hull, c.psnr_hull);
-  row("refined", c.refined, c.psnr_refined);
+  row("hull", c.hull, c.psnr_hull, c.psnr_full_hull);
+  row("refined", c.refined, c.psnr_refined, c.psnr_full_refined);
+  // Where the error is: share of the pooled mean and of the samples beyond the p95, per body
+  // region, within one cell of the truth (placement) or beyond (excess or missed volume).
+  for (const auto& [what, m] : std::vector<std::pair<const char*, const hull::Mesh*>>{
+           {"hull", &hull_mesh}, {"refined", &mesh}}) {
+    std::printf("  %-8s error by region (share of mean / of p95 tail):", what);
+    for (const auto& b : testing::error_breakdown(*m, f.truth.body, 3.0 / kGrid))
+      std::printf(" %s%s %.0f/%.0f %%", b.region.c_str(), b.far ? ">cell" : "", 100 * b.share,
+                  100 * b.p95_share);
+    std::printf("\n");
+  }
   return cache[key] = c;
 }
 
@@ -121,9 +163,9 @@ TEST(PhotoCarve, RefinedSurfaceIsCloserToTheTruthThanTheHull) {
   const double mean_gain = 1 - mean / hull_mean, p95_gain = 1 - p95 / hull_p95;
   std::printf("over the poses: mean %.1f %% lower, p95 %.1f %% lower than the hull\n",
               100 * mean_gain, 100 * p95_gain);
-  // Measured 11 % / 17 % (docs/offline.md); the 30 % is not reached.
-  EXPECT_GE(mean_gain, 0.08);
-  EXPECT_GE(p95_gain, 0.10);
+  // Measured 12 % / 19 % (docs/offline.md); the 30 % is not reached.
+  EXPECT_GE(mean_gain, 0.10);
+  EXPECT_GE(p95_gain, 0.15);
 }
 
 TEST(Texture, HeldOutViewPsnr) {
@@ -131,6 +173,11 @@ TEST(Texture, HeldOutViewPsnr) {
     const Case& c = evaluate(motion, frame);
     EXPECT_GE(c.psnr_refined, 28.0) << sim::motion_name(motion);
     EXPECT_GE(c.psnr_refined, c.psnr_hull - 0.25) << sim::motion_name(motion);
+    // Over the union of the true and the rendered silhouettes (anti-aliased render over the
+    // held-out camera's clean plate): measured 24.2 (idle) and 22.9 dB (crouch); the issue's
+    // 28 dB is not reached there (docs/offline.md: the contour's position, not the colour).
+    EXPECT_GE(c.psnr_full_refined, 22.0) << sim::motion_name(motion);
+    EXPECT_GE(c.psnr_full_refined, c.psnr_full_hull - 0.25) << sim::motion_name(motion);
   }
 }
 

@@ -254,7 +254,9 @@ TEST_F(HullFarm, SlurmJobArray) {
   ASSERT_EQ(started.code, 0) << started.err;
   struct Stop {
     fs::path dir;
-    ~Stop() { (void)std::system((std::string(STUDIO_SLURM_SINGLE_NODE) + " stop " + dir.string()).c_str()); }
+    ~Stop() {
+      (void)std::system((std::string(STUDIO_SLURM_SINGLE_NODE) + " stop " + dir.string()).c_str());
+    }
   } stop{cluster};
   ::setenv("SLURM_CONF", (cluster / "slurm.conf").c_str(), 1);
   const fs::path whole = dir_ / "slurm_whole", farm = dir_ / "slurm_farm";

@@ -41,7 +41,7 @@ constexpr const char* kUsage =
                            --out DIR (--refine | --texture | --refine --texture)
                            [--frames A:B] [--name NAME] [--fps F] [--axis x|y|z]
                            [--keyer keyer.yaml | --key blue|green] [--min-views N|all]
-                           [--threshold T] [--max-depth CELLS] [--threads N]
+                           [--threshold T] [--ncc T|off] [--max-depth CELLS] [--threads N]
                            [--json | --progress | --quiet]
        studio-hull offline --take DIR [--rig rig.yaml] --plan SHARDS   (prints A:B per shard)
        studio-hull offline --take DIR [--rig rig.yaml] --out DIR --index-only [--name] [--fps]
@@ -58,6 +58,9 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
   --fps F           frame rate of the index's animation (default 25)
   --frames A:B      a shard: only frames A..B inclusive (the farm script gives each job one)
   --threshold T     photo-consistency threshold, RMS grey levels (default 6)
+  --ncc T|off       also carve where shading patches disagree: mean NCC over camera pairs below
+                    T (default 0) and a point 1-3 cells deeper matching clearly better; off:
+                    colours alone
   --max-depth C     carving stops C cells below the hull (default 12)
   --plan N          print the take's frames split into N contiguous shards, one A:B per line
   --index-only      (re)write the index from the frame files in DIR (every take frame needed)
@@ -85,7 +88,8 @@ struct Args {
   int threads = int(std::max(1u, std::thread::hardware_concurrency()));
   bool refine = false, texture = false, json = false, index_only = false;
   int plan = 0;
-  double fps = 25, threshold = 6;
+  double fps = 25, threshold = 6, ncc = 0;
+  bool patches = true;
   int max_depth = 12;
   std::optional<bool> progress;
 };
@@ -164,6 +168,14 @@ Expected<Args> parse(int argc, char** argv) {
       auto d = number(opt, v);
       if (!d || !(*d > 0)) return fail(opt + ": '" + v + "': expected a number > 0");
       (opt == "--fps" ? a.fps : a.threshold) = *d;
+    } else if (opt == "--ncc") {
+      if (v == "off") {
+        a.patches = false;
+      } else {
+        auto d = number(opt, v);
+        if (!d || !(*d >= -1 && *d <= 1)) return fail("--ncc: '" + v + "': expected -1..1 or off");
+        a.ncc = *d;
+      }
     } else if (opt == "--axis") {
       auto ax = parse_axis(v);
       if (!ax) return std::unexpected(ax.error());
@@ -341,6 +353,8 @@ int run_refined(int argc, char** argv) {
   offline::CarveOptions carve;
   carve.threshold = a.threshold;
   carve.max_depth_cells = a.max_depth;
+  carve.ncc_threshold = a.ncc;
+  if (!a.patches) carve.patch_half = 0;
   if (auto ok = carve.validate(); !ok) {
     std::cerr << "studio-hull: " << ok.error().message << "\n";
     return 2;
@@ -357,15 +371,15 @@ int run_refined(int argc, char** argv) {
   remove_stale_temporaries(a.out);
   // What makes a frame's bytes, besides its images: a frame file made with other settings or
   // cameras is recomputed, not skipped.
-  std::string settings = "studio-hull offline v1";
+  std::string settings = "studio-hull offline v2";
   {
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   " grid %d box %.9g %.9g %.9g %.9g %.9g %.9g axis %d min_views %d refine %d "
-                  "texture %d threshold %.9g max_depth %d key %d",
+                  "texture %d threshold %.9g ncc %.9g patch %d max_depth %d key %d",
                   a.grid, a.box_min.x(), a.box_min.y(), a.box_min.z(), a.box_max.x(), a.box_max.y(),
                   a.box_max.z(), int(a.axis), a.min_views, int(a.refine), int(a.texture),
-                  a.threshold, a.max_depth, int(key.mode));
+                  a.threshold, a.ncc, carve.patch_half, a.max_depth, int(key.mode));
     settings += buf;
     if (!a.keyer_file.empty()) {
       std::ifstream in(a.keyer_file, std::ios::binary);

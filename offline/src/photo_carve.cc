@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -57,6 +58,16 @@ Expected<void> CarveOptions::validate() const {
   if (max_iterations < 0 || max_iterations > 10000)
     return fail("carve: max_iterations must be 0..10000");
   if (threads < 1 || threads > 64) return fail("carve: threads must be 1..64");
+  if (patch_half < 0 || patch_half > 8) return fail("carve: patch_half must be 0..8");
+  if (!(patch_spacing_cells > 0 && patch_spacing_cells <= 4))
+    return fail("carve: patch_spacing_cells must be in (0, 4]");
+  if (!(patch_min_std > 0) || !std::isfinite(patch_min_std))
+    return fail("carve: patch_min_std must be > 0");
+  if (!(ncc_threshold >= -1 && ncc_threshold <= 1))
+    return fail("carve: ncc_threshold must be in [-1, 1]");
+  if (!(ncc_gain >= 0 && ncc_gain <= 2)) return fail("carve: ncc_gain must be in [0, 2]");
+  if (!(ncc_min_spread >= 0) || !std::isfinite(ncc_min_spread))
+    return fail("carve: ncc_min_spread must be >= 0");
   return {};
 }
 
@@ -170,6 +181,8 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
     carve_flag.assign(surface.size(), 0);
     parallel_for(surface.size(), options.threads, [&](std::size_t a, std::size_t b) {
       std::vector<Observation> obs;
+      std::vector<std::size_t> seen;
+      std::vector<std::vector<float>> patches;
       for (std::size_t n = a; n < b; ++n) {
         const Surface& s = surface[n];
         if (depth[s.x] > max_depth) continue;
@@ -190,14 +203,47 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         normal.normalize();
         const Eigen::Vector3d x = centre(s.ii, s.jj, s.k);
         obs.clear();
+        seen.clear();
         for (std::size_t c = 0; c < cams.size(); ++c) {
           if (auto o = observe(cams[c], buffers[c], x, normal, options.min_cos, tol,
                                options.sample_radius_px)) {
             obs.push_back(*o);
+            seen.push_back(c);
           }
         }
         if (int(obs.size()) < options.min_cameras) continue;
-        if (colour_spread(obs) > options.threshold) carve_flag[n] = 1;
+        const double spread = colour_spread(obs);
+        if (spread > options.threshold) {
+          carve_flag[n] = 1;
+          continue;
+        }
+        if (options.patch_half == 0 || spread <= options.ncc_min_spread) continue;
+        // Mean NCC over the seeing cameras' patch pairs at y (extra: depth slack, metres).
+        const auto patch_score = [&](const Eigen::Vector3d& y,
+                                     double extra) -> std::optional<double> {
+          patches.clear();
+          for (const std::size_t c : seen) {
+            auto q = observe_patch(cams[c], buffers[c], y, normal, options.min_cos, tol + extra,
+                                   options.patch_half, options.patch_spacing_cells * L.dt);
+            if (!q.empty()) patches.push_back(std::move(q));
+          }
+          double sum = 0;
+          int pairs = 0;
+          for (std::size_t p = 0; p < patches.size(); ++p)
+            for (std::size_t q = p + 1; q < patches.size(); ++q)
+              if (auto r = ncc(patches[p], patches[q], options.patch_min_std)) sum += *r, ++pairs;
+          if (pairs == 0) return std::nullopt;
+          return sum / pairs;
+        };
+        const auto here = patch_score(x, 0);
+        if (!here || *here >= options.ncc_threshold) continue;
+        // Carve only towards consistency: some point 1..3 cells deeper along the normal must
+        // match clearly better (a phantom voxel has the true surface behind it; a voxel on the
+        // true surface has the body's inside, which matches no better).
+        for (int k = 1; k <= 3 && !carve_flag[n]; ++k) {
+          const auto deeper = patch_score(x - k * L.dt * normal, k * L.dt);
+          if (deeper && *deeper > *here + options.ncc_gain) carve_flag[n] = 1;
+        }
       }
     });
     std::size_t carved = 0;

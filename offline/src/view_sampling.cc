@@ -152,6 +152,56 @@ std::optional<Observation> observe(const SampledView& v, const DepthBuffer& dept
   return Observation{c, float(cos * cos), float(cos)};
 }
 
+std::vector<float> observe_patch(const SampledView& v, const DepthBuffer& depth,
+                                 const Eigen::Vector3d& x, const Eigen::Vector3d& n, double min_cos,
+                                 double tolerance, int h, double spacing) {
+  std::vector<float> out;
+  if (!observe(v, depth, x, n, min_cos, tolerance)) return out;
+  // Tangent basis: t1 horizontal where possible (stable between neighbouring voxels).
+  Eigen::Vector3d t1 = n.cross(Eigen::Vector3d::UnitY());
+  if (t1.squaredNorm() < 1e-6) t1 = n.cross(Eigen::Vector3d::UnitX());
+  t1.normalize();
+  const Eigen::Vector3d t2 = n.cross(t1);
+  const int W = v.camera->width, H = v.camera->height;
+  out.reserve(std::size_t((2 * h + 1) * (2 * h + 1)));
+  for (int j = -h; j <= h; ++j) {
+    for (int i = -h; i <= h; ++i) {
+      Eigen::Vector2d p;
+      if (!v.camera->project(x + spacing * (i * t1 + j * t2), &p)) return {};
+      const int x0 = int(std::floor(p.x())), y0 = int(std::floor(p.y()));
+      if (x0 < 0 || y0 < 0 || x0 + 1 >= W || y0 + 1 >= H) return {};
+      if (!v.inside(x0, y0) || !v.inside(x0 + 1, y0) || !v.inside(x0, y0 + 1) ||
+          !v.inside(x0 + 1, y0 + 1)) {
+        return {};
+      }
+      const double fx = p.x() - x0, fy = p.y() - y0;
+      const auto lum = [&](int xx, int yy) {
+        const Rgb8 q = v.image.row(yy)[xx];
+        return 0.3 * q.r + 0.6 * q.g + 0.1 * q.b;
+      };
+      out.push_back(float((1 - fy) * ((1 - fx) * lum(x0, y0) + fx * lum(x0 + 1, y0)) +
+                          fy * ((1 - fx) * lum(x0, y0 + 1) + fx * lum(x0 + 1, y0 + 1))));
+    }
+  }
+  return out;
+}
+
+std::optional<double> ncc(std::span<const float> a, std::span<const float> b, double min_std) {
+  const std::size_t n = a.size();
+  if (n == 0 || b.size() != n) return std::nullopt;
+  double ma = 0, mb = 0;
+  for (std::size_t k = 0; k < n; ++k) ma += a[k], mb += b[k];
+  ma /= double(n), mb /= double(n);
+  double saa = 0, sbb = 0, sab = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double da = a[k] - ma, db = b[k] - mb;
+    saa += da * da, sbb += db * db, sab += da * db;
+  }
+  const double floor2 = min_std * min_std * double(n);
+  if (saa < floor2 || sbb < floor2) return std::nullopt;
+  return sab / std::sqrt(saa * sbb);
+}
+
 double colour_spread(std::span<const Observation> obs) {
   double sw = 0;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();

@@ -106,6 +106,98 @@ SurfaceScore surface_distance(const hull::Mesh& mesh, const sim::ActorBody& trut
   return s;
 }
 
+namespace {
+
+// Approximate distance of x to a part's surface (exact for capsules; ellipsoids: the radial
+// excess scaled by the smallest radius).
+double part_distance(const sim::Part& p, const Eigen::Vector3d& x) {
+  if (p.shape == sim::PartShape::capsule) {
+    const Eigen::Vector3d ab = p.b - p.a;
+    const double len2 = ab.squaredNorm();
+    const double h = len2 > 0 ? std::clamp((x - p.a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    return std::abs((x - p.a - h * ab).norm() - p.radius);
+  }
+  const Eigen::Vector3d u = (p.axes.transpose() * (x - p.centre)).cwiseQuotient(p.radii);
+  return std::abs(u.norm() - 1) * p.radii.minCoeff();
+}
+
+int region_of(const sim::ActorBody& body, const Eigen::Vector3d& x) {
+  int best = 0;
+  double best_d = std::numeric_limits<double>::max();
+  for (std::size_t k = 0; k < body.parts.size(); ++k) {
+    const double d = part_distance(body.parts[k], x);
+    if (d < best_d) best_d = d, best = int(k);
+  }
+  using P = sim::PartId;
+  switch (P(best)) {
+    case P::pelvis:
+    case P::torso:
+    case P::shoulders:
+      return 0;
+    case P::upper_arm_l:
+    case P::lower_arm_l:
+    case P::hand_l:
+    case P::upper_arm_r:
+    case P::lower_arm_r:
+    case P::hand_r:
+      return 1;
+    case P::neck:
+    case P::head:
+    case P::hair:
+      return 3;
+    default:
+      return 2;
+  }
+}
+
+}  // namespace
+
+std::vector<ErrorBucket> error_breakdown(const hull::Mesh& mesh, const sim::ActorBody& truth,
+                                         double cell, int samples) {
+  const std::vector<Eigen::Vector3d> on_truth = truth.surface_samples(samples, 3);
+  const std::vector<Eigen::Vector3d> on_mesh = mesh_samples(mesh, samples);
+  const PointIndex truth_index(on_truth, 0.01), mesh_index(on_mesh, 0.01);
+  struct S {
+    double d;
+    int region;
+  };
+  std::vector<S> all;
+  for (const auto& x : on_mesh) {
+    // The region of the nearest body part (the sample itself may be off the body).
+    all.push_back({truth_index.nearest(x), region_of(truth, x)});
+  }
+  for (const auto& x : on_truth) all.push_back({mesh_index.nearest(x), region_of(truth, x)});
+  std::vector<double> ds;
+  double total = 0;
+  for (const S& s : all) ds.push_back(s.d), total += s.d;
+  const std::size_t k = std::min(ds.size() - 1, std::size_t(0.95 * double(ds.size())));
+  std::nth_element(ds.begin(), ds.begin() + std::ptrdiff_t(k), ds.end());
+  const double p95 = ds[k];
+  static const char* kNames[4] = {"torso", "arms", "legs", "head"};
+  std::vector<ErrorBucket> out;
+  for (int far = 0; far < 2; ++far)
+    for (int r = 0; r < 4; ++r) out.push_back({kNames[r], far == 1});
+  double above = 0;
+  for (const S& s : all) {
+    ErrorBucket& b = out[std::size_t((s.d > cell ? 4 : 0) + s.region)];
+    b.samples += 1.0 / double(all.size());
+    b.share += s.d / total;
+    if (s.d > p95) b.p95_share += 1, above += 1;
+  }
+  for (ErrorBucket& b : out) b.p95_share = above > 0 ? b.p95_share / above : 0;
+  return out;
+}
+
+std::vector<double> distances_to_truth(const std::vector<Eigen::Vector3d>& points,
+                                       const sim::ActorBody& truth, int samples) {
+  const std::vector<Eigen::Vector3d> on_truth = truth.surface_samples(samples, 3);
+  const PointIndex index(on_truth, 0.01);
+  std::vector<double> out;
+  out.reserve(points.size());
+  for (const auto& x : points) out.push_back(index.nearest(x));
+  return out;
+}
+
 std::vector<Eigen::Vector3d> far_mesh_points(const hull::Mesh& mesh, const sim::ActorBody& truth,
                                              double distance, int samples) {
   const std::vector<Eigen::Vector3d> on_truth = truth.surface_samples(samples, 3);
@@ -135,10 +227,14 @@ Frame render_frame(const sim::SimulatedStudio& studio, int64_t frame) {
   return f;
 }
 
-Image<Rgb8> render_coloured(const hull::Mesh& mesh, const std::vector<Eigen::Vector3f>& colours,
-                            const Camera& camera, Rgb8 background) {
+namespace {
+
+// Z-buffered, perspective-correct raster of a vertex-coloured mesh; `covered` per pixel.
+Image<Rgb8> raster(const hull::Mesh& mesh, const std::vector<Eigen::Vector3f>& colours,
+                   const Camera& camera, Rgb8 background, std::vector<uint8_t>* covered) {
   const int W = camera.width, H = camera.height;
   Image<Rgb8> out(W, H);
+  covered->assign(std::size_t(W) * H, 0);
   std::vector<float> zbuf(std::size_t(W) * H, std::numeric_limits<float>::infinity());
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) out.view().row(y)[x] = background;
@@ -172,6 +268,7 @@ Image<Rgb8> render_coloured(const hull::Mesh& mesh, const std::vector<Eigen::Vec
         float& zb = zbuf[std::size_t(y) * W + x];
         if (depth >= zb) continue;
         zb = depth;
+        (*covered)[std::size_t(y) * W + x] = 1;
         const Eigen::Vector3f col =
             (float(w0) * colours[t[0]] + float(w1) * colours[t[1]] + float(w2) * colours[t[2]]) /
             float(ws);
@@ -179,6 +276,48 @@ Image<Rgb8> render_coloured(const hull::Mesh& mesh, const std::vector<Eigen::Vec
         out.view().row(y)[x] = Rgb8{q8(col.x()), q8(col.y()), q8(col.z())};
       }
   }
+  return out;
+}
+
+}  // namespace
+
+Image<Rgb8> render_coloured(const hull::Mesh& mesh, const std::vector<Eigen::Vector3f>& colours,
+                            const Camera& camera, Rgb8 background) {
+  std::vector<uint8_t> covered;
+  return raster(mesh, colours, camera, background, &covered);
+}
+
+Image<Rgb8> render_over(const hull::Mesh& mesh, const std::vector<Eigen::Vector3f>& colours,
+                        const Camera& camera, const Image<Rgb8>& plate, int ss, Mask* coverage) {
+  // The same camera with ss x ss sub-pixels per pixel (pixel centres at integer coordinates:
+  // sub-pixel (i, j) of pixel (x, y) is at x + (i + 0.5) / ss - 0.5).
+  Camera fine = camera;
+  fine.width = camera.width * ss, fine.height = camera.height * ss;
+  fine.intrinsics.fx *= ss, fine.intrinsics.fy *= ss, fine.intrinsics.skew *= ss;
+  fine.intrinsics.cx = (camera.intrinsics.cx + 0.5) * ss - 0.5;
+  fine.intrinsics.cy = (camera.intrinsics.cy + 0.5) * ss - 0.5;
+  std::vector<uint8_t> covered;
+  const Image<Rgb8> big = raster(mesh, colours, fine, {0, 0, 0}, &covered);
+  Image<Rgb8> out(camera.width, camera.height);
+  if (coverage) *coverage = Mask(camera.width, camera.height);
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const Rgb8 bg = plate.view().row(y)[x];
+      float sum[3] = {0, 0, 0};
+      int hits = 0;
+      for (int j = 0; j < ss; ++j)
+        for (int i = 0; i < ss; ++i) {
+          const int fx = x * ss + i, fy = y * ss + j;
+          const bool on = covered[std::size_t(fy) * fine.width + fx] != 0;
+          const Rgb8 c = on ? big.view().row(fy)[fx] : bg;
+          sum[0] += c.r, sum[1] += c.g, sum[2] += c.b;
+          hits += on;
+        }
+      const float n = float(ss * ss);
+      auto q8 = [](float v) { return uint8_t(std::clamp(v + 0.5f, 0.0f, 255.0f)); };
+      out.view().row(y)[x] = Rgb8{q8(sum[0] / n), q8(sum[1] / n), q8(sum[2] / n)};
+      if (coverage) coverage->view().row(y)[x] = hits ? 255 : 0;
+    }
   return out;
 }
 

@@ -18,6 +18,10 @@
 //      and with weights cos^2 (grazing views carry the most spill);
 //   3. a voxel whose weighted colour spread (RMS over cameras, blue channel half weight: the
 //      spill and the blue LED ring tint mostly blue) exceeds `threshold` is carved;
+//   4. a voxel the colours leave undecided is also carved when luminance patches on its tangent
+//      plane disagree between the seeing cameras (mean NCC < ncc_threshold) and a point 1..3
+//      cells deeper along the normal agrees clearly better (shading gradients: a phantom voxel
+//      in front of uniformly coloured cloth sees different surfaces in different cameras);
 // until nothing changes. Carving never goes deeper than `max_depth_cells` below the hull (a
 // bound on what a wrong colour can do) and never removes a voxel seen by fewer than
 // min_cameras cameras (no evidence: the hull stays).
@@ -54,7 +58,18 @@ struct CarveOptions {
   double depth_tolerance = 1.5;  // cells: visibility slack of the depth buffers
   int max_depth_cells = 12;      // carving stops this many cells below the hull surface
   int max_iterations = 60;
-  int threads = 1;  // surface voxels are judged in parallel
+  // Shading structure (patches): a voxel is also carved when the zero-mean NCC of luminance
+  // patches on its tangent plane, averaged over the pairs of seeing cameras whose patches have
+  // structure (std >= patch_min_std), is below ncc_threshold while its colour spread exceeds
+  // ncc_min_spread. A phantom voxel in front of a uniformly coloured concavity sees different
+  // shading gradients in different cameras; on the true surface they agree. patch_half = 0: off.
+  int patch_half = 3;                // (2h+1)^2 samples
+  double patch_spacing_cells = 0.5;  // sample spacing on the tangent plane
+  double patch_min_std = 2.0;        // grey levels
+  double ncc_threshold = 0.0;
+  double ncc_min_spread = 2.0;
+  double ncc_gain = 0.3;  // ... and a point 1..3 cells deeper matches better by this much
+  int threads = 1;        // surface voxels are judged in parallel
   Expected<void> validate() const;
 };
 

@@ -62,6 +62,19 @@ std::optional<Observation> observe(const SampledView& v, const DepthBuffer& dept
                                    const Eigen::Vector3d& x, const Eigen::Vector3d& n,
                                    double min_cos, double tolerance, int radius_px = 0);
 
+// A small square patch on the tangent plane of x (normal n): (2h+1)^2 points spaced `spacing`
+// metres, projected into camera v and sampled (bilinear, luminance 0.3 R + 0.6 G + 0.1 B: the
+// blue LED ring and the spill tint mostly blue). Empty when v does not see x (as observe()) or
+// any sample's footprint leaves the silhouette's interior.
+std::vector<float> observe_patch(const SampledView& v, const DepthBuffer& depth,
+                                 const Eigen::Vector3d& x, const Eigen::Vector3d& n, double min_cos,
+                                 double tolerance, int h, double spacing);
+
+// Zero-mean normalised cross-correlation of two patches of equal size; nullopt when either's
+// standard deviation is below min_std (no shading structure to compare: a uniform patch says
+// nothing).
+std::optional<double> ncc(std::span<const float> a, std::span<const float> b, double min_std);
+
 // Weighted RMS distance of the observations' colours from their weighted mean, blue channel at
 // half weight (grey levels).
 double colour_spread(std::span<const Observation> obs);
