@@ -1,6 +1,8 @@
 #include "scene_render/renderer.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
@@ -20,7 +22,49 @@ struct GpuMesh {
   GLuint vao = 0, vbo = 0, ebo = 0;
   GLsizei index_count = 0;
   int material = -1;
-  std::size_t vbo_bytes = 0, ebo_bytes = 0;  // capacity (actor meshes grow)
+  std::size_t vbo_bytes = 0, ebo_bytes = 0;          // capacity (actor meshes grow)
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, model frame
+  float radius = 0;
+};
+
+// A bounding sphere of the points (centre of their box, radius to the farthest point).
+void set_bounds(GpuMesh& mesh, const std::vector<Eigen::Vector3f>& points) {
+  Eigen::AlignedBox3f box;
+  for (const Eigen::Vector3f& p : points) box.extend(p);
+  mesh.centre =
+      box.isEmpty() ? Eigen::Vector3f(Eigen::Vector3f::Zero()) : Eigen::Vector3f(box.center());
+  float r2 = 0;
+  for (const Eigen::Vector3f& p : points) r2 = std::max(r2, (p - mesh.centre).squaredNorm());
+  mesh.radius = std::sqrt(r2);
+}
+
+// Half-spaces of a view (world planes a x + b y + c z + d >= 0, (a, b, c) unit): a sphere wholly
+// on the negative side of one of them draws nothing.
+class CullPlanes {
+ public:
+  // The clip volume of clip_from_world, -w <= x, y, z <= w (Gribb and Hartmann's extraction);
+  // sides_only: left, right, bottom, top.
+  void add_frustum(const Eigen::Matrix4d& clip_from_world, bool sides_only) {
+    const Eigen::RowVector4d w = clip_from_world.row(3);
+    for (int axis = 0; axis < (sides_only ? 2 : 3); ++axis) {
+      add((w + clip_from_world.row(axis)).transpose());
+      add((w - clip_from_world.row(axis)).transpose());
+    }
+  }
+  void add(const Eigen::Vector4d& plane) {
+    const double n = plane.head<3>().norm();
+    if (!(n > 1e-12) || count_ == static_cast<int>(planes_.size())) return;
+    planes_[static_cast<std::size_t>(count_++)] = plane / n;
+  }
+  bool outside(const Eigen::Vector3d& centre, double radius) const {
+    for (int i = 0; i < count_; ++i)
+      if (planes_[static_cast<std::size_t>(i)].dot(centre.homogeneous()) < -radius) return true;
+    return false;
+  }
+
+ private:
+  std::array<Eigen::Vector4d, 12> planes_;
+  int count_ = 0;
 };
 
 struct GpuAsset {
@@ -144,6 +188,13 @@ struct Renderer::Impl {
   std::vector<char> visible;
   std::vector<float> vertex_scratch;
   std::vector<std::uint32_t> index_scratch;
+  // One mesh to draw: node index in scene order, mesh index in its asset (-1: the actor's mesh).
+  struct Item {
+    double key;
+    std::uint32_t node;
+    std::int32_t mesh;
+  };
+  std::vector<Item> items;
   int draw_calls = 0;
   bool culling = false;
 
@@ -301,6 +352,7 @@ Expected<void> Renderer::upload(const scene_assets::Asset& asset) {
     }
     GpuMesh gm;
     fill(gm, v, m.indices);
+    set_bounds(gm, m.positions);
     gm.material = m.material;
     g.meshes.push_back(gm);
   }
@@ -330,7 +382,9 @@ Expected<void> Renderer::set_actor_mesh(const scene::ActorMesh& mesh) {
     v.insert(v.end(), {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), 0.0f, 0.0f, c.x(), c.y(), c.z()});
   }
   for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t[0], t[1], t[2]});
-  fill(impl_->actors[mesh.actor_id], v, idx);
+  GpuMesh& gm = impl_->actors[mesh.actor_id];
+  fill(gm, v, idx);
+  set_bounds(gm, mesh.vertices);
   return {};
 }
 
@@ -353,9 +407,11 @@ std::vector<AssetStatus> Renderer::check_assets(const scene::Scene& scene) const
 void Renderer::draw(const scene::Scene& scene, const View& view) {
   Impl& r = *impl_;
   r.draw_calls = 0;
-  const Eigen::Vector4f& cc = r.options.clear_colour;
-  glClearColor(cc[0], cc[1], cc[2], cc[3]);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (view.clear) {
+    const Eigen::Vector4f& cc = r.options.clear_colour;
+    glClearColor(cc[0], cc[1], cc[2], cc[3]);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  }
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
@@ -373,10 +429,12 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
     r.visible[i] =
         order[i]->visible && (parent[i] < 0 || r.visible[static_cast<std::size_t>(parent[i])]);
 
-  const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
-  const Eigen::Vector3f eye =
-      view.eye_in_world ? view.eye_in_world->cast<float>()
-                        : Eigen::Vector3f(view.cam_from_world.inverse().col(3).head<3>().cast<float>());
+  const Eigen::Matrix4d clip_from_world_d = view.clip_from_cam * view.cam_from_world;
+  const Eigen::Matrix4f clip_from_world = clip_from_world_d.cast<float>();
+  const Eigen::Vector3d eye_d =
+      view.eye_in_world ? *view.eye_in_world
+                        : Eigen::Vector3d(view.cam_from_world.inverse().col(3).head<3>());
+  const Eigen::Vector3f eye = eye_d.cast<float>();
   glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
   glEnable(GL_CLIP_DISTANCE0);
   set_clip_plane(r.u.clip_plane, view.clip_plane_world);
@@ -389,6 +447,29 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   glBindSampler(0, r.sampler);
   r.set_lights(scene);
 
+  // What to draw: every mesh of the visible model and actor nodes, culled and sorted nearest
+  // first (RendererOptions::cull_and_sort), else in scene order.
+  const bool cull_and_sort = r.options.cull_and_sort;
+  CullPlanes planes;
+  if (cull_and_sort) {
+    planes.add_frustum(clip_from_world_d, false);
+    if (view.clip_plane_world) planes.add(*view.clip_plane_world);
+    if (view.cull_clip_from_world) planes.add_frustum(*view.cull_clip_from_world, true);
+  }
+  r.items.clear();
+  auto consider = [&](std::size_t i, std::int32_t m, const GpuMesh& mesh) {
+    double key = 0;
+    if (cull_and_sort) {
+      const Eigen::Matrix4d& w = r.world[i];
+      const Eigen::Vector3d centre = (w * mesh.centre.cast<double>().homogeneous()).head<3>();
+      const double scale = std::max(
+          {w.col(0).head<3>().norm(), w.col(1).head<3>().norm(), w.col(2).head<3>().norm()});
+      const double radius = mesh.radius * scale * 1.0001 + 1e-6;
+      if (planes.outside(centre, radius)) return;
+      key = (centre - eye_d).norm() + radius;
+    }
+    r.items.push_back({key, static_cast<std::uint32_t>(i), m});
+  };
   for (std::size_t i = 0; i < order.size(); ++i) {
     const scene::Node& n = *order[i];
     if (!r.visible[i]) continue;
@@ -396,55 +477,66 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
       auto it = r.assets.find(n.asset.path);
       if (it == r.assets.end() || it->second.sha256 != n.asset.sha256) continue;  // check_assets()
       const GpuAsset& a = it->second;
-      r.set_matrices(r.world[i]);
-      const GLuint override_texture =
-          n.material.texture.empty() ? 0 : r.texture_for_path(n.material.texture);
-      auto draw_one = [&](std::size_t m) {
-        if (m >= a.meshes.size()) return;
-        const GpuMesh& mesh = a.meshes[m];
-        Eigen::Vector4f base = n.material.colour;
-        Eigen::Vector3f emissive = Eigen::Vector3f::Zero();
-        GLuint texture = override_texture;
-        if (mesh.material >= 0) {
-          const scene_assets::MaterialData& md =
-              a.materials[static_cast<std::size_t>(mesh.material)];
-          base = base.cwiseProduct(md.base_colour);
-          emissive = md.emissive;
-          if (!texture && md.texture >= 0)
-            texture = a.textures[static_cast<std::size_t>(md.texture)];
-        }
-        bool cull = false;
-        if (mesh.material >= 0)
-          cull = !a.materials[static_cast<std::size_t>(mesh.material)].double_sided;
-        if (cull != r.culling) {
-          cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
-          r.culling = cull;
-        }
-        glUniform4fv(r.u.base, 1, base.data());
-        if (n.material.high_contrast) emissive.setZero();  // unlit: base colour only
-        glUniform3fv(r.u.emissive, 1, emissive.data());
-        glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
-        glUniform1i(r.u.textured, texture ? 1 : 0);
-        if (texture) glBindTexture(GL_TEXTURE_2D, texture);
-        r.draw_mesh(mesh);
-      };
-      if (n.asset.meshes.empty())
-        for (std::size_t m = 0; m < a.meshes.size(); ++m) draw_one(m);
-      else
-        for (std::uint32_t m : n.asset.meshes) draw_one(m);
+      if (n.asset.meshes.empty()) {
+        for (std::size_t m = 0; m < a.meshes.size(); ++m)
+          consider(i, static_cast<std::int32_t>(m), a.meshes[m]);
+      } else {
+        for (std::uint32_t m : n.asset.meshes)
+          if (m < a.meshes.size()) consider(i, static_cast<std::int32_t>(m), a.meshes[m]);
+      }
     } else if (n.kind == scene::NodeKind::actor) {
       auto it = r.actors.find(n.actor_id);
       if (it == r.actors.end() || it->second.index_count == 0) continue;
+      consider(i, -1, it->second);
+    }
+  }
+  if (cull_and_sort)
+    std::stable_sort(r.items.begin(), r.items.end(),
+                     [](const Impl::Item& a, const Impl::Item& b) { return a.key < b.key; });
+
+  std::size_t matrices_of = order.size();  // node whose matrices are set
+  for (const Impl::Item& item : r.items) {
+    const std::size_t i = item.node;
+    const scene::Node& n = *order[i];
+    if (matrices_of != i) {
+      r.set_matrices(r.world[i]);
+      matrices_of = i;
+    }
+    if (item.mesh < 0) {                       // an actor's mesh
       if (r.culling) glDisable(GL_CULL_FACE);  // actor meshes are drawn two-sided
       r.culling = false;
-      r.set_matrices(r.world[i]);
       glUniform4fv(r.u.base, 1, n.material.colour.data());
       const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
       glUniform3fv(r.u.emissive, 1, zero.data());
       glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
       glUniform1i(r.u.textured, 0);
-      r.draw_mesh(it->second);
+      r.draw_mesh(r.actors.find(n.actor_id)->second);
+      continue;
     }
+    const GpuAsset& a = r.assets.find(n.asset.path)->second;
+    const GpuMesh& mesh = a.meshes[static_cast<std::size_t>(item.mesh)];
+    GLuint texture = n.material.texture.empty() ? 0 : r.texture_for_path(n.material.texture);
+    Eigen::Vector4f base = n.material.colour;
+    Eigen::Vector3f emissive = Eigen::Vector3f::Zero();
+    bool cull = false;
+    if (mesh.material >= 0) {
+      const scene_assets::MaterialData& md = a.materials[static_cast<std::size_t>(mesh.material)];
+      base = base.cwiseProduct(md.base_colour);
+      emissive = md.emissive;
+      if (!texture && md.texture >= 0) texture = a.textures[static_cast<std::size_t>(md.texture)];
+      cull = !md.double_sided;
+    }
+    if (cull != r.culling) {
+      cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+      r.culling = cull;
+    }
+    glUniform4fv(r.u.base, 1, base.data());
+    if (n.material.high_contrast) emissive.setZero();  // unlit: base colour only
+    glUniform3fv(r.u.emissive, 1, emissive.data());
+    glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
+    glUniform1i(r.u.textured, texture ? 1 : 0);
+    if (texture) glBindTexture(GL_TEXTURE_2D, texture);
+    r.draw_mesh(mesh);
   }
   glBindVertexArray(0);
   glDisable(GL_CULL_FACE);
@@ -475,6 +567,32 @@ void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, fl
   glUniform1f(r.u.inflate, 0.0f);
   glBindVertexArray(0);
   glEnable(GL_DEPTH_TEST);
+}
+
+void Renderer::draw_actor_occluder(const std::string& actor_id, const View& view,
+                                   const Eigen::Vector4f& colour) {
+  Impl& r = *impl_;
+  auto it = r.actors.find(actor_id);
+  if (it == r.actors.end() || it->second.index_count == 0) return;
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_ALWAYS);
+  glDepthRange(0.0, 0.0);  // every fragment at the near plane: nothing drawn later passes GL_LESS
+  glUseProgram(r.program);
+  const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
+  glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+  set_clip_plane(r.u.clip_plane, std::nullopt);
+  r.set_matrices(Eigen::Matrix4d::Identity());
+  glUniform1f(r.u.inflate, 0.0f);
+  glUniform4fv(r.u.base, 1, colour.data());
+  glUniform1f(r.u.alpha, colour[3]);
+  const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
+  glUniform3fv(r.u.emissive, 1, zero.data());
+  glUniform1i(r.u.unlit, 1);
+  glUniform1i(r.u.textured, 0);
+  r.draw_mesh(it->second);
+  glBindVertexArray(0);
+  glDepthRange(0.0, 1.0);
+  glDepthFunc(GL_LESS);
 }
 
 void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen) {
