@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -11,6 +12,7 @@
 
 #include "gl.h"
 #include "gl_program.h"
+#include "mesh_lod.h"
 #include "shaders.h"
 
 namespace studio::scene_render {
@@ -25,6 +27,7 @@ struct GpuMesh {
   std::size_t vbo_bytes = 0, ebo_bytes = 0;          // capacity (actor meshes grow)
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, model frame
   float radius = 0;
+  std::vector<LodLevel> lods;  // finest first (empty: index_count indices from 0)
 };
 
 // A bounding sphere of the points (centre of their box, radius to the farthest point).
@@ -171,6 +174,8 @@ void set_clip_plane(GLint location, const std::optional<Eigen::Vector4d>& plane)
 Expected<void> RendererOptions::validate() const {
   if (!clear_colour.allFinite() || !ambient.allFinite() || !std::isfinite(exposure) || exposure < 0)
     return fail("renderer options: colours and exposure must be finite, exposure >= 0");
+  if (!std::isfinite(lod_pixel_error) || lod_pixel_error < 0)
+    return fail("renderer options: lod_pixel_error must be finite and >= 0");
   return {};
 }
 
@@ -193,9 +198,11 @@ struct Renderer::Impl {
     double key;
     std::uint32_t node;
     std::int32_t mesh;
+    std::uint32_t first, count;  // index range (a level of detail)
   };
   std::vector<Item> items;
   int draw_calls = 0;
+  std::int64_t triangles = 0;
   bool culling = false;
 
   ~Impl() {
@@ -266,10 +273,13 @@ struct Renderer::Impl {
     glUniform1fv(u.light_range, count, range);
   }
 
-  void draw_mesh(const GpuMesh& m) {
+  void draw_mesh(const GpuMesh& m) { draw_range(m, 0, static_cast<std::uint32_t>(m.index_count)); }
+  void draw_range(const GpuMesh& m, std::uint32_t first, std::uint32_t count) {
     glBindVertexArray(m.vao);
-    glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(std::uintptr_t(first) * sizeof(std::uint32_t)));
     ++draw_calls;
+    triangles += count / 3;
   }
 };
 
@@ -351,7 +361,14 @@ Expected<void> Renderer::upload(const scene_assets::Asset& asset) {
                 m.normals[i].y(), m.normals[i].z(), uv.x(), uv.y(), c.x(), c.y(), c.z()});
     }
     GpuMesh gm;
-    fill(gm, v, m.indices);
+    if (impl_->options.lod_pixel_error > 0) {
+      MeshLods lods = build_lods(m.positions, m.indices);
+      fill(gm, v, lods.indices);
+      gm.index_count = static_cast<GLsizei>(lods.levels.front().count);
+      if (lods.levels.size() > 1) gm.lods = std::move(lods.levels);
+    } else {
+      fill(gm, v, m.indices);
+    }
     set_bounds(gm, m.positions);
     gm.material = m.material;
     g.meshes.push_back(gm);
@@ -407,6 +424,7 @@ std::vector<AssetStatus> Renderer::check_assets(const scene::Scene& scene) const
 void Renderer::draw(const scene::Scene& scene, const View& view) {
   Impl& r = *impl_;
   r.draw_calls = 0;
+  r.triangles = 0;
   if (view.clear) {
     const Eigen::Vector4f& cc = r.options.clear_colour;
     glClearColor(cc[0], cc[1], cc[2], cc[3]);
@@ -457,18 +475,49 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
     if (view.cull_clip_from_world) planes.add_frustum(*view.cull_clip_from_world, true);
   }
   r.items.clear();
+  GLint viewport[4] = {0, 0, 1, 1};
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  const double half_w = 0.5 * viewport[2], half_h = 0.5 * viewport[3];
+  // Pixels per world unit at world point c (an upper bound over directions: the Frobenius norm
+  // of the 2x3 Jacobian of the pixel position).
+  auto pixels_per_unit = [&](const Eigen::Vector3d& c) {
+    const Eigen::Vector4d p = clip_from_world_d * c.homogeneous();
+    if (!(p.w() > 1e-9)) return std::numeric_limits<double>::infinity();
+    double sum = 0;
+    for (int j = 0; j < 3; ++j) {
+      const double dx = (clip_from_world_d(0, j) * p.w() - p.x() * clip_from_world_d(3, j)) *
+                        half_w / (p.w() * p.w());
+      const double dy = (clip_from_world_d(1, j) * p.w() - p.y() * clip_from_world_d(3, j)) *
+                        half_h / (p.w() * p.w());
+      sum += dx * dx + dy * dy;
+    }
+    return std::sqrt(sum);
+  };
+  const double lod_pixels = r.options.lod_pixel_error;
   auto consider = [&](std::size_t i, std::int32_t m, const GpuMesh& mesh) {
     double key = 0;
-    if (cull_and_sort) {
+    std::uint32_t first = 0, count = static_cast<std::uint32_t>(mesh.index_count);
+    if (cull_and_sort || (lod_pixels > 0 && !mesh.lods.empty())) {
       const Eigen::Matrix4d& w = r.world[i];
       const Eigen::Vector3d centre = (w * mesh.centre.cast<double>().homogeneous()).head<3>();
       const double scale = std::max(
           {w.col(0).head<3>().norm(), w.col(1).head<3>().norm(), w.col(2).head<3>().norm()});
       const double radius = mesh.radius * scale * 1.0001 + 1e-6;
-      if (planes.outside(centre, radius)) return;
-      key = (centre - eye_d).norm() + radius;
+      if (cull_and_sort && planes.outside(centre, radius)) return;
+      const double distance = (centre - eye_d).norm();
+      key = distance + radius;
+      // Level of detail: the error measured at the nearest point of the bounding sphere
+      // (projected size grows as 1 / distance); inside the sphere, full detail.
+      if (lod_pixels > 0 && !mesh.lods.empty() && distance > 1.25 * radius) {
+        const double px = pixels_per_unit(centre) * distance / (distance - radius) * scale;
+        for (const LodLevel& level : mesh.lods)
+          if (level.error * px <= lod_pixels) {
+            first = level.first;
+            count = level.count;
+          }
+      }
     }
-    r.items.push_back({key, static_cast<std::uint32_t>(i), m});
+    r.items.push_back({key, static_cast<std::uint32_t>(i), m, first, count});
   };
   for (std::size_t i = 0; i < order.size(); ++i) {
     const scene::Node& n = *order[i];
@@ -536,7 +585,7 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
     glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
     glUniform1i(r.u.textured, texture ? 1 : 0);
     if (texture) glBindTexture(GL_TEXTURE_2D, texture);
-    r.draw_mesh(mesh);
+    r.draw_range(mesh, item.first, item.count);
   }
   glBindVertexArray(0);
   glDisable(GL_CULL_FACE);
@@ -610,5 +659,6 @@ void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_sc
 }
 
 int Renderer::draw_calls_last_frame() const { return impl_->draw_calls; }
+std::int64_t Renderer::triangles_last_frame() const { return impl_->triangles; }
 
 }  // namespace studio::scene_render

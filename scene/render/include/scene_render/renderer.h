@@ -18,6 +18,7 @@
 // by check_assets() (what a renderer reports in its status).
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,6 +46,10 @@ struct RendererOptions {
   // them. The same image as false (every mesh in scene order) up to ties in depth; false is the
   // baseline of the renderer bench and its tests.
   bool cull_and_sort = true;
+  // Levels of detail: asset meshes of >= 2048 triangles get coarser versions at upload
+  // (mesh_lod.h); draw() takes the coarsest whose geometric error, projected at the mesh's
+  // nearest point, stays within this many pixels. 0: always the full mesh (set before upload).
+  double lod_pixel_error = 0.5;
   Expected<void> validate() const;
 };
 
@@ -110,6 +115,8 @@ class Renderer {
                     const Eigen::Matrix3f& tex_from_screen = Eigen::Matrix3f::Identity());
 
   int draw_calls_last_frame() const;
+  // Triangles submitted since the last draw() began (its levels of detail, culling).
+  std::int64_t triangles_last_frame() const;
 
  private:
   struct Impl;
