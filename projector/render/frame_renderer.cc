@@ -3,6 +3,10 @@
 #include <GL/gl.h>
 #include <GL/glext.h>
 
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -51,6 +55,9 @@ struct FrameRenderer::Impl {
   scene_render::RenderTarget target;
   std::optional<scene_render::RenderTarget> eye_target;  // two pass
   scene_render::View mask_view;
+  // The screen rectangle's bounding box in the projector target (GL window coordinates: x, y
+  // from the bottom left, width, height); the single pass draws the scene only there.
+  std::array<int, 4> screen_box;
   std::vector<std::string> mask_ids;
   scene::ActorMesh scratch;
   std::vector<std::uint8_t> rgba;
@@ -105,12 +112,30 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
   }
   scene_render::View mask_view;
   mask_view.clip_from_cam = projector::clip_from_world(cam, 0.05, 100.0);
+  std::array<int, 4> box{0, 0, cam.width, cam.height};
+  {  // the corners' pixels, 2 px of slack around them (pixel centre conventions, rounding)
+    Eigen::AlignedBox2d b;
+    bool all = true;
+    for (const auto& c : view.screen().corners()) {
+      Eigen::Vector2d px;
+      all = all && cam.project(c, &px);
+      b.extend(px);
+    }
+    if (all) {
+      const int x0 = std::clamp(int(std::floor(b.min().x())) - 2, 0, cam.width);
+      const int x1 = std::clamp(int(std::ceil(b.max().x())) + 2, 0, cam.width);
+      const int y0 = std::clamp(int(std::floor(b.min().y())) - 2, 0, cam.height);
+      const int y1 = std::clamp(int(std::ceil(b.max().y())) + 2, 0, cam.height);
+      box = {x0, cam.height - y1, x1 - x0, y1 - y0};
+    }
+  }
   return FrameRenderer(std::unique_ptr<Impl>(new Impl{view,
                                                       options,
                                                       std::move(*renderer),
                                                       std::move(*target),
                                                       std::move(eye_target),
                                                       mask_view,
+                                                      box,
                                                       {},
                                                       {},
                                                       {}}));
@@ -133,9 +158,20 @@ Expected<int> FrameRenderer::render(const scene::Scene& scene, const Eigen::Vect
     v.clip_from_cam = pass->clip_from_world;
     v.eye_in_world = eye;
     v.clip_plane_world = pass->eye_clip_plane;
+    // Only what the eye sees through the screen rectangle reaches the frame.
+    v.cull_clip_from_world = pass->eye.clip_from_world;
+    v.clear = false;
     r.target.bind();
+    const Eigen::Vector4f& cc = r.options.renderer.clear_colour;
+    glClearColor(cc[0], cc[1], cc[2], cc[3]);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    // Black around the screen first, at depth 0: the scene is then shaded only on the screen
+    // (inside the rectangle's bounding box, and there where the depth test lets it through).
+    r.renderer.draw_actor_occluder(kFrameId, r.mask_view, Eigen::Vector4f(0, 0, 0, 1));
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(r.screen_box[0], r.screen_box[1], r.screen_box[2], r.screen_box[3]);
     r.renderer.draw(scene, v);
-    r.renderer.draw_actor_flat(kFrameId, r.mask_view, 0.0f, Eigen::Vector4f(0, 0, 0, 1));
+    glDisable(GL_SCISSOR_TEST);
   } else {
     auto pass = r.view.two_pass(eye, r.options.off_axis);
     if (!pass) return std::unexpected(pass.error());

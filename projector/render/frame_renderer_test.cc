@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "projector/camera_clip.h"
 #include "scene/view.h"
 #include "scene_assets/scene_description.h"
 #include "scene_config/scene_yaml.h"
@@ -236,3 +237,94 @@ TEST(FrameRenderer, TheActorSeesWhatAPlainPerspectiveRenderShows) {
 }
 
 }  // namespace
+
+// The single pass lays the black around the screen first (at depth 0) and draws the scene only
+// inside the screen's bounding box, culled to the eye's frustum through the screen: the same
+// frame as drawing the whole scene over the projector image and the black frame after it (the
+// straightforward order, here with a renderer that culls nothing), with the actor's mask.
+TEST(FrameRenderer, SinglePassShadingOnlyTheScreenKeepsTheFrame) {
+  (void)context();
+  const Projector p = projector::testing::studio_projectors()[0];
+  auto view = projector::ProjectorView::create(p).value();
+  auto d = scene_config::read_scene_file(std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml");
+  ASSERT_TRUE(d) << d.error().message;
+  scene_assets::AssetCache cache;
+  auto scene = scene_assets::build_scene(*d, cache, 0);
+  ASSERT_TRUE(scene) << scene.error().message;
+  FrameRendererOptions fo;
+  auto fr = FrameRenderer::create(view, fo);
+  ASSERT_TRUE(fr) << fr.error().message;
+  scene_render::RendererOptions plain_options = fo.renderer;
+  plain_options.cull_and_sort = false;
+  auto plain = scene_render::Renderer::create(plain_options);
+  ASSERT_TRUE(plain);
+  for (const auto& [path, a] : cache.all()) {
+    ASSERT_TRUE(fr->renderer().upload(*a));
+    ASSERT_TRUE(plain->upload(*a));
+  }
+  // The black frame: the screen's plane around the rectangle out to 50 m.
+  scene::ActorMesh frame;
+  frame.actor_id = "frame";
+  const auto c = view.screen().corners();
+  const Eigen::Vector3d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+  for (const auto& k : c) frame.vertices.push_back(k.cast<float>());
+  for (const auto& k : c)
+    frame.vertices.push_back((centre + (k - centre).normalized() * 50.0).cast<float>());
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    const std::uint32_t j = (i + 1) % 4;
+    frame.triangles.push_back({i, j, 4 + j});
+    frame.triangles.push_back({i, 4 + j, 4 + i});
+  }
+  ASSERT_TRUE(plain->set_actor_mesh(frame));
+  // A box-shaped actor mask between the eye and the screen.
+  projector::ActorMesh mask;
+  for (int k = 0; k < 8; ++k)
+    mask.vertices.push_back(
+        Eigen::Vector3f(k & 1 ? 0.3f : -0.3f, k & 2 ? 1.8f : 0.0f, k & 4 ? -0.4f : -0.8f));
+  const std::array<std::uint32_t, 3> tris[] = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5},
+                                               {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6},
+                                               {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
+  mask.triangles.assign(std::begin(tris), std::end(tris));
+  scene::ActorMesh mask_mesh;
+  mask_mesh.actor_id = "mask";
+  mask_mesh.vertices = mask.vertices;
+  mask_mesh.triangles = mask.triangles;
+  ASSERT_TRUE(plain->set_actor_mesh(mask_mesh));
+  scene_render::View mask_view;
+  mask_view.clip_from_cam = projector::clip_from_world(p.camera, 0.05, 100.0);
+  auto target = scene_render::RenderTarget::create(p.camera.width, p.camera.height);
+  ASSERT_TRUE(target);
+  for (const Eigen::Vector3d& eye :
+       {Eigen::Vector3d(0.1, 1.65, 1.2), Eigen::Vector3d(-0.9, 1.5, 0.4)}) {
+    const std::vector<projector::ActorMesh> masks{mask};
+    ASSERT_TRUE(fr->render(*scene, eye, masks));
+    fr->finish();
+    Readback rb;
+    fr->read(rb, true);
+    auto pass = view.single_pass(eye, fo.off_axis);
+    ASSERT_TRUE(pass);
+    scene_render::View v;
+    v.clip_from_cam = pass->clip_from_world;
+    v.eye_in_world = eye;
+    v.clip_plane_world = pass->eye_clip_plane;
+    target->bind();
+    plain->draw(*scene, v);
+    plain->draw_actor_flat("frame", mask_view, 0.0f, Eigen::Vector4f(0, 0, 0, 1));
+    plain->draw_actor_flat("mask", mask_view, 0.0f, Eigen::Vector4f::Zero());
+    std::vector<std::uint8_t> want;
+    target->read_rgba(want);
+    const cv::Mat a(fr->height(), fr->width(), CV_8UC4, rb.rgba.data()),
+        b(fr->height(), fr->width(), CV_8UC4, want.data());
+    cv::Mat diff;
+    cv::absdiff(a, b, diff);
+    diff = diff.reshape(1);
+    const int differ = cv::countNonZero(diff);
+    const double psnr = cv::PSNR(a, b);
+    std::printf("eye %s: %d of %d values differ, PSNR %.1f dB, blackout %lld px\n",
+                to_text(eye).c_str(), differ, int(diff.total()), psnr,
+                static_cast<long long>(rb.blackout.area()));
+    EXPECT_GE(psnr, 60.0);
+    EXPECT_GT(rb.blackout.area(), 1000);  // the mask is in the frame
+    EXPECT_EQ(rb.blackout, blackout_of(want, fr->width(), fr->height()));
+  }
+}

@@ -112,7 +112,7 @@ void BM_PlainScene(benchmark::State& s) { run(s, Work::plain); }
 void BM_SinglePass(benchmark::State& s) { run(s, Work::single_pass); }
 void BM_TwoPass(benchmark::State& s) { run(s, Work::two_pass); }
 void BM_SinglePassReadback(benchmark::State& s) { run(s, Work::single_pass_readback); }
-#define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0)
+#define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(2.0)
 BENCHMARK(BM_Clear) OPTS;
 BENCHMARK(BM_PlainScene) OPTS;
 BENCHMARK(BM_SinglePass) OPTS;

@@ -1,6 +1,8 @@
 // Renderer frame time on Mesa llvmpipe (EGL surfaceless) with the default demo scene at 1280x720
 // and 1920x1080, against baselines in the same run: clear only, clear + read-back, and the
-// reference shading (Blinn-Phong per fragment) beside the fast one (per vertex, the default).
+// reference shading (Blinn-Phong per fragment) beside the fast one (per vertex, the default), and
+// the fast one drawing every full mesh in scene order (cull_and_sort off, lod_pixel_error 0: the
+// renderer before those levers).
 #include <benchmark/benchmark.h>
 
 #include <numbers>
@@ -24,6 +26,7 @@ struct Fixture {
   scene::Scene scene;
   Renderer renderer;
   Renderer reference;
+  Renderer every;  // fast shading, full meshes, no culling, scene order (the renderer before)
   scene_assets::ViewSpec view;
 };
 
@@ -41,14 +44,20 @@ Fixture& fixture() {
     auto r = Renderer::create(ro);
     if (!r) throw std::runtime_error(r.error().message);
     ro.shading = RendererOptions::Shading::reference;
+    ro.lod_pixel_error = 0;  // the exact path: full meshes
     auto ref = Renderer::create(ro);
     if (!ref) throw std::runtime_error(ref.error().message);
+    ro.shading = RendererOptions::Shading::fast;
+    ro.cull_and_sort = false;
+    auto every = Renderer::create(ro);
+    if (!every) throw std::runtime_error(every.error().message);
     for (const auto& [p, a] : cache.all()) {
       (void)r->upload(*a);
       (void)ref->upload(*a);
+      (void)every->upload(*a);
     }
-    return new Fixture{std::move(*ctx), std::move(cache), std::move(*s), std::move(*r),
-                       std::move(*ref), *d->view};
+    return new Fixture{std::move(*ctx), std::move(cache),  std::move(*s), std::move(*r),
+                       std::move(*ref), std::move(*every), *d->view};
   }();
   return *f;
 }
@@ -61,7 +70,7 @@ View view_for(const scene_assets::ViewSpec& v, int w, int h) {
   return out;
 }
 
-enum class Work { clear, clear_readback, draw, draw_readback, draw_reference };
+enum class Work { clear, clear_readback, draw, draw_readback, draw_reference, draw_every };
 
 void run(benchmark::State& state, Work work) {
   Fixture& f = fixture();
@@ -76,9 +85,12 @@ void run(benchmark::State& state, Work work) {
   std::int64_t frame = 0;
   for (auto _ : state) {
     target->bind();
-    if (work == Work::draw || work == Work::draw_readback || work == Work::draw_reference) {
+    if (work != Work::clear && work != Work::clear_readback) {
       (void)f.scene.apply({frame++, scene::Tick{}});  // the flyer moves every frame
-      (work == Work::draw_reference ? f.reference : f.renderer).draw(f.scene, view);
+      (work == Work::draw_reference ? f.reference
+       : work == Work::draw_every   ? f.every
+                                    : f.renderer)
+          .draw(f.scene, view);
     } else {
       glClearColor(0, 0, 0, 1);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -98,13 +110,20 @@ void BM_ClearReadback(benchmark::State& s) { run(s, Work::clear_readback); }
 void BM_DrawScene(benchmark::State& s) { run(s, Work::draw); }
 void BM_DrawSceneReadback(benchmark::State& s) { run(s, Work::draw_readback); }
 void BM_DrawSceneReference(benchmark::State& s) { run(s, Work::draw_reference); }
+void BM_DrawSceneEvery(benchmark::State& s) { run(s, Work::draw_every); }
 
-#define SIZES ->Args({1280, 720})->Args({1920, 1080})->Unit(benchmark::kMillisecond)->UseRealTime()
+#define SIZES                         \
+  ->Args({1280, 720})                 \
+      ->Args({1920, 1080})            \
+      ->Unit(benchmark::kMillisecond) \
+      ->UseRealTime()                 \
+      ->MeasureProcessCPUTime()
 BENCHMARK(BM_Clear) SIZES;
 BENCHMARK(BM_ClearReadback) SIZES;
 BENCHMARK(BM_DrawScene) SIZES;
 BENCHMARK(BM_DrawSceneReadback) SIZES;
 BENCHMARK(BM_DrawSceneReference) SIZES;
+BENCHMARK(BM_DrawSceneEvery) SIZES;
 
 }  // namespace
 

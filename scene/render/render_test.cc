@@ -231,10 +231,10 @@ TEST_F(DefaultScene, RenderToTextureFeedsAnotherPass) {
 TEST_F(DefaultScene, FastShadingStaysCloseToTheReference) {
   RendererOptions ro;
   ro.shading = RendererOptions::Shading::reference;
+  ro.lod_pixel_error = 0;  // the exact path: full meshes
   auto reference = Renderer::create(ro);
   ASSERT_TRUE(reference) << reference.error().message;
-  ro.shading = RendererOptions::Shading::fast;
-  auto fast_renderer = Renderer::create(ro);
+  auto fast_renderer = Renderer::create();  // the default: fast shading, levels of detail
   ASSERT_TRUE(fast_renderer) << fast_renderer.error().message;
   for (const auto& [path, a] : cache_.all()) {
     ASSERT_TRUE(reference->upload(*a));
@@ -242,7 +242,8 @@ TEST_F(DefaultScene, FastShadingStaysCloseToTheReference) {
   }
   View actor_eye;
   actor_eye.cam_from_world = scene::look_at({0.3, 1.7, 0.5}, {-1, 1.4, -8});
-  actor_eye.clip_from_cam = scene::perspective(70 * std::numbers::pi / 180, double(kW) / kH, 0.05, 200);
+  actor_eye.clip_from_cam =
+      scene::perspective(70 * std::numbers::pi / 180, double(kW) / kH, 0.05, 200);
   for (const View& v : {view_, actor_eye}) {
     target_->bind();
     fast_renderer->draw(scene_, v);
@@ -257,6 +258,98 @@ TEST_F(DefaultScene, FastShadingStaysCloseToTheReference) {
     // reference twice).
     EXPECT_GT(cv::norm(fast, exact, cv::NORM_L1), 0.0);
   }
+}
+
+// Culling (bounding spheres outside the frustum, the clip plane, a caller's frustum) and the
+// nearest-first order change the work, not the picture: against the renderer drawing every mesh
+// in scene order, from the scene's view and from an actor's eye looking at two exhibits (most of
+// the hall behind the eye or outside the frustum: culling must drop meshes there).
+TEST_F(DefaultScene, CullingAndSortingKeepTheImage) {
+  RendererOptions ro;
+  ro.lod_pixel_error = 0;  // full meshes in both (levels of detail: the next test)
+  auto culled = Renderer::create(ro);
+  ASSERT_TRUE(culled) << culled.error().message;
+  ro.cull_and_sort = false;
+  auto every = Renderer::create(ro);
+  ASSERT_TRUE(every) << every.error().message;
+  for (const auto& [path, a] : cache_.all()) {
+    ASSERT_TRUE(every->upload(*a));
+    ASSERT_TRUE(culled->upload(*a));
+  }
+  View close_up;
+  close_up.cam_from_world = scene::look_at({-6, 1.7, -4.5}, {-6, 1.4, -8});
+  close_up.clip_from_cam =
+      scene::perspective(50 * std::numbers::pi / 180, double(kW) / kH, 0.05, 200);
+  View clipped = view_;  // a clip plane: x >= -2
+  clipped.clip_plane_world = Eigen::Vector4d(1, 0, 0, 2);
+  // The caller's frustum: the close-up's centre (30 of its 50 degrees); only the picture inside
+  // it counts.
+  View narrowed = close_up;
+  narrowed.cull_clip_from_world =
+      scene::perspective(30 * std::numbers::pi / 180, double(kW) / kH, 0.05, 200) *
+      close_up.cam_from_world;
+  const double f = std::tan(15 * std::numbers::pi / 180) / std::tan(25 * std::numbers::pi / 180);
+  const cv::Rect centre(int(kW * (1 - f) / 2) + 1, int(kH * (1 - f) / 2) + 1, int(kW * f) - 2,
+                        int(kH * f) - 2);
+  int fewer = 0;
+  for (const View* v : {&view_, &close_up, &clipped, &narrowed}) {
+    const cv::Rect region = v == &narrowed ? centre : cv::Rect(0, 0, kW, kH);
+    target_->bind();
+    every->draw(scene_, *v);
+    const int all_calls = every->draw_calls_last_frame();
+    const cv::Mat want = read(*target_)(region).clone();
+    target_->bind();
+    culled->draw(scene_, *v);
+    const int calls = culled->draw_calls_last_frame();
+    const cv::Mat got = read(*target_)(region).clone();
+    const double psnr = cv::PSNR(got, want);
+    cv::Mat diff;
+    cv::absdiff(got, want, diff);
+    cv::cvtColor(diff, diff, cv::COLOR_BGR2GRAY);
+    std::printf("culled and sorted: %d of %d draw calls, %d of %d pixels differ, PSNR %.1f dB\n",
+                calls, all_calls, cv::countNonZero(diff), region.area(), psnr);
+    EXPECT_GE(psnr, 60.0);
+    EXPECT_LE(calls, all_calls);
+    fewer += calls < all_calls;
+  }
+  EXPECT_GE(fewer, 3);  // the close-up, the clip plane and the caller's frustum leave meshes out
+}
+
+// Levels of detail (the default: error <= 0.5 px at the mesh's nearest point) against the full
+// meshes: the scene's view and an actor's eye (exhibits 8-10 m away: coarser levels), and a
+// close-up of two exhibits (finer ones). Close over every pixel, and really fewer triangles.
+TEST_F(DefaultScene, DetailLevelsStayCloseToTheFullMeshes) {
+  RendererOptions ro;
+  ro.lod_pixel_error = 0;
+  auto full = Renderer::create(ro);
+  ASSERT_TRUE(full) << full.error().message;
+  for (const auto& [path, a] : cache_.all()) ASSERT_TRUE(full->upload(*a));
+  View actor_eye;
+  actor_eye.cam_from_world = scene::look_at({0.3, 1.7, 0.5}, {-1, 1.4, -8});
+  actor_eye.clip_from_cam =
+      scene::perspective(70 * std::numbers::pi / 180, double(kW) / kH, 0.05, 200);
+  View close_up;
+  close_up.cam_from_world = scene::look_at({-6, 1.7, -5.5}, {-6, 1.4, -8});
+  close_up.clip_from_cam =
+      scene::perspective(50 * std::numbers::pi / 180, double(kW) / kH, 0.05, 200);
+  std::int64_t saved = 0;
+  for (const View* v : {&view_, &actor_eye, &close_up}) {
+    target_->bind();
+    full->draw(scene_, *v);
+    const std::int64_t all = full->triangles_last_frame();
+    const cv::Mat want = read(*target_);
+    target_->bind();
+    renderer_->draw(scene_, *v);
+    const std::int64_t drawn = renderer_->triangles_last_frame();
+    const cv::Mat got = read(*target_);
+    const double psnr = cv::PSNR(got, want);
+    std::printf("levels of detail: %lld of %lld triangles, PSNR %.1f dB\n",
+                static_cast<long long>(drawn), static_cast<long long>(all), psnr);
+    EXPECT_GE(psnr, 40.0);
+    EXPECT_LE(drawn, all);
+    saved += all - drawn;
+  }
+  EXPECT_GT(saved, 20000);  // the exhibits' levels are really used
 }
 
 TEST_F(DefaultScene, MissingOrDifferentAssetsAreReported) {

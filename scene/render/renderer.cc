@@ -1,7 +1,10 @@
 #include "scene_render/renderer.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -9,6 +12,7 @@
 
 #include "gl.h"
 #include "gl_program.h"
+#include "mesh_lod.h"
 #include "shaders.h"
 
 namespace studio::scene_render {
@@ -20,7 +24,50 @@ struct GpuMesh {
   GLuint vao = 0, vbo = 0, ebo = 0;
   GLsizei index_count = 0;
   int material = -1;
-  std::size_t vbo_bytes = 0, ebo_bytes = 0;  // capacity (actor meshes grow)
+  std::size_t vbo_bytes = 0, ebo_bytes = 0;          // capacity (actor meshes grow)
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, model frame
+  float radius = 0;
+  std::vector<LodLevel> lods;  // finest first (empty: index_count indices from 0)
+};
+
+// A bounding sphere of the points (centre of their box, radius to the farthest point).
+void set_bounds(GpuMesh& mesh, const std::vector<Eigen::Vector3f>& points) {
+  Eigen::AlignedBox3f box;
+  for (const Eigen::Vector3f& p : points) box.extend(p);
+  mesh.centre =
+      box.isEmpty() ? Eigen::Vector3f(Eigen::Vector3f::Zero()) : Eigen::Vector3f(box.center());
+  float r2 = 0;
+  for (const Eigen::Vector3f& p : points) r2 = std::max(r2, (p - mesh.centre).squaredNorm());
+  mesh.radius = std::sqrt(r2);
+}
+
+// Half-spaces of a view (world planes a x + b y + c z + d >= 0, (a, b, c) unit): a sphere wholly
+// on the negative side of one of them draws nothing.
+class CullPlanes {
+ public:
+  // The clip volume of clip_from_world, -w <= x, y, z <= w (Gribb and Hartmann's extraction);
+  // sides_only: left, right, bottom, top.
+  void add_frustum(const Eigen::Matrix4d& clip_from_world, bool sides_only) {
+    const Eigen::RowVector4d w = clip_from_world.row(3);
+    for (int axis = 0; axis < (sides_only ? 2 : 3); ++axis) {
+      add((w + clip_from_world.row(axis)).transpose());
+      add((w - clip_from_world.row(axis)).transpose());
+    }
+  }
+  void add(const Eigen::Vector4d& plane) {
+    const double n = plane.head<3>().norm();
+    if (!(n > 1e-12) || count_ == static_cast<int>(planes_.size())) return;
+    planes_[static_cast<std::size_t>(count_++)] = plane / n;
+  }
+  bool outside(const Eigen::Vector3d& centre, double radius) const {
+    for (int i = 0; i < count_; ++i)
+      if (planes_[static_cast<std::size_t>(i)].dot(centre.homogeneous()) < -radius) return true;
+    return false;
+  }
+
+ private:
+  std::array<Eigen::Vector4d, 12> planes_;
+  int count_ = 0;
 };
 
 struct GpuAsset {
@@ -127,6 +174,8 @@ void set_clip_plane(GLint location, const std::optional<Eigen::Vector4d>& plane)
 Expected<void> RendererOptions::validate() const {
   if (!clear_colour.allFinite() || !ambient.allFinite() || !std::isfinite(exposure) || exposure < 0)
     return fail("renderer options: colours and exposure must be finite, exposure >= 0");
+  if (!std::isfinite(lod_pixel_error) || lod_pixel_error < 0)
+    return fail("renderer options: lod_pixel_error must be finite and >= 0");
   return {};
 }
 
@@ -144,7 +193,16 @@ struct Renderer::Impl {
   std::vector<char> visible;
   std::vector<float> vertex_scratch;
   std::vector<std::uint32_t> index_scratch;
+  // One mesh to draw: node index in scene order, mesh index in its asset (-1: the actor's mesh).
+  struct Item {
+    double key;
+    std::uint32_t node;
+    std::int32_t mesh;
+    std::uint32_t first, count;  // index range (a level of detail)
+  };
+  std::vector<Item> items;
   int draw_calls = 0;
+  std::int64_t triangles = 0;
   bool culling = false;
 
   ~Impl() {
@@ -215,10 +273,13 @@ struct Renderer::Impl {
     glUniform1fv(u.light_range, count, range);
   }
 
-  void draw_mesh(const GpuMesh& m) {
+  void draw_mesh(const GpuMesh& m) { draw_range(m, 0, static_cast<std::uint32_t>(m.index_count)); }
+  void draw_range(const GpuMesh& m, std::uint32_t first, std::uint32_t count) {
     glBindVertexArray(m.vao);
-    glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(std::uintptr_t(first) * sizeof(std::uint32_t)));
     ++draw_calls;
+    triangles += count / 3;
   }
 };
 
@@ -300,7 +361,15 @@ Expected<void> Renderer::upload(const scene_assets::Asset& asset) {
                 m.normals[i].y(), m.normals[i].z(), uv.x(), uv.y(), c.x(), c.y(), c.z()});
     }
     GpuMesh gm;
-    fill(gm, v, m.indices);
+    if (impl_->options.lod_pixel_error > 0) {
+      MeshLods lods = build_lods(m.positions, m.indices);
+      fill(gm, v, lods.indices);
+      gm.index_count = static_cast<GLsizei>(lods.levels.front().count);
+      if (lods.levels.size() > 1) gm.lods = std::move(lods.levels);
+    } else {
+      fill(gm, v, m.indices);
+    }
+    set_bounds(gm, m.positions);
     gm.material = m.material;
     g.meshes.push_back(gm);
   }
@@ -330,7 +399,9 @@ Expected<void> Renderer::set_actor_mesh(const scene::ActorMesh& mesh) {
     v.insert(v.end(), {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), 0.0f, 0.0f, c.x(), c.y(), c.z()});
   }
   for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t[0], t[1], t[2]});
-  fill(impl_->actors[mesh.actor_id], v, idx);
+  GpuMesh& gm = impl_->actors[mesh.actor_id];
+  fill(gm, v, idx);
+  set_bounds(gm, mesh.vertices);
   return {};
 }
 
@@ -353,9 +424,12 @@ std::vector<AssetStatus> Renderer::check_assets(const scene::Scene& scene) const
 void Renderer::draw(const scene::Scene& scene, const View& view) {
   Impl& r = *impl_;
   r.draw_calls = 0;
-  const Eigen::Vector4f& cc = r.options.clear_colour;
-  glClearColor(cc[0], cc[1], cc[2], cc[3]);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  r.triangles = 0;
+  if (view.clear) {
+    const Eigen::Vector4f& cc = r.options.clear_colour;
+    glClearColor(cc[0], cc[1], cc[2], cc[3]);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  }
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
@@ -373,10 +447,12 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
     r.visible[i] =
         order[i]->visible && (parent[i] < 0 || r.visible[static_cast<std::size_t>(parent[i])]);
 
-  const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
-  const Eigen::Vector3f eye =
-      view.eye_in_world ? view.eye_in_world->cast<float>()
-                        : Eigen::Vector3f(view.cam_from_world.inverse().col(3).head<3>().cast<float>());
+  const Eigen::Matrix4d clip_from_world_d = view.clip_from_cam * view.cam_from_world;
+  const Eigen::Matrix4f clip_from_world = clip_from_world_d.cast<float>();
+  const Eigen::Vector3d eye_d =
+      view.eye_in_world ? *view.eye_in_world
+                        : Eigen::Vector3d(view.cam_from_world.inverse().col(3).head<3>());
+  const Eigen::Vector3f eye = eye_d.cast<float>();
   glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
   glEnable(GL_CLIP_DISTANCE0);
   set_clip_plane(r.u.clip_plane, view.clip_plane_world);
@@ -389,6 +465,60 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   glBindSampler(0, r.sampler);
   r.set_lights(scene);
 
+  // What to draw: every mesh of the visible model and actor nodes, culled and sorted nearest
+  // first (RendererOptions::cull_and_sort), else in scene order.
+  const bool cull_and_sort = r.options.cull_and_sort;
+  CullPlanes planes;
+  if (cull_and_sort) {
+    planes.add_frustum(clip_from_world_d, false);
+    if (view.clip_plane_world) planes.add(*view.clip_plane_world);
+    if (view.cull_clip_from_world) planes.add_frustum(*view.cull_clip_from_world, true);
+  }
+  r.items.clear();
+  GLint viewport[4] = {0, 0, 1, 1};
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  const double half_w = 0.5 * viewport[2], half_h = 0.5 * viewport[3];
+  // Pixels per world unit at world point c (an upper bound over directions: the Frobenius norm
+  // of the 2x3 Jacobian of the pixel position).
+  auto pixels_per_unit = [&](const Eigen::Vector3d& c) {
+    const Eigen::Vector4d p = clip_from_world_d * c.homogeneous();
+    if (!(p.w() > 1e-9)) return std::numeric_limits<double>::infinity();
+    double sum = 0;
+    for (int j = 0; j < 3; ++j) {
+      const double dx = (clip_from_world_d(0, j) * p.w() - p.x() * clip_from_world_d(3, j)) *
+                        half_w / (p.w() * p.w());
+      const double dy = (clip_from_world_d(1, j) * p.w() - p.y() * clip_from_world_d(3, j)) *
+                        half_h / (p.w() * p.w());
+      sum += dx * dx + dy * dy;
+    }
+    return std::sqrt(sum);
+  };
+  const double lod_pixels = r.options.lod_pixel_error;
+  auto consider = [&](std::size_t i, std::int32_t m, const GpuMesh& mesh) {
+    double key = 0;
+    std::uint32_t first = 0, count = static_cast<std::uint32_t>(mesh.index_count);
+    if (cull_and_sort || (lod_pixels > 0 && !mesh.lods.empty())) {
+      const Eigen::Matrix4d& w = r.world[i];
+      const Eigen::Vector3d centre = (w * mesh.centre.cast<double>().homogeneous()).head<3>();
+      const double scale = std::max(
+          {w.col(0).head<3>().norm(), w.col(1).head<3>().norm(), w.col(2).head<3>().norm()});
+      const double radius = mesh.radius * scale * 1.0001 + 1e-6;
+      if (cull_and_sort && planes.outside(centre, radius)) return;
+      const double distance = (centre - eye_d).norm();
+      key = distance + radius;
+      // Level of detail: the error measured at the nearest point of the bounding sphere
+      // (projected size grows as 1 / distance); inside the sphere, full detail.
+      if (lod_pixels > 0 && !mesh.lods.empty() && distance > 1.25 * radius) {
+        const double px = pixels_per_unit(centre) * distance / (distance - radius) * scale;
+        for (const LodLevel& level : mesh.lods)
+          if (level.error * px <= lod_pixels) {
+            first = level.first;
+            count = level.count;
+          }
+      }
+    }
+    r.items.push_back({key, static_cast<std::uint32_t>(i), m, first, count});
+  };
   for (std::size_t i = 0; i < order.size(); ++i) {
     const scene::Node& n = *order[i];
     if (!r.visible[i]) continue;
@@ -396,55 +526,66 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
       auto it = r.assets.find(n.asset.path);
       if (it == r.assets.end() || it->second.sha256 != n.asset.sha256) continue;  // check_assets()
       const GpuAsset& a = it->second;
-      r.set_matrices(r.world[i]);
-      const GLuint override_texture =
-          n.material.texture.empty() ? 0 : r.texture_for_path(n.material.texture);
-      auto draw_one = [&](std::size_t m) {
-        if (m >= a.meshes.size()) return;
-        const GpuMesh& mesh = a.meshes[m];
-        Eigen::Vector4f base = n.material.colour;
-        Eigen::Vector3f emissive = Eigen::Vector3f::Zero();
-        GLuint texture = override_texture;
-        if (mesh.material >= 0) {
-          const scene_assets::MaterialData& md =
-              a.materials[static_cast<std::size_t>(mesh.material)];
-          base = base.cwiseProduct(md.base_colour);
-          emissive = md.emissive;
-          if (!texture && md.texture >= 0)
-            texture = a.textures[static_cast<std::size_t>(md.texture)];
-        }
-        bool cull = false;
-        if (mesh.material >= 0)
-          cull = !a.materials[static_cast<std::size_t>(mesh.material)].double_sided;
-        if (cull != r.culling) {
-          cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
-          r.culling = cull;
-        }
-        glUniform4fv(r.u.base, 1, base.data());
-        if (n.material.high_contrast) emissive.setZero();  // unlit: base colour only
-        glUniform3fv(r.u.emissive, 1, emissive.data());
-        glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
-        glUniform1i(r.u.textured, texture ? 1 : 0);
-        if (texture) glBindTexture(GL_TEXTURE_2D, texture);
-        r.draw_mesh(mesh);
-      };
-      if (n.asset.meshes.empty())
-        for (std::size_t m = 0; m < a.meshes.size(); ++m) draw_one(m);
-      else
-        for (std::uint32_t m : n.asset.meshes) draw_one(m);
+      if (n.asset.meshes.empty()) {
+        for (std::size_t m = 0; m < a.meshes.size(); ++m)
+          consider(i, static_cast<std::int32_t>(m), a.meshes[m]);
+      } else {
+        for (std::uint32_t m : n.asset.meshes)
+          if (m < a.meshes.size()) consider(i, static_cast<std::int32_t>(m), a.meshes[m]);
+      }
     } else if (n.kind == scene::NodeKind::actor) {
       auto it = r.actors.find(n.actor_id);
       if (it == r.actors.end() || it->second.index_count == 0) continue;
+      consider(i, -1, it->second);
+    }
+  }
+  if (cull_and_sort)
+    std::stable_sort(r.items.begin(), r.items.end(),
+                     [](const Impl::Item& a, const Impl::Item& b) { return a.key < b.key; });
+
+  std::size_t matrices_of = order.size();  // node whose matrices are set
+  for (const Impl::Item& item : r.items) {
+    const std::size_t i = item.node;
+    const scene::Node& n = *order[i];
+    if (matrices_of != i) {
+      r.set_matrices(r.world[i]);
+      matrices_of = i;
+    }
+    if (item.mesh < 0) {                       // an actor's mesh
       if (r.culling) glDisable(GL_CULL_FACE);  // actor meshes are drawn two-sided
       r.culling = false;
-      r.set_matrices(r.world[i]);
       glUniform4fv(r.u.base, 1, n.material.colour.data());
       const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
       glUniform3fv(r.u.emissive, 1, zero.data());
       glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
       glUniform1i(r.u.textured, 0);
-      r.draw_mesh(it->second);
+      r.draw_mesh(r.actors.find(n.actor_id)->second);
+      continue;
     }
+    const GpuAsset& a = r.assets.find(n.asset.path)->second;
+    const GpuMesh& mesh = a.meshes[static_cast<std::size_t>(item.mesh)];
+    GLuint texture = n.material.texture.empty() ? 0 : r.texture_for_path(n.material.texture);
+    Eigen::Vector4f base = n.material.colour;
+    Eigen::Vector3f emissive = Eigen::Vector3f::Zero();
+    bool cull = false;
+    if (mesh.material >= 0) {
+      const scene_assets::MaterialData& md = a.materials[static_cast<std::size_t>(mesh.material)];
+      base = base.cwiseProduct(md.base_colour);
+      emissive = md.emissive;
+      if (!texture && md.texture >= 0) texture = a.textures[static_cast<std::size_t>(md.texture)];
+      cull = !md.double_sided;
+    }
+    if (cull != r.culling) {
+      cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+      r.culling = cull;
+    }
+    glUniform4fv(r.u.base, 1, base.data());
+    if (n.material.high_contrast) emissive.setZero();  // unlit: base colour only
+    glUniform3fv(r.u.emissive, 1, emissive.data());
+    glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
+    glUniform1i(r.u.textured, texture ? 1 : 0);
+    if (texture) glBindTexture(GL_TEXTURE_2D, texture);
+    r.draw_range(mesh, item.first, item.count);
   }
   glBindVertexArray(0);
   glDisable(GL_CULL_FACE);
@@ -477,6 +618,32 @@ void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, fl
   glEnable(GL_DEPTH_TEST);
 }
 
+void Renderer::draw_actor_occluder(const std::string& actor_id, const View& view,
+                                   const Eigen::Vector4f& colour) {
+  Impl& r = *impl_;
+  auto it = r.actors.find(actor_id);
+  if (it == r.actors.end() || it->second.index_count == 0) return;
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_ALWAYS);
+  glDepthRange(0.0, 0.0);  // every fragment at the near plane: nothing drawn later passes GL_LESS
+  glUseProgram(r.program);
+  const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
+  glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+  set_clip_plane(r.u.clip_plane, std::nullopt);
+  r.set_matrices(Eigen::Matrix4d::Identity());
+  glUniform1f(r.u.inflate, 0.0f);
+  glUniform4fv(r.u.base, 1, colour.data());
+  glUniform1f(r.u.alpha, colour[3]);
+  const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
+  glUniform3fv(r.u.emissive, 1, zero.data());
+  glUniform1i(r.u.unlit, 1);
+  glUniform1i(r.u.textured, 0);
+  r.draw_mesh(it->second);
+  glBindVertexArray(0);
+  glDepthRange(0.0, 1.0);
+  glDepthFunc(GL_LESS);
+}
+
 void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen) {
   Impl& r = *impl_;
   glDisable(GL_DEPTH_TEST);
@@ -492,5 +659,6 @@ void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_sc
 }
 
 int Renderer::draw_calls_last_frame() const { return impl_->draw_calls; }
+std::int64_t Renderer::triangles_last_frame() const { return impl_->triangles; }
 
 }  // namespace studio::scene_render

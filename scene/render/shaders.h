@@ -32,7 +32,6 @@ vec3 light_towards(int i, vec3 p, out float attenuation) {
 }
 )";
 
-
 // Lit pass: per-fragment Blinn-Phong over up to 8 lights, base colour x texture x vertex colour.
 inline constexpr const char* kSceneVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;

@@ -8,8 +8,10 @@
 // Forms (projector/projector_view.h):
 // - single pass: the scene drawn once with ProjectorView::single_pass's clip_from_world (the
 //   homography folded into the off-axis projection) and its eye clip plane; what lies outside
-//   the screen rectangle in the projector's image is then drawn black (no cloth there: the same
-//   frame as the two-pass warp's);
+//   the screen rectangle in the projector's image is black (no cloth there: the same frame as
+//   the two-pass warp's). That black is laid first, at depth 0, and the scene is drawn inside
+//   the rectangle's bounding box only, culled to the eye's frustum through the rectangle: no
+//   fragment outside the cloth is shaded;
 // - two pass: the eye's off-axis view rendered into a texture covering the screen rectangle
 //   (ProjectorView::suggested_texture_size, or the configured size), then warped onto the
 //   projector frame by one full-screen quad sampling it through the 3x3 texture_from_ndc.

@@ -18,6 +18,7 @@
 // by check_assets() (what a renderer reports in its status).
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,6 +40,16 @@ struct RendererOptions {
   Eigen::Vector3f ambient{0.22f, 0.22f, 0.24f};
   // Scale from light units (candela, lux) to the shader's unit radiance.
   float exposure = 0.3f;
+  // Skip meshes whose bounding sphere lies outside the view (its frustum, the clip plane and
+  // View::cull_clip_from_world) and draw the rest nearest first (by the far side of their
+  // bounding sphere), so llvmpipe's early depth test rejects hidden fragments before shading
+  // them. The same image as false (every mesh in scene order) up to ties in depth; false is the
+  // baseline of the renderer bench and its tests.
+  bool cull_and_sort = true;
+  // Levels of detail: asset meshes of >= 2048 triangles get coarser versions at upload
+  // (mesh_lod.h); draw() takes the coarsest whose geometric error, projected at the mesh's
+  // nearest point, stays within this many pixels. 0: always the full mesh (set before upload).
+  double lod_pixel_error = 0.5;
   Expected<void> validate() const;
 };
 
@@ -51,6 +62,13 @@ struct View {
   // World plane (a, b, c, d): only points with a x + b y + c z + d >= 0 are drawn
   // (gl_ClipDistance[0]); the projector's single-pass form clips behind the eye with it.
   std::optional<Eigen::Vector4d> clip_plane_world;
+  // A frustum the caller cares about (only its side planes: left, right, bottom, top): what is
+  // drawn outside it will be overwritten, so meshes entirely outside it may be skipped. The
+  // projector's single pass passes the eye's frustum through the screen rectangle.
+  std::optional<Eigen::Matrix4d> cull_clip_from_world;
+  // false: draw() keeps the bound framebuffer's colour and depth (the caller cleared it, e.g. to
+  // lay an occluder at depth 0 first).
+  bool clear = true;
 };
 
 struct AssetStatus {
@@ -85,6 +103,10 @@ class Renderer {
   // from black scene pixels in the read-back.
   void draw_actor_flat(const std::string& actor_id, const View& view, float inflate_m = 0.0f,
                        const Eigen::Vector4f& colour = Eigen::Vector4f(0, 0, 0, 1));
+  // The same mesh as an occluder: flat `colour`, written at depth 0 (the near plane) whatever
+  // its distance, so a later draw(view with clear = false) shades nothing behind it.
+  void draw_actor_occluder(const std::string& actor_id, const View& view,
+                           const Eigen::Vector4f& colour = Eigen::Vector4f(0, 0, 0, 1));
   // Draws a texture (e.g. a RenderTarget's colour texture) over the whole bound framebuffer;
   // the output pixel at normalised coordinates p in [0,1]^2 samples the texture at
   // dehomogenised tex_from_screen * (p, 1) (identity: a plain copy; the projector passes its
@@ -93,6 +115,8 @@ class Renderer {
                     const Eigen::Matrix3f& tex_from_screen = Eigen::Matrix3f::Identity());
 
   int draw_calls_last_frame() const;
+  // Triangles submitted since the last draw() began (its levels of detail, culling).
+  std::int64_t triangles_last_frame() const;
 
  private:
   struct Impl;
