@@ -5,7 +5,8 @@
 # measures it live with studio-demo-probe (one line per second); records a take and reconstructs
 # it offline at high resolution; stops everything (SIGTERM, exit codes checked); and writes
 # OUT/report.json, report.md, latency.png, projector.png (a scored projector frame: its thumbnail,
-# blackout mask and the true actor), preview.png (the headless preview's picture) and the offline
+# blackout mask and the true actor), actor_view.png (that frame on the cloth seen from the true
+# eye: what the actor sees), preview.png (the headless preview's picture) and the offline
 # meshes. Builds nothing itself.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -14,7 +15,8 @@ usage() {
   cat <<'TXT'
 usage: deploy/demo.sh [--seconds S] [--cameras N] [--projectors N] [--gui] [--out DIR]
                       [--keyer inprocess|separate] [--offline-grid N] [--take-frames N]
-                      [--keep-take] [--scheduling realtime|normal] [--build DIR]
+                      [--keep-take] [--scheduling realtime|normal] [--sweep-frames N]
+                      [--build DIR]
 
 Runs the studio end to end from deploy/examples/studio/ (usually through ./studio demo).
   --seconds S        measurement window (default 20), after the pipeline is up and 3 s warm-up
@@ -36,6 +38,10 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
                      installed; the projector (nice 5) and the preview time-sharing, as their
                      units run them;
                      normal: time-sharing
+  --sweep-frames N   frames of the projector mask's margin sweep (default 100; 0: none), run
+                     after the services stopped, offline (studio-demo-probe sweep: the fast
+                     arm swing through the hull library and the projector's MaskPlanner, at
+                     the live motion-to-photon p99): OUT/sweep.json, OUT/sweep.png
   --build DIR        build tree with the binaries (default build/release)
 Environment: STUDIO_DDS_DOMAIN / STUDIO_DDS_TAG choose the DDS domain (default: a random private
 domain 1..230 and a unique discovery tag, so the demo never meets another studio on this host).
@@ -45,7 +51,7 @@ TXT
 }
 
 seconds=20 cameras=6 projectors=1 gui=0 out=out/demo keyer=inprocess offline_grid=256
-take_frames=50 keep_take=0 build=build/release scheduling=auto
+take_frames=50 keep_take=0 build=build/release scheduling=auto sweep_frames=100
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds=${2:?}; shift 2 ;;
@@ -58,6 +64,7 @@ while [ $# -gt 0 ]; do
     --take-frames) take_frames=${2:?}; shift 2 ;;
     --keep-take) keep_take=1; shift ;;
     --scheduling) scheduling=${2:?}; shift 2 ;;
+    --sweep-frames) sweep_frames=${2:?}; shift 2 ;;
     --build) build=${2:?}; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "demo: unknown option '$1' (see --help)" >&2; exit 2 ;;
@@ -69,6 +76,7 @@ is_int "$projectors" || { echo "demo: --projectors: expected a number" >&2; exit
 [[ "$seconds" =~ ^[0-9]+(\.[0-9]+)?$ ]] && [ "${seconds%.*}" -ge 1 ] || { echo "demo: --seconds: expected >= 1" >&2; exit 2; }
 is_int "$offline_grid" && [ "$offline_grid" -ge 8 ] || { echo "demo: --offline-grid: expected >= 8" >&2; exit 2; }
 is_int "$take_frames" && [ "$take_frames" -ge 1 ] || { echo "demo: --take-frames: expected >= 1" >&2; exit 2; }
+is_int "$sweep_frames" && { [ "$sweep_frames" -eq 0 ] || [ "$sweep_frames" -ge 3 ]; } || { echo "demo: --sweep-frames: expected 0 or >= 3" >&2; exit 2; }
 case "$keyer" in inprocess|separate) ;; *) echo "demo: --keyer: expected inprocess or separate" >&2; exit 2 ;; esac
 case "$scheduling" in
   auto) if chrt -f 1 true 2>/dev/null; then scheduling=realtime; else scheduling=normal; fi ;;
@@ -121,7 +129,7 @@ fi
 if [ -f "$cfg/preview.yaml" ]; then
   sed -i "s|^asset_root: .*|asset_root: $build/scene/default|" "$cfg/preview.yaml"
 fi
-rm -f "$out/preview.png" "$out/projector.png"
+rm -f "$out/preview.png" "$out/projector.png" "$out/actor_view.png" "$out/sweep.json" "$out/sweep.png"
 cam_ids=() capture_cfgs=()
 for ((i = 0; i < cameras; i++)); do cam_ids+=("cam$i"); capture_cfgs+=("$cfg/capture-cam$i.yaml"); done
 if [ "$cameras" -lt 6 ]; then
@@ -222,7 +230,8 @@ say "measuring: ${seconds} s after the pipeline is up (3 s warm-up); one line pe
 probe_rc=0
 $(rt 45) "$build/$probe_bin" watch --capture "${capture_cfgs[@]}" --rig "$cfg/rig.yaml" \
   --seconds "$seconds" --warmup 3 --histogram "$out/latency.png" \
-  --projector-png "$out/projector.png" --out "$out/live.json" || probe_rc=$?
+  --projector-png "$out/projector.png" --actor-view "$out/actor_view.png" \
+  --out "$out/live.json" || probe_rc=$?
 
 # ---- a take, recorded frame-accurately on every camera ------------------------------------------
 say "recording a take of $take_frames frames on every camera"
@@ -272,6 +281,19 @@ if [ -d "$out/takes/demo" ]; then
   if [ "$keep_take" = 0 ]; then find "$out/takes" -name frames.raw -delete; fi
 else
   say "no take was recorded"; offline_rc=1
+fi
+
+# ---- the projector mask's margin sweep, offline, at the live motion-to-photon p99 ------------------
+sweep_rc=0
+if [ "$sweep_frames" -gt 0 ] && [ -f "$out/live.json" ]; then
+  m2p=$(python3 -c 'import json,sys; p=(json.load(open(sys.argv[1])).get("projector") or {}); v=(p.get("motion_to_photon_ms") or {}).get("p99"); print("" if v is None or v != v else v)' "$out/live.json" 2>/dev/null || true)
+  if [ -n "$m2p" ]; then
+    say "margin sweep of the projector mask: $sweep_frames frames of the fast arm swing at the live motion-to-photon p99 ($m2p ms)"
+    # The sweep's default projector (the simulated studio's, on the side wall): the example
+    # proj1's beam does not reach the spot where the arm swing stands.
+    "$build/$probe_bin" sweep --rig "$cfg/rig.yaml" --latency-ms "$m2p" --frames "$sweep_frames" --out "$out/sweep.json" --png "$out/sweep.png" \
+      2>>"$out/logs/sweep.log" || sweep_rc=$?
+  fi
 fi
 
 # ---- the report ----------------------------------------------------------------------------------

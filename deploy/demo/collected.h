@@ -49,6 +49,7 @@ struct ProjectorSample {
 struct ProjectorPicture {
   std::string projector_id;
   uint64_t render_frame = 0, lit_actor_px = 0, actor_px = 0;
+  double studio_frame = 0;  // its render time on the simulator's clock (fractional frame)
   int thumb_width = 0, thumb_height = 0;
   std::vector<uint8_t> thumbnail;  // RGB8
   Mask actor;

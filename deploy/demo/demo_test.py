@@ -31,11 +31,14 @@ import time
 
 
 
-# The projector is not in this test's run YET: on this 2-core machine, beside 6 simulated cameras,
-# hull and tracker, studio-projector renders ~0.5 frames/s (llvmpipe, and a per-mesh motion fit;
-# BENCHMARKS.md, demo), so its mask is seconds old and lit_actor_px is far from 0 (issue 15 open).
-# `./studio demo` runs it by default and reports lit_actor_px; set this to 1 when the projector
-# keeps up, and the lit_actor_px == 0 check below applies.
+# The projector is not in this test's run YET: beside 6 simulated cameras, hull and tracker on 2
+# cores, studio-projector's frames are now mesh-driven (each new mesh drawn at once, its motion
+# estimated on a fixed vertex budget in ~6 ms of CPU, stale meshes dropped), but the 1280x720
+# frame itself (llvmpipe: ~80 % of the projector's CPU, perf) does not keep up at nice 5 on a
+# loaded machine (BENCHMARKS.md, demo: 0.2-0.3 meshes/s reached a projector frame at load 15), so
+# lit_actor_px cannot be 0 yet (issue 15 open; renderer speed is projector/render's). `./studio
+# demo` runs it by default and reports lit_actor_px, actor_view.png and the margin sweep; set this
+# to 1 when the projector keeps up, and the lit_actor_px == 0 check below applies.
 PROJECTORS = 0
 
 def main():

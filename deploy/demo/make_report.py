@@ -104,11 +104,14 @@ def main():
         lit_reason = ("projector frames arrived but none could be scored: "
                       + str((live.get("lit_actor_detail") or {}).get("first_error")))
     pictures = {}
-    for name in ("latency.png", "preview.png", "projector.png"):
+    for name in ("latency.png", "preview.png", "projector.png", "actor_view.png", "sweep.png"):
         pictures[name] = os.path.exists(os.path.join(out, name)) and os.path.getsize(os.path.join(out, name)) > 0
-    pictures["actor_view.png"] = False
-    pictures["actor_view_reason"] = ("not rendered: the projector publishes only a 160x90 thumbnail of "
-                                     "its frame, too coarse for the actor's view (sim::eye_view)")
+    if pictures["actor_view.png"]:
+        pictures["actor_view_source"] = ("sim::eye_view from the true eye at display time: the projector.png frame "
+                                         "(its 160x90 thumbnail scaled to the projector's size, its full-resolution "
+                                         "blackout black) on the cloth, the actor's shadow cast")
+    else:
+        pictures["actor_view_reason"] = "no scored projector frame (the projector did not run or no frame was scored)"
     report = {
         "generated_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "machine": {"cpu": cpu_model(), "cores": os.cpu_count(),
@@ -139,6 +142,7 @@ def main():
         "lit_actor_px_reason": lit_reason,
         "lit_actor_detail": live.get("lit_actor_detail"),
         "projector": proj or None,
+        "margin_sweep": load(os.path.join(out, "sweep.json")),
         "pictures": pictures,
         "masks_lost": live.get("masks_lost"),
         "masks_detail": live.get("masks_detail"),
@@ -245,6 +249,19 @@ def write_markdown(r, path):
                  f"per frame on average.\n")
         if (r.get("pictures") or {}).get("projector.png"):
             L.append("![projector](projector.png)\n")
+        sw = r.get("margin_sweep") or {}
+        if sw:
+            pn, nn = sw.get("prediction") or {}, sw.get("no_prediction") or {}
+            mm = lambda v: "none of the sweep" if v is None else f"{v * 1e3:.0f} mm"
+            L.append(f"Margin sweep (offline, {sw.get('frames_scored')} frames of the 1.5 m/s arm swing through "
+                     f"the hull library and the projector's MaskPlanner, drawn {fmt(sw.get('latency_s', 0) * 1e3, 1)} ms "
+                     f"after capture = the live motion-to-photon p99): margin needed for 0 lit actor pixels "
+                     f"{mm(pn.get('needed_margin_m'))} with prediction, {mm(nn.get('needed_margin_m'))} without "
+                     f"(sweep.json).\n")
+            if (r.get("pictures") or {}).get("sweep.png"):
+                L.append("![margin sweep](sweep.png)\n")
+        if (r.get("pictures") or {}).get("actor_view.png"):
+            L.append("What the actor sees (that frame on the cloth from the true eye):\n\n![actor view](actor_view.png)\n")
     if (r.get("pictures") or {}).get("preview.png"):
         L.append("![preview](preview.png)\n")
     lat = r.get("latency_ms") or {}

@@ -11,6 +11,9 @@
 #include <deque>
 #include <fstream>
 #include <mutex>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <thread>
 
 #include "core/clock.h"
@@ -206,6 +209,41 @@ class Recorder {
     return buf;
   }
 
+  // OUT/actor_view.png: the pictured projector frame (its thumbnail scaled to the projector's
+  // size, its full-resolution blackout black) on the cloth from the true eye at display time.
+  void write_actor_view(const Collected& c, const std::string& path) const {
+    if (!c.projector_picture || !truth_) return;
+    const ProjectorPicture& p = *c.projector_picture;
+    const auto it = projectors_.find(p.projector_id);
+    if (it == projectors_.end() || p.thumb_width <= 0 ||
+        p.thumbnail.size() != std::size_t(p.thumb_width) * p.thumb_height * 3)
+      return;
+    const Camera& cam = it->second.camera;
+    cv::Mat thumb(p.thumb_height, p.thumb_width, CV_8UC3, const_cast<uint8_t*>(p.thumbnail.data()));
+    cv::Mat full;
+    cv::resize(thumb, full, cv::Size(cam.width, cam.height), 0, 0, cv::INTER_LINEAR);
+    Image<Rgb8> frame(cam.width, cam.height);
+    for (int y = 0; y < cam.height; ++y) {
+      const auto* row = full.ptr<cv::Vec3b>(y);
+      for (int x = 0; x < cam.width; ++x)
+        frame(x, y) =
+            p.blackout.contains(x, y) ? Rgb8{0, 0, 0} : Rgb8{row[x][0], row[x][1], row[x][2]};
+    }
+    auto view = truth_->actor_view(it->second, p.studio_frame, o_.display_lag_s, std::move(frame));
+    if (!view) {
+      std::fprintf(stderr, "[demo] actor view: %s\n", view.error().message.c_str());
+      return;
+    }
+    cv::Mat rgb(view->height(), view->width(), CV_8UC3, view->data());
+    cv::Mat bgr;
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    cv::putText(bgr,
+                p.projector_id + " render frame " + std::to_string(p.render_frame) +
+                    ": the cloth from the true eye",
+                {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1);
+    if (!cv::imwrite(path, bgr)) std::fprintf(stderr, "[demo] could not write %s\n", path.c_str());
+  }
+
   Collected finish(bool ready, const std::string& why) {
     std::lock_guard lock(mutex_);
     c_.ready = ready;
@@ -374,7 +412,7 @@ class Recorder {
       auto p = wire::to_core(s);
       if (!p) return;
       std::lock_guard lock(mutex_);
-      projectors_.insert_or_assign(std::string(s.projector_id), p->camera);
+      projectors_.insert_or_assign(std::string(s.projector_id), *p);
       c_.projector_calibrations[s.projector_id] = p->camera.width * p->camera.height;
     });
   }
@@ -421,7 +459,7 @@ class Recorder {
     while (true) {
       ProjectorJob job;
       const TruthScorer* truth = nullptr;
-      std::optional<Camera> projector;
+      std::optional<Projector> projector;
       {
         std::unique_lock lock(mutex_);
         wake_.wait(lock, [&] { return stopping_ || !projector_jobs_.empty(); });
@@ -440,8 +478,8 @@ class Recorder {
       Expected<TruthScorer::Lit> lit = fail("no calibration of projector " + p.projector_id +
                                             " on studio/projector/calibration");
       if (projector)
-        lit =
-            truth->projector_lit(*projector, studio_frame, o_.display_lag_s, job.blackout, &actor);
+        lit = truth->projector_lit(projector->camera, studio_frame, o_.display_lag_s, job.blackout,
+                                   &actor);
       std::lock_guard lock(mutex_);
       if (!lit) {
         note_projector_error(lit.error().message);
@@ -456,9 +494,9 @@ class Recorder {
         if (!pic || p.lit_actor_px > pic->lit_actor_px ||
             (p.lit_actor_px == pic->lit_actor_px && pic->actor_px == 0 && p.actor_px > 0)) {
           pic = ProjectorPicture{
-              p.projector_id,         p.render_frame,   p.lit_actor_px,           p.actor_px,
-              job.thumb_width,        job.thumb_height, std::move(job.thumbnail), std::move(actor),
-              std::move(job.blackout)};
+              p.projector_id,   p.render_frame,         p.lit_actor_px,   p.actor_px,
+              studio_frame,     job.thumb_width,        job.thumb_height, std::move(job.thumbnail),
+              std::move(actor), std::move(job.blackout)};
         }
       }
       c_.projector.push_back(std::move(p));
@@ -529,7 +567,7 @@ class Recorder {
   bool stopping_ = false, scoring_ = false, first_mesh_ = false;
   int64_t last_pick_ns_ = 0;
   std::map<std::string, Camera> cameras_;
-  std::map<std::string, Camera> projectors_;  // studio/projector/calibration
+  std::map<std::string, Projector> projectors_;  // studio/projector/calibration
   std::deque<ProjectorJob> projector_jobs_;
   std::thread projector_thread_;
   std::map<std::string, ServiceSeen> services_;
@@ -590,6 +628,7 @@ Expected<std::string> run_probe(const ProbeOptions& o) {
   }
   rec.stop();
   Collected c = rec.finish(ready, why);
+  if (!o.actor_view_png.empty()) rec.write_actor_view(c, o.actor_view_png);
   return make_report(o, c);
 }
 

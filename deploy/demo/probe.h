@@ -49,6 +49,7 @@ struct ProbeOptions {
   std::string head_id = "actor";
   std::string histogram_png;         // latency histogram (OpenCV), optional
   std::string projector_png;         // a scored projector frame (thumbnail, blackout, true actor)
+  std::string actor_view_png;        // that frame on the cloth from the true eye (optional)
   double display_lag_s = 0.016;      // projector frame rendered → on the cloth (sim's default)
   std::size_t projector_queue = 64;  // frames waiting for scoring; beyond: counted unscored
   bool progress = true;

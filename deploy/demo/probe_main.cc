@@ -5,6 +5,8 @@
 //   studio-demo-probe take  --capture FILE... [--name TAKE] [--frames N] [--lead S] [--timeout S]
 //   studio-demo-probe rig   (--from RIG | --published --capture FILE...) [--cameras ID,...] --out
 //   FILE studio-demo-probe score --rig RIG --meshes DIR [--out FILE]
+//   studio-demo-probe sweep --rig RIG --latency-ms L [--projectors RIG --projector ID]
+//                           [--frames N] [--grid N] [--display-lag S] --out FILE [--png PNG]
 // DDS domain and profile as every service: $STUDIO_DDS_DOMAIN, $CYCLONEDDS_URI.
 #include <algorithm>
 #include <chrono>
@@ -21,7 +23,9 @@
 
 #include "core/clock.h"
 #include "json_writer.h"
+#include "margin_sweep.h"
 #include "probe.h"
+#include "sim/projector_light.h"
 #include "take.h"
 #include "testing/mesh_read.h"
 #include "truth.h"
@@ -38,6 +42,8 @@ constexpr const char* kUsage = R"(usage: studio-demo-probe watch --capture FILE.
        studio-demo-probe take  --capture FILE... [--name TAKE] [--frames N] [--lead S]
        studio-demo-probe rig   (--from RIG | --published --capture FILE...) [--cameras ID,...] --out FILE
        studio-demo-probe score --rig RIG --meshes DIR [--out FILE]
+       studio-demo-probe sweep --rig RIG --latency-ms L [--projectors RIG --projector ID]
+                               [--frames N] [--grid N] [--display-lag S] [--out FILE] [--png PNG]
 
 The demo's measuring instrument (deploy/demo.sh runs it; not a service). It joins the studio's
 DDS domain ($STUDIO_DDS_DOMAIN, profile $CYCLONEDDS_URI) like any subscriber.
@@ -63,6 +69,8 @@ watch   records masks, segments, meshes, heads and service status for a bounded 
   --projector-png PNG the scored projector frame with the most lit actor pixels (thumbnail,
                       blackout, true actor)
   --display-lag S     projector frame rendered -> on the cloth, for the truth (default 0.016)
+  --actor-view PNG    what the actor sees: the projector.png frame (its thumbnail scaled up,
+                      the full-resolution blackout black) on the cloth, from the true eye
   --out FILE          write the JSON there instead of stdout
   --quiet             no progress lines
 take    records a take on every capture server, frame-accurate: START at a future frame, STOP
@@ -72,6 +80,17 @@ rig     writes a rig.yaml: the cameras of RIG (--from), or the calibrations the 
         servers publish (--published, cameras of --capture); --cameras keeps only those ids.
 score   scores meshes DIR/<frame>.ply (studio-hull offline --out DIR) against the simulator's true
         masks of the same frame in every camera of RIG: {frames, mean_iou, min_iou, worst_at}.
+sweep   the projector mask's margin sweep, offline (margin_sweep.h): the simulated actor's fast
+        arm swing seen by RIG's cameras -> true masks -> hull library (--grid, default 160) ->
+        the projector's MaskPlanner with floor = cap = each margin, prediction on and off ->
+        the mask rasterised into the projector (projector ID of the rig file --projectors;
+        default a 1280x720 projector of the simulated studio on the side wall, whose beam
+        covers the spot where the arm swing stands, which the example proj1's does not) ->
+        lit-actor and
+        wasted pixels against the true actor, the mesh drawn --latency-ms after its capture
+        (the demo passes its live motion-to-photon p99) and shown --display-lag later (0.016).
+        --frames N (default 100) scored frames. JSON: both curves and needed_margin_m (the
+        smallest margin with 0 lit pixels); --png: the plot.
 Exit status: 0 done; 1 the pipeline delivered nothing / the take did not complete; 2 bad
 arguments or setup error (one line on stderr).
 )";
@@ -168,11 +187,12 @@ int watch(const Args& a) {
   o.display_lag_s = *lag;
   o.histogram_png = opt(a, "histogram");
   o.projector_png = opt(a, "projector-png");
+  o.actor_view_png = opt(a, "actor-view");
   o.progress = !a.quiet;
   for (const auto& [k, v] : a.opts)
     if (k != "rig" && k != "seconds" && k != "warmup" && k != "ready-timeout" &&
         k != "score-rate" && k != "histogram" && k != "out" && k != "projector-png" &&
-        k != "display-lag")
+        k != "display-lag" && k != "actor-view")
       return usage_error("watch: unknown option --" + k);
   auto json = demo::run_probe(o);
   if (!json) return usage_error(json.error().message);
@@ -245,6 +265,48 @@ int rig(const Args& a) {
   return 0;
 }
 
+int sweep(const Args& a) {
+  const std::string rig_path = opt(a, "rig"), proj_path = opt(a, "projectors"),
+                    id = opt(a, "projector");
+  if (rig_path.empty() || !a.opts.contains("latency-ms"))
+    return usage_error("sweep: --rig and --latency-ms are required");
+  if (proj_path.empty() != id.empty())
+    return usage_error("sweep: give --projectors and --projector together (or neither)");
+  auto rig = yaml::read_rig(rig_path);
+  if (!rig) return usage_error(rig.error().message);
+  // Default: a 1280x720 projector of the simulated studio lighting the side wall (x = -4.5),
+  // whose beam covers the spot where the arm swing stands and sees the swing across its image.
+  Projector chosen = sim::studio_projector(sim::Cyclorama{}, {3.8, 2.3, 0.6}, 6.0, 1280, 720,
+                                           Eigen::Vector3d(-4.5, 1.4, 0.3), "sim_side_wall");
+  if (!proj_path.empty()) {
+    auto projectors = yaml::read_rig(proj_path);
+    if (!projectors) return usage_error(projectors.error().message);
+    const Projector* p = projectors->find_projector(id);
+    if (!p) return usage_error("sweep: no projector '" + id + "' in " + proj_path);
+    chosen = *p;
+  }
+  demo::SweepOptions o;
+  o.projector = chosen;
+  o.cameras = rig->cameras;
+  auto latency = number(a, "latency-ms", 0), frames = number(a, "frames", o.frames),
+       grid = number(a, "grid", o.grid), lag = number(a, "display-lag", o.display_lag_s);
+  for (auto* v : {&latency, &frames, &grid, &lag})
+    if (!*v) return usage_error(v->error().message);
+  o.latency_s = *latency * 1e-3;
+  o.frames = int(*frames);
+  o.grid = int(*grid);
+  o.display_lag_s = *lag;
+  for (const auto& [k, v] : a.opts)
+    if (k != "rig" && k != "projectors" && k != "projector" && k != "latency-ms" && k != "frames" &&
+        k != "grid" && k != "display-lag" && k != "out" && k != "png")
+      return usage_error("sweep: unknown option --" + k);
+  auto r = demo::margin_sweep(o, !a.quiet);
+  if (!r) return usage_error(r.error().message);
+  if (const std::string png = opt(a, "png"); !png.empty() && !demo::draw_sweep_png(*r, png))
+    return usage_error("sweep: could not write " + png);
+  return emit(demo::sweep_json(*r), opt(a, "out"));
+}
+
 int score(const Args& a) {
   const std::string rig_path = opt(a, "rig"), dir = opt(a, "meshes");
   if (rig_path.empty() || dir.empty())
@@ -307,9 +369,10 @@ int main(int argc, char** argv) {
     if (args->verb == "take") return take(*args);
     if (args->verb == "rig") return rig(*args);
     if (args->verb == "score") return score(*args);
+    if (args->verb == "sweep") return sweep(*args);
   } catch (const std::exception& e) {
     return usage_error(e.what());
   }
   return usage_error("unknown command '" + args->verb +
-                     "' (watch, take, rig or score; see --help)");
+                     "' (watch, take, rig, score or sweep; see --help)");
 }

@@ -1,9 +1,11 @@
 #include "truth.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "capture/sim_source.h"
+#include "core/look_at.h"
 #include "sim/projector_light.h"
 #include "sim/studio.h"
 #include "support/masks.h"
@@ -79,6 +81,35 @@ Expected<TruthScorer::Lit> TruthScorer::projector_lit(const Camera& projector, d
   const sim::LitCount n = sim::count_lit(actor, blackout);
   if (actor_out) *actor_out = std::move(actor);
   return Lit{n.actor, n.lit_actor, n.blackout, n.wasted};
+}
+
+Expected<Image<Rgb8>> TruthScorer::actor_view(const Projector& projector, double studio_frame,
+                                              double display_lag_s, Image<Rgb8> frame, int width,
+                                              int height) const {
+  if (frame.width() != projector.camera.width || frame.height() != projector.camera.height)
+    return fail("actor view: the frame is not of the projector's size");
+  if (width < 16 || height < 16) return fail("actor view: image too small");
+  const double t = studio_frame / impl_->studio.options().fps + display_lag_s;
+  const sim::ActorBody body = impl_->studio.actor().body_at(t);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double back = 0;
+  for (const Eigen::Vector3d& c : projector.screen) {
+    centre += c / 4;
+    back = std::max(back, std::abs(c.z()));
+  }
+  Camera eye;
+  eye.id = "actor_eye";
+  eye.width = width;
+  eye.height = height;
+  const double f = 0.5 * width / std::tan(0.5 * 100.0 * M_PI / 180);
+  eye.intrinsics = {f, f, 0.5 * (width - 1), 0.5 * (height - 1), 0};
+  eye.cam_from_world = look_at(body.head_centre(), centre);
+  sim::ProjectorLight light;
+  light.projectors.push_back({projector, std::move(frame)});
+  if (auto ok = light.validate(); !ok) return std::unexpected(ok.error());
+  sim::Cyclorama cyc;
+  if (back > 0.5) cyc.half_width = back;
+  return sim::eye_view(light, cyc, eye, &body).image;
 }
 
 }  // namespace studio::demo

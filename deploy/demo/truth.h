@@ -11,6 +11,8 @@
 //   - projector light (issue 15 item 5, sim/projector_light.h): the projector pixels whose ray
 //     meets the TRUE actor at the instant a projector frame is on the cloth (render time + the
 //     simulator's display lag), and of those the ones the frame's blackout mask leaves lit.
+//   - what the actor sees (OUT/actor_view.png): a projector frame's light on the cloth seen from
+//     the TRUE eye at its display time (sim::eye_view, the actor's body casting its shadow).
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -21,6 +23,7 @@
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "core/rig.h"
 #include "core/run_mask.h"
 #include "hull/segment_mesh.h"
 
@@ -57,6 +60,14 @@ class TruthScorer {
   };
   Expected<Lit> projector_lit(const Camera& projector, double studio_frame, double display_lag_s,
                               const RunMask& blackout, Mask* actor_out = nullptr) const;
+
+  // What the actor sees when `frame` (the projector's image, of its size) is on the cloth: a
+  // width x height camera at the true head centre at studio_frame + display lag, looking at the
+  // centre of the projector's screen, 100 degrees across; the cloth is taken as the box whose
+  // back wall is the screen's plane (sim::Cyclorama with the screen's |z| as half width).
+  Expected<Image<Rgb8>> actor_view(const Projector& projector, double studio_frame,
+                                   double display_lag_s, Image<Rgb8> frame, int width = 640,
+                                   int height = 360) const;
 
  private:
   struct Impl;

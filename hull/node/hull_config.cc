@@ -50,7 +50,9 @@ runtime::ServiceDefinition hull_service_definition() {
       "    actor_prefix: actor     actor ids <prefix>0, <prefix>1, ... largest first\n"
       "    projector_masks: false  publish studio/projector/mask: for every projector of the\n"
       "                            rig, the projector pixels the actors cover (viewpoint cut,\n"
-      "                            eq. 7-8), one sample per frame and projector\n"
+      "                            eq. 7-8), one sample per frame and projector; the\n"
+      "                            projectors' own studio/projector/calibration join or\n"
+      "                            replace the rig's (projector_calibrations_in)\n"
       "    projector_mask_step: 2  the cut samples every step-th projector pixel (1..64)\n";
   d.create = [](yaml::MapReader& config,
                 runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {

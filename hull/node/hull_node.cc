@@ -56,8 +56,20 @@ class HullNode : public runtime::Node {
         poses_(std::move(cameras)),
         projectors_(std::move(projectors)),
         loop_(ctx, kLog) {
-    if (options_.projector_masks)
-      projector_masks_ = &loop_.output<studio_ProjectorMask>({.counter = "projector_masks_out", .rate = false});
+    if (options_.projector_masks) {
+      projector_masks_ =
+          &loop_.output<studio_ProjectorMask>({.counter = "projector_masks_out", .rate = false});
+      // The projectors' own calibrations (studio-projector publishes its rig entry, transient
+      // local): a projector not in our rig joins, one in it is replaced.
+      loop_.input<studio_ProjectorCalibration>(
+          {.received = "projector_calibrations_in",
+           .rejected = "projector_calibrations_rejected",
+           .reason_prefix = "projector_calibrations_rejected_",
+           .rate = false},
+          [this](const studio_ProjectorCalibration& s, const wire::SampleMeta&) {
+            return on_projector_calibration(s);
+          });
+    }
     segs_ = &loop_.output<studio_SegmentSet>({.counter = "segment_sets_out"});
     meshes_ = &loop_.output<studio_ActorMesh>({.counter = "meshes_out", .rate = false});
     // Every per-frame pose of a tracked camera, even when a cut holds this node up (the topic
@@ -107,6 +119,18 @@ class HullNode : public runtime::Node {
     auto cam = wire::to_core(s);
     if (!cam) return runtime::reject("to_core", cam.error().message);
     poses_.update(std::size_t(index), s.frame, s.tracked, std::move(*cam));
+    return {};
+  }
+
+  runtime::Outcome on_projector_calibration(const studio_ProjectorCalibration& s) {
+    auto p = wire::to_core(s);
+    if (!p) return runtime::reject("to_core", p.error().message);
+    for (Camera& c : projectors_)
+      if (c.id == p->camera.id) {
+        c = p->camera;
+        return {};
+      }
+    projectors_.push_back(p->camera);
     return {};
   }
 

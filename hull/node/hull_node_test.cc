@@ -366,9 +366,10 @@ TEST_F(HullNodeTest, ProjectorMasksOut) {
     }
     ProjectorMaskOptions po;
     po.step = 2;
-    return projector_mask(proj.camera, Eigen::AlignedBox3d(Eigen::Vector3d(-1.5, 0, -1.5),
-                                                           Eigen::Vector3d(1.5, 2.2, 1.5)),
-                          views, po)
+    return projector_mask(
+               proj.camera,
+               Eigen::AlignedBox3d(Eigen::Vector3d(-1.5, 0, -1.5), Eigen::Vector3d(1.5, 2.2, 1.5)),
+               views, po)
         .value();
   };
   std::vector<int> all(cameras_.size());
@@ -396,8 +397,81 @@ TEST_F(HullNodeTest, ProjectorMasksOut) {
       std::this_thread::sleep_for(20ms);
     }
   }
-  EXPECT_TRUE(matched) << received << " masks received, none equal to the library's\n" << hull.log();
+  EXPECT_TRUE(matched) << received << " masks received, none equal to the library's\n"
+                       << hull.log();
   EXPECT_EQ(pms.rejected().total(), 0u);
+  EXPECT_EQ(hull.stop(), 0) << hull.log();
+}
+
+// A projector the rig does not hold joins by its own studio/projector/calibration (as
+// studio-projector publishes it, transient local): its viewpoint-cut mask follows, equal to the
+// library's; a refused calibration (non-finite) is counted and changes nothing.
+TEST_F(HullNodeTest, ProjectorCalibrationFromTheWireJoinsTheMasks) {
+  Projector proj = sim::studio_projector(sim::Cyclorama{}, {-0.5, 2.4, 3.6}, 6.0, 640, 360);
+  proj.camera.id = "proj7";
+  Rig rig;
+  rig.cameras = cameras_;  // no projector
+  ASSERT_TRUE(yaml::write_rig(rig, (dir_ / "rig.yaml").string()).has_value());
+  auto p = wire::Participant::create().value();
+  auto mask_topic = wire::Topic<studio_AlphaMask>::create(p).value();
+  auto masks = wire::Writer<studio_AlphaMask>::create(p, mask_topic).value();
+  auto cal_topic = wire::Topic<studio_ProjectorCalibration>::create(p).value();
+  auto cals = wire::Writer<studio_ProjectorCalibration>::create(p, cal_topic).value();
+  auto pm_topic = wire::Topic<studio_ProjectorMask>::create(p).value();
+  auto pms = wire::Reader<studio_ProjectorMask>::create(p, pm_topic).value();
+  // Published before the hull starts: transient local, the hull still gets it.
+  wire::Owned<studio_ProjectorCalibration> c;
+  ASSERT_TRUE(wire::from_core(proj, Eigen::Matrix3d::Identity(), *c).has_value());
+  ASSERT_TRUE(cals.write(*c).has_value());
+  auto& hull = spawn("hull", "hull/studio-hull",
+                     {"--config", write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 64\n"
+                                               "  deadline_ms: 300\n  projector_masks: true\n"
+                                               "  projector_mask_step: 2\n")});
+  ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
+  ASSERT_TRUE(masks.wait_for_readers(1, 10s));
+  wire::Owned<studio_ProjectorCalibration> bad;
+  ASSERT_TRUE(wire::from_core(proj, Eigen::Matrix3d::Identity(), *bad).has_value());
+  wire::set(bad->projector_id, "proj8");
+  bad->t[0] = NAN;
+  ASSERT_TRUE(cals.write(*bad).has_value());
+
+  auto local = [&](int64_t frame) {
+    std::vector<RunMask> runs(cameras_.size());
+    std::vector<View> views;
+    for (std::size_t i = 0; i < cameras_.size(); ++i) {
+      Mask truth;
+      studio_->render(int(i), frame, nullptr, &truth);
+      runs[i] = RunMask::from_mask(truth.view());
+      views.push_back({&cameras_[i], &runs[i]});
+    }
+    ProjectorMaskOptions po;
+    po.step = 2;
+    return projector_mask(
+               proj.camera,
+               Eigen::AlignedBox3d(Eigen::Vector3d(-1.5, 0, -1.5), Eigen::Vector3d(1.5, 2.2, 1.5)),
+               views, po)
+        .value();
+  };
+  std::vector<int> all(cameras_.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+  const int64_t frame = 60, capture_ns = 1'700'000'000'000'000'000;
+  bool matched = false;
+  for (int attempt = 0; attempt < 20 && !matched; ++attempt) {
+    publish_masks(masks, frame + attempt, capture_ns + attempt, all);
+    const auto until = std::chrono::steady_clock::now() + 2s;
+    while (std::chrono::steady_clock::now() < until && !matched) {
+      for (auto& s : pms.take()) {
+        if (!s.meta.valid_data) continue;
+        EXPECT_EQ(std::string(s.data->projector_id), "proj7");  // never the refused proj8
+        auto core = wire::to_core(*s.data);
+        ASSERT_TRUE(core.has_value()) << core.error().message;
+        ASSERT_EQ(core->width(), 640);
+        if (core->area() > 1000 && *core == local(int64_t(s.data->frame))) matched = true;
+      }
+      std::this_thread::sleep_for(20ms);
+    }
+  }
+  EXPECT_TRUE(matched) << hull.log();
   EXPECT_EQ(hull.stop(), 0) << hull.log();
 }
 

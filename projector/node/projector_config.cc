@@ -43,7 +43,10 @@ runtime::ServiceDefinition projector_service_definition() {
       "    mesh_actor: actor0      that actor's mesh (studio/actor/mesh key; the hull's ids):\n"
       "                            the head's speed joins its margin. Every actor's mesh is\n"
       "                            masked, whichever head is followed\n"
-      "    rate: 25                frames per second rendered (1..240)\n"
+      "    rate: 25                frames per second rendered without meshes (1..240); a new\n"
+      "                            actor mesh is drawn at once (its motion estimated once,\n"
+      "                            on a fixed vertex budget); a mesh not yet drawn when a\n"
+      "                            newer one arrives is dropped (meshes_superseded)\n"
       "    form: single_pass       single_pass (homography folded into the projection, the\n"
       "                            paper's) or two_pass (eye texture + 3x3 warp)\n"
       "    eye_texture: [0, 0]     two_pass eye texture size; 0 0 = one texel per projector pixel\n"
@@ -66,7 +69,8 @@ runtime::ServiceDefinition projector_service_definition() {
       "  renderer in a graphical session (not built yet: see deploy/systemd/studio-projector@).\n"
       "  Topics: studio/scene/node, studio/actor/mesh, studio/actor/head in;\n"
       "  studio/projector/calibration, studio/projector/frame, studio/service/status out\n"
-      "  (latency = motion to photon; margin_mm, latency_p_ms, eye_rejected, meshes_rejected).\n";
+      "  (latency = motion to photon; margin_mm, latency_p_ms, render_ms, motion_ms,\n"
+      "  eye_rejected, meshes_rejected, meshes_superseded, mesh_motion_errors).\n";
   d.create = [](yaml::MapReader& config,
                 runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto section = config.required("projector");

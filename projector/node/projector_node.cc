@@ -9,6 +9,7 @@
 
 #include "core/clock.h"
 #include "core/log.h"
+#include "projector/mesh_inbox.h"
 #include "projector_wire.h"
 #include "runtime/service_loop.h"
 #include "scene_mirror.h"
@@ -70,6 +71,9 @@ class ProjectorNode : public runtime::Node {
     head_stale_ = &loop_.counter("head_stale");
     scene_left_out_ = &loop_.counter("scene_nodes_left_out");
     assets_failed_ = &loop_.counter("assets_failed");
+    superseded_ = &loop_.counter("meshes_superseded");
+    mesh_errors_ = &loop_.counter("mesh_motion_errors");
+    motion_ms_ = &loop_.metrics().gauge("motion_ms");
     margin_mm_ = &loop_.metrics().gauge("margin_mm");
     latency_p_ms_ = &loop_.metrics().gauge("latency_p_ms");
     render_ms_ = &loop_.metrics().gauge("render_ms");
@@ -115,18 +119,23 @@ class ProjectorNode : public runtime::Node {
     return {};
   }
 
+  // A mesh is decoded and checked here and handed to the render thread (MeshInbox), which is
+  // woken at once and estimates its motion once, in the next frame.
   runtime::Outcome on_mesh(const studio_ActorMesh& s, const wire::SampleMeta& meta) {
     const std::string id(s.actor_id);
     if (meta.disposed || !meta.valid_data) {
       std::lock_guard lock(mutex_);
-      planner_.remove(id);
+      inbox_.dispose(id);
       return {};
     }
     if (s.vertices._length == 0 || s.triangles._length == 0)
       return runtime::reject("empty", "actor " + id + ": empty mesh (previous mask kept)");
+    ActorMesh mesh = mesh_of(s);
     std::lock_guard lock(mutex_);
-    if (auto ok = planner_.set_mesh(id, s.frame, mesh_of(s)); !ok)
-      return runtime::reject("mesh", ok.error().message);
+    auto replaced = inbox_.offer(id, s.frame, std::move(mesh));
+    if (!replaced) return runtime::reject("mesh", replaced.error().message);
+    if (*replaced) superseded_->add();
+    wake_.notify_all();
     return {};
   }
 
@@ -135,9 +144,33 @@ class ProjectorNode : public runtime::Node {
     const Eigen::Vector3d v(s.velocity[0], s.velocity[1], s.velocity[2]);
     std::lock_guard lock(mutex_);
     if (options_.actor != s.actor_id) return {};  // another actor's head
-    planner_.set_head_speed(options_.mesh_actor, v.norm());
+    head_speed_ = v.norm();
     head_ = Head{p, SteadyClock::now()};
     return {};
+  }
+
+  // The render thread's planner takes what the handlers left: removals, new meshes (their
+  // motion estimated here, outside the lock), the followed head's speed.
+  void take_inputs() {
+    MeshInbox::Taken taken;
+    std::optional<double> head_speed;
+    {
+      std::lock_guard lock(mutex_);
+      taken = inbox_.take();
+      head_speed = head_speed_;
+    }
+    if (!taken.meshes.empty()) {
+      const auto t0 = SteadyClock::now();
+      std::string error;
+      if (const int refused = apply(std::move(taken), planner_, &error); refused > 0) {
+        mesh_errors_->add(refused);
+        STUDIO_LOG(debug, kLog) << error;
+      }
+      motion_ms_->set(std::chrono::duration<double, std::milli>(SteadyClock::now() - t0).count());
+    } else {
+      apply(std::move(taken), planner_);
+    }
+    if (head_speed) planner_.set_head_speed(options_.mesh_actor, *head_speed);
   }
 
   // The eye for this frame: the followed head when fresh, else the last good eye.
@@ -162,13 +195,16 @@ class ProjectorNode : public runtime::Node {
     const auto period = std::chrono::duration_cast<SteadyClock::duration>(
         std::chrono::duration<double>(1.0 / options_.rate));
     auto next = SteadyClock::now();
+    // A frame when a new mesh arrives (at once: the mesh's motion-to-photon latency is its
+    // transport + motion estimate + one render), else one period after the last frame (the
+    // scene and the eye move without meshes too).
     while (loop_.running()) {
       {
         std::unique_lock lock(mutex_);
-        if (wake_.wait_until(lock, next, [this] { return stop_; })) return;
+        if (wake_.wait_until(lock, next, [this] { return stop_ || inbox_.has_meshes(); }) && stop_)
+          return;
       }
-      next += period;
-      if (const auto now = SteadyClock::now(); next < now) next = now;  // behind: no burst
+      next = SteadyClock::now() + period;
       render_one(*fr, state);
     }
   }
@@ -214,13 +250,11 @@ class ProjectorNode : public runtime::Node {
       scene_left_out_->add(r.left_out);
       assets_failed_->add(r.assets_failed);
     }
+    take_inputs();
     Eigen::Vector3d eye = eye_now(SteadyClock::now());
     const int64_t start_ns = realtime_ns();
     std::optional<MaskPlan> plan;
-    {
-      std::lock_guard lock(mutex_);
-      if (auto p = planner_.plan(start_ns + int64_t(st.render_s * 1e9))) plan = std::move(*p);
-    }
+    if (auto p = planner_.plan(start_ns + int64_t(st.render_s * 1e9))) plan = std::move(*p);
     const std::span<const ActorMesh> masks =
         plan ? std::span<const ActorMesh>(plan->masks) : std::span<const ActorMesh>();
     auto drawn = fr.render(st.scene, eye, masks);
@@ -241,9 +275,9 @@ class ProjectorNode : public runtime::Node {
     {
       std::lock_guard lock(mutex_);
       if (drawn) last_good_eye_ = eye;
-      if (plan) planner_.shown(*plan, done_ns);
-      latency_p_ms_->set(planner_.latency_s() * 1e3);
     }
+    if (plan) planner_.shown(*plan, done_ns);
+    latency_p_ms_->set(planner_.latency_s() * 1e3);
     render_ms_->set(st.render_s * 1e3);
     if (plan) margin_mm_->set(plan->margin.margin_m * 1e3);
     if (plan && plan->newest_capture_ns > 0)
@@ -275,16 +309,20 @@ class ProjectorNode : public runtime::Node {
   std::condition_variable wake_;
   bool stop_ = false;
   SceneMirror mirror_;
-  MaskPlanner planner_;
+  MeshInbox inbox_;  // meshes for the render thread
+  std::optional<double> head_speed_;
   std::optional<Head> head_;
   Eigen::Vector3d last_good_eye_ = Eigen::Vector3d::Zero();
   std::promise<Expected<void>> init_;
   std::atomic<bool> degraded_{false};
   runtime::Output<studio_ProjectorCalibration>* calibration_ = nullptr;
   runtime::Output<studio_ProjectorFrame>* frames_ = nullptr;
+  MaskPlanner planner_;  // the render thread's alone
   runtime::Counter *rendered_ = nullptr, *eye_rejected_ = nullptr, *head_stale_ = nullptr,
-                   *scene_left_out_ = nullptr, *assets_failed_ = nullptr;
-  runtime::Gauge *margin_mm_ = nullptr, *latency_p_ms_ = nullptr, *render_ms_ = nullptr;
+                   *scene_left_out_ = nullptr, *assets_failed_ = nullptr, *superseded_ = nullptr,
+                   *mesh_errors_ = nullptr;
+  runtime::Gauge *margin_mm_ = nullptr, *latency_p_ms_ = nullptr, *render_ms_ = nullptr,
+                 *motion_ms_ = nullptr;
   runtime::ServiceLoop loop_;  // last: stopped before the state above goes
 
  public:

@@ -2,7 +2,8 @@
 // The projector service (issue 15 item 3; TCSVT 2004 §V-C/D): one data projector's visualisation
 // server. Renders the virtual scene from the actor's eye through the projector's screen rectangle
 // (single pass: the homography folded into the projection, or two pass: eye texture + warp) at
-// the projector's rate, headless (EGL surfaceless; no window), and blacks out every actor: their
+// once per new actor mesh (drawn at once; stale undrawn meshes dropped and counted) and at least
+// at the projector's rate, headless (EGL surfaceless; no window), and blacks out every actor: their
 // latest meshes, moved forward by the predicted motion and grown by the computed margin, drawn
 // black from the projector with no depth test (projector/mask_planner.h).
 //
@@ -41,7 +42,7 @@ struct ProjectorNodeOptions {
   std::string projector;        // its id
   std::string actor = "actor";  // the head (studio/actor/head key) that is the eye
   std::string mesh_actor = "actor0";  // that actor's mesh id: the head's speed joins its margin
-  double rate = 25;                   // frames per second
+  double rate = 25;                   // frames per second without meshes (a mesh: a frame at once)
   projector_render::Form form = projector_render::Form::single_pass;
   std::vector<int> eye_texture{0, 0};            // two pass: eye texture size, 0 0 = suggested
   std::vector<double> default_eye{0, 1.7, 2.0};  // eye until a head pose arrives, studio frame

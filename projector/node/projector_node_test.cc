@@ -9,6 +9,7 @@
 
 #include <fstream>
 #include <opencv2/imgproc.hpp>
+#include <set>
 #include <sstream>
 
 #include "core/clock.h"
@@ -239,6 +240,28 @@ TEST_F(ProjectorNodeTest, RendersTheSceneMasksTheActorAndReportsOverDds) {
   }
   EXPECT_TRUE(counted) << node.log();
   EXPECT_GE(later_frames, 3);
+
+  // A burst of meshes faster than frames are drawn (a hull catching up): the newest is drawn and
+  // the older ones are not queued (dropped by the reader's keep-last history or, once taken,
+  // by the node's MeshInbox: meshes_superseded; its logic is MeshInbox's unit test).
+  const int64_t base = std::max(capture_ns + 1'000'000, realtime_ns() - 1'200'000'000);
+  for (int k = 1; k <= 30; ++k) {
+    wire::Owned<studio_ActorMesh> b;
+    to_wire(box({0.2f, 1.0f, -0.5f}, 0.25f, base + k * 40'000'000), "actor0", 2000 + k, *b);
+    ASSERT_TRUE(meshes.write(*b).has_value());
+  }
+  bool newest = false;
+  std::set<uint64_t> drawn;
+  for (auto until = SteadyClock::now() + 15s; !newest && SteadyClock::now() < until;) {
+    for (auto& s : frames.take())
+      if (s.meta.valid_data && s.data->frame > 2000) {
+        drawn.insert(s.data->frame);
+        newest = newest || s.data->frame == 2030;
+      }
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_TRUE(newest) << node.log();
+  EXPECT_LT(drawn.size(), 30u);  // not one frame per mesh of the burst
 
   // The actor leaves (the hull disposes its mesh): no mask any more.
   ASSERT_TRUE(meshes.dispose(*m).has_value());

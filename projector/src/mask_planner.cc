@@ -43,6 +43,12 @@ void MaskPlanner::set_head_speed(const std::string& actor_id, double speed_mps) 
   if (it != actors_.end()) it->second.head_speed_mps = speed_mps;
 }
 
+Expected<void> MaskPlanner::set_margin_options(const MarginOptions& margin) {
+  if (auto ok = margin.validate(); !ok) return ok;
+  options_.margin = margin;
+  return {};
+}
+
 double MaskPlanner::latency_s() const {
   return latencies_.empty() ? options_.initial_latency_s : latencies_.latency_s();
 }

@@ -18,49 +18,92 @@ int64_t cell_key(const Eigen::Vector3i& c) {
   return ((c.x() + kOffset) << 42) | ((c.y() + kOffset) << 21) | (c.z() + kOffset);
 }
 
-// Uniform hash grid over a mesh's vertices for nearest-vertex queries.
+// Uniform grid over a mesh's vertices for nearest-vertex queries: dense over the vertices'
+// bounding box (cell lists in one array, counting sort), so a query costs a few array reads.
 class VertexGrid {
  public:
   VertexGrid(const std::vector<Eigen::Vector3f>& points, double cell)
       : points_(points), cell_(cell) {
-    for (size_t i = 0; i < points.size(); ++i)
-      cells_[cell_key(cell_of(points[i].cast<double>()))].push_back(static_cast<int>(i));
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+    for (const auto& q : points) {
+      lo = lo.cwiseMin(q.cast<double>());
+      hi = hi.cwiseMax(q.cast<double>());
+    }
+    if (points.empty()) lo = hi = Eigen::Vector3d::Zero();
+    // At most ~4M cells (two actors at opposite corners of a large studio): coarser cells then.
+    while (true) {
+      dims_ = ((hi - lo) / cell_).array().floor().cast<int>() + 1;
+      if (double(dims_.x()) * dims_.y() * dims_.z() <= 4e6) break;
+      cell_ *= 1.5;
+    }
+    lo_ = lo;
+    start_.assign(size_t(dims_.x()) * dims_.y() * dims_.z() + 1, 0);
+    std::vector<int> cell_of_point(points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+      cell_of_point[i] = index(cell_of(points[i].cast<double>()));
+      ++start_[cell_of_point[i] + 1];
+    }
+    for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+    order_.resize(points.size());
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    for (size_t i = 0; i < points.size(); ++i) order_[fill[cell_of_point[i]]++] = int(i);
   }
 
   // Index of the nearest point within max_distance, or -1.
   int nearest(const Eigen::Vector3d& p, double max_distance) const {
-    const Eigen::Vector3i c = cell_of(p);
-    const int shells = static_cast<int>(std::ceil(max_distance / cell_));
+    const Eigen::Vector3d g = (p - lo_) / cell_;
+    const Eigen::Vector3i c = g.array().floor().cast<int>();
+    // Distance from p to the nearest face of its own cell: every point outside the cube of
+    // shells 0..k is at least k cells + this far away.
+    const Eigen::Vector3d f = g - c.cast<double>();
+    const double wall = cell_ * std::min({f.x(), 1 - f.x(), f.y(), 1 - f.y(), f.z(), 1 - f.z()});
+    // Beyond this shell there are no cells.
+    const int last = ((c.array()).abs().max((c.array() - dims_.array() + 1).abs())).maxCoeff();
+    const int shells = std::min(last, static_cast<int>(std::ceil(max_distance / cell_)));
     int best = -1;
     double best_d2 = max_distance * max_distance;
+    auto scan = [&](int x, int y, int z) {
+      const int cell = index({x, y, z});
+      for (int j = start_[cell]; j < start_[cell + 1]; ++j) {
+        const int i = order_[j];
+        const double d2 = (points_[i].cast<double>() - p).squaredNorm();
+        if (d2 < best_d2) {
+          best_d2 = d2;
+          best = i;
+        }
+      }
+    };
     for (int k = 0; k <= shells; ++k) {
-      for (int dx = -k; dx <= k; ++dx)
-        for (int dy = -k; dy <= k; ++dy)
-          for (int dz = -k; dz <= k; ++dz) {
-            if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != k) continue;
-            const auto it = cells_.find(cell_key(c + Eigen::Vector3i(dx, dy, dz)));
-            if (it == cells_.end()) continue;
-            for (int i : it->second) {
-              const double d2 = (points_[i].cast<double>() - p).squaredNorm();
-              if (d2 < best_d2) {
-                best_d2 = d2;
-                best = i;
-              }
-            }
+      // The cells of shell k (Chebyshev distance k from c) inside the grid.
+      const Eigen::Vector3i a = (c.array() - k).max(0), b = (c.array() + k).min(dims_.array() - 1);
+      for (int x = a.x(); x <= b.x(); ++x)
+        for (int y = a.y(); y <= b.y(); ++y) {
+          if (std::max(std::abs(x - c.x()), std::abs(y - c.y())) == k) {
+            for (int z = a.z(); z <= b.z(); ++z) scan(x, y, z);
+          } else {
+            const int below = c.z() - k, above = c.z() + k;
+            if (below >= a.z() && below <= b.z()) scan(x, y, below);
+            if (k > 0 && above >= a.z() && above <= b.z()) scan(x, y, above);
           }
-      // Every point in shell k + 1 or beyond is at least k cells away.
-      if (best >= 0 && best_d2 <= (k * cell_) * (k * cell_)) break;
+        }
+      const double reach = k * cell_ + wall;
+      if (best >= 0 && best_d2 <= reach * reach) break;
     }
     return best;
   }
 
  private:
   Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const {
-    return (p / cell_).array().floor().cast<int>();
+    return ((p - lo_) / cell_).array().floor().cast<int>().max(0).min(dims_.array() - 1);
+  }
+  int index(const Eigen::Vector3i& c) const {
+    return (c.x() * dims_.y() + c.y()) * dims_.z() + c.z();
   }
   const std::vector<Eigen::Vector3f>& points_;
   double cell_;
-  std::unordered_map<int64_t, std::vector<int>> cells_;
+  Eigen::Vector3d lo_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3i dims_ = Eigen::Vector3i::Ones();
+  std::vector<int> start_, order_;
 };
 
 // Closest point of triangle abc to p (Ericson, Real-Time Collision Detection §5.1.5).
@@ -86,27 +129,28 @@ Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vecto
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
+}  // namespace
+
 // The previous mesh as ICP's target: nearest vertex by grid, then the closest point on the
 // triangles around it, with that triangle's normal (point-to-triangle: no bias from
-// tessellations that differ from frame to frame).
-struct Target {
-  const ActorMesh& mesh;
-  const VertexGrid& grid;
-  std::vector<std::vector<int>> triangles_of_vertex;
-  std::vector<Eigen::Vector3d> face_normals;
-
-  Target(const ActorMesh& m, const VertexGrid& g) : mesh(m), grid(g) {
-    triangles_of_vertex.resize(m.vertices.size());
-    face_normals.resize(m.triangles.size());
-    for (size_t t = 0; t < m.triangles.size(); ++t) {
-      const auto& tri = m.triangles[t];
-      const Eigen::Vector3d a = m.vertices[tri[0]].cast<double>();
-      const Eigen::Vector3d n =
-          (m.vertices[tri[1]].cast<double>() - a).cross(m.vertices[tri[2]].cast<double>() - a);
+// tessellations that differ from frame to frame). Built once per mesh; never moved (the grid
+// refers to the mesh's vertices).
+class MotionTarget {
+ public:
+  MotionTarget(ActorMesh m, double cell) : mesh(std::move(m)), grid(mesh.vertices, cell) {
+    triangles_of_vertex.resize(mesh.vertices.size());
+    face_normals.resize(mesh.triangles.size());
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const auto& tri = mesh.triangles[t];
+      const Eigen::Vector3d a = mesh.vertices[tri[0]].cast<double>();
+      const Eigen::Vector3d n = (mesh.vertices[tri[1]].cast<double>() - a)
+                                    .cross(mesh.vertices[tri[2]].cast<double>() - a);
       face_normals[t] = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
       for (uint32_t v : tri) triangles_of_vertex[v].push_back(static_cast<int>(t));
     }
   }
+  MotionTarget(const MotionTarget&) = delete;
+  MotionTarget& operator=(const MotionTarget&) = delete;
 
   // Closest surface point and its normal; false when no vertex is within max_distance.
   bool closest(const Eigen::Vector3d& p, double max_distance, Eigen::Vector3d* point,
@@ -129,7 +173,30 @@ struct Target {
     }
     return std::isfinite(best);
   }
+
+  const ActorMesh mesh;
+  const VertexGrid grid;
+  std::vector<std::vector<int>> triangles_of_vertex;
+  std::vector<Eigen::Vector3d> face_normals;
 };
+
+namespace {
+
+using Target = MotionTarget;
+
+double grid_cell(const MotionOptions& options) {
+  return std::max(0.01, options.max_correspondence_m / 8);
+}
+
+// A stratified sample of at most `budget` of `indices` (every k-th, evenly over the list; the
+// hull's vertex order is spatially coherent); budget 0: all of them.
+std::vector<int> stratified(const std::vector<int>& indices, int budget) {
+  if (budget <= 0 || indices.size() <= size_t(budget)) return indices;
+  std::vector<int> out(static_cast<size_t>(budget));
+  const double step = double(indices.size()) / budget;
+  for (int k = 0; k < budget; ++k) out[k] = indices[size_t((k + 0.5) * step)];
+  return out;
+}
 
 struct Fit {
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
@@ -140,9 +207,10 @@ struct Fit {
 
 // Point-to-plane ICP of the translation t with current = previous moved by t, over the current
 // vertices `indices`, damped towards `prior`.
+// `weight` scales the information of the result (members / sample of a subsampled fit).
 Fit icp_translation(const ActorMesh& current, const std::vector<int>& indices, const Target& target,
                     const Eigen::Vector3d& start, const Eigen::Vector3d& prior,
-                    const MotionOptions& options) {
+                    const MotionOptions& options, double weight = 1) {
   Fit fit;
   fit.translation = start;
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
@@ -161,7 +229,7 @@ Fit icp_translation(const ActorMesh& current, const std::vector<int>& indices, c
       ++used;
     }
     fit.used = used;
-    fit.information = a;
+    fit.information = weight * a;
     if (used < 3) break;
     fit.rms = std::sqrt(sum / used);
     const double lambda = options.damping * a.trace() / 3;
@@ -171,16 +239,15 @@ Fit icp_translation(const ActorMesh& current, const std::vector<int>& indices, c
                                       .solve(b - lambda * (fit.translation - prior));
     if (!delta.allFinite()) break;
     fit.translation += delta;
-    if (delta.norm() < 1e-7) break;
+    if (delta.norm() < options.converged_m) break;
   }
   return fit;
 }
 
-Expected<MeshMotion> estimate(const ActorMesh& previous, const ActorMesh& current,
+// previous: target.mesh, already validated.
+Expected<MeshMotion> estimate(const Target& target, const ActorMesh& current,
                               const MotionOptions& options, const MeshMotion* previous_motion) {
-  if (auto v = options.validate(); !v) return std::unexpected(v.error());
-  if (auto v = previous.validate(); !v) return fail("motion: previous " + v.error().message);
-  if (auto v = current.validate(); !v) return fail("motion: current " + v.error().message);
+  const ActorMesh& previous = target.mesh;
   const double dt = 1e-9 * static_cast<double>(current.capture_ns - previous.capture_ns);
   if (!(dt > 0))
     return fail(text("motion: the meshes' capture times do not increase (dt %.6f s)", dt));
@@ -188,16 +255,14 @@ Expected<MeshMotion> estimate(const ActorMesh& previous, const ActorMesh& curren
     return fail(
         text("motion: the meshes are %.3f s apart (more than %.3f s)", dt, options.max_dt_s));
 
-  const VertexGrid grid(previous.vertices, std::max(0.01, options.max_correspondence_m / 8));
-  const Target target(previous, grid);
   const std::vector<Eigen::Vector3f> current_normals = vertex_normals(current);
   MeshMotion motion;
   motion.dt_s = dt;
 
   std::vector<int> all(current.vertices.size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
-  const Fit global = icp_translation(current, all, target, Eigen::Vector3d::Zero(),
-                                     Eigen::Vector3d::Zero(), options);
+  const Fit global = icp_translation(current, stratified(all, options.global_fit_vertices), target,
+                                     Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), options);
   motion.global_velocity = global.translation / dt;
 
   std::unordered_map<int64_t, int> region_of_cell;
@@ -229,9 +294,10 @@ Expected<MeshMotion> estimate(const ActorMesh& previous, const ActorMesh& curren
     if (region.vertices < options.min_region_vertices) continue;
     // Started from, and damped towards, the whole mesh's translation (the convergence basin);
     // what the region sees weakly or not at all is replaced below.
-    const Fit fit = icp_translation(current, members[r], target, global.translation,
-                                    global.translation, options);
-    if (fit.used < options.min_region_vertices / 2) continue;
+    const std::vector<int> sample = stratified(members[r], options.fit_vertices);
+    const Fit fit = icp_translation(current, sample, target, global.translation, global.translation,
+                                    options, double(members[r].size()) / double(sample.size()));
+    if (fit.used < std::min<int>(sample.size(), options.min_region_vertices) / 2) continue;
     translation[r] = fit.translation;
     information[r] = fit.information;
     region.rms_m = fit.rms;
@@ -367,6 +433,12 @@ Expected<void> MotionOptions::validate() const {
   if (!(region_size_m > 0) || !std::isfinite(region_size_m))
     return fail("motion: region_size_m must be > 0");
   if (iterations < 1) return fail("motion: iterations must be >= 1");
+  if (!(converged_m > 0) || !std::isfinite(converged_m))
+    return fail("motion: converged_m must be > 0");
+  if (fit_vertices < 0 || (fit_vertices > 0 && fit_vertices < min_region_vertices))
+    return fail("motion: fit_vertices must be 0 (all) or >= min_region_vertices");
+  if (global_fit_vertices < 0 || (global_fit_vertices > 0 && global_fit_vertices < 3))
+    return fail("motion: global_fit_vertices must be 0 (all) or >= 3");
   if (!(max_correspondence_m > 0) || !std::isfinite(max_correspondence_m))
     return fail("motion: max_correspondence_m must be > 0");
   if (!(damping >= 0) || !std::isfinite(damping)) return fail("motion: damping must be >= 0");
@@ -375,21 +447,39 @@ Expected<void> MotionOptions::validate() const {
   return {};
 }
 
+namespace {
+Expected<void> check_pair(const ActorMesh& previous, const ActorMesh& current,
+                          const MotionOptions& options) {
+  if (auto v = options.validate(); !v) return std::unexpected(v.error());
+  if (auto v = previous.validate(); !v) return fail("motion: previous " + v.error().message);
+  if (auto v = current.validate(); !v) return fail("motion: current " + v.error().message);
+  return {};
+}
+}  // namespace
+
 Expected<MeshMotion> estimate_motion(const ActorMesh& previous, const ActorMesh& current,
                                      const MotionOptions& options) {
-  return estimate(previous, current, options, nullptr);
+  if (auto ok = check_pair(previous, current, options); !ok) return std::unexpected(ok.error());
+  const MotionTarget target(previous, grid_cell(options));
+  return estimate(target, current, options, nullptr);
 }
+
+MotionTracker::MotionTracker(MotionOptions options) : options_(std::move(options)) {}
+MotionTracker::~MotionTracker() = default;
+MotionTracker::MotionTracker(MotionTracker&&) noexcept = default;
+MotionTracker& MotionTracker::operator=(MotionTracker&&) noexcept = default;
 
 Expected<std::optional<MeshMotion>> MotionTracker::update(const ActorMesh& mesh) {
   if (auto v = mesh.validate(); !v) {
     reset();
     return std::unexpected(v.error());
   }
-  if (last_ && mesh.capture_ns <= last_->capture_ns)
+  if (auto v = options_.validate(); !v) return std::unexpected(v.error());
+  if (last_ && mesh.capture_ns <= last_->mesh.capture_ns)
     return fail("motion: a mesh no newer than the last one (ignored)");
   std::optional<MeshMotion> motion;
   if (last_ &&
-      1e-9 * static_cast<double>(mesh.capture_ns - last_->capture_ns) <= options_.max_dt_s) {
+      1e-9 * static_cast<double>(mesh.capture_ns - last_->mesh.capture_ns) <= options_.max_dt_s) {
     auto m = estimate(*last_, mesh, options_, last_motion_ ? &*last_motion_ : nullptr);
     if (!m) {
       reset();
@@ -397,9 +487,10 @@ Expected<std::optional<MeshMotion>> MotionTracker::update(const ActorMesh& mesh)
     }
     motion = std::move(*m);
   }
-  last_ = mesh;
-  last_motion_ = motion;
-  return motion;
+  // This mesh is the next one's target: its structure is built once, here.
+  last_ = std::make_unique<MotionTarget>(mesh, grid_cell(options_));
+  last_motion_ = std::move(motion);
+  return last_motion_;
 }
 
 void MotionTracker::reset() {

@@ -52,6 +52,9 @@ class MaskPlanner {
   Expected<void> set_mesh(const std::string& actor_id, std::uint64_t frame, ActorMesh mesh);
   void remove(const std::string& actor_id);
   void set_head_speed(const std::string& actor_id, double speed_mps);
+  // Replaces the margin options for the next plans (a margin sweep: floor = cap = the margin
+  // under test, prediction on or off). Errors: invalid options (the old ones stay).
+  Expected<void> set_margin_options(const MarginOptions& margin);
   std::size_t actors() const { return actors_.size(); }
 
   // The masks for a frame to be shown at display_ns (CLOCK_REALTIME).

@@ -29,11 +29,20 @@
 //    still torso along (limitation: parts closer than one region size share a cell and get one
 //    mixed velocity).
 //
+// Cost (the projector renders every 25 Hz mesh): each fit runs on a fixed budget of vertices,
+// not on all of them: the whole-mesh fit on global_fit_vertices, each region's on fit_vertices,
+// both a stratified sample (every k-th vertex in mesh order: the hull's marching cubes emit
+// vertices slice by slice, so a stride spreads the sample over the region). A fit's information
+// (sum n n^T) is scaled by members / sample so regions keep the weights of their full size when
+// cells combine them. The previous mesh's correspondence structure (vertex grid, triangles per
+// vertex, face normals) is built once, when that mesh arrives, and kept by MotionTracker.
+//
 // Velocity of a region = its translation / dt (the mean velocity over the two captures); its
 // acceleration = the change since the previous estimate of the velocity of the region that,
 // moved by its velocity, lands nearest, divided by the time between the two mean velocities.
 
 #include <Eigen/Core>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -44,7 +53,10 @@ namespace studio::projector {
 
 struct MotionOptions {
   double region_size_m = 0.15;
-  int iterations = 15;                 // ICP iterations per region (and for the whole mesh)
+  int iterations = 15;            // ICP iterations per region (and for the whole mesh), at most
+  double converged_m = 1e-5;      // an ICP step shorter than this ends the fit
+  int fit_vertices = 24;          // vertices per region fit (stratified sample); 0: all
+  int global_fit_vertices = 300;  // vertices of the whole-mesh fit; 0: all
   double max_correspondence_m = 0.25;  // no previous vertex nearer than this: vertex ignored
   // Damping of each region's fit towards no motion, relative to the region's
   // information (trace of sum n n^T / 3): small, it only steers directions the region cannot see.
@@ -93,15 +105,21 @@ Expected<MeshMotion> estimate_motion(const ActorMesh& previous, const ActorMesh&
 // accelerations from the previous estimate). The first mesh, or one after a gap longer than
 // max_dt_s or a rejected mesh, yields no motion (std::nullopt): the margin then falls back to
 // the no-prediction term.
+// The previous mesh as ICP's target (grid, triangles per vertex, face normals), built once.
+class MotionTarget;
+
 class MotionTracker {
  public:
-  explicit MotionTracker(MotionOptions options = {}) : options_(std::move(options)) {}
+  explicit MotionTracker(MotionOptions options = {});
+  ~MotionTracker();
+  MotionTracker(MotionTracker&&) noexcept;
+  MotionTracker& operator=(MotionTracker&&) noexcept;
   Expected<std::optional<MeshMotion>> update(const ActorMesh& mesh);
   void reset();
 
  private:
   MotionOptions options_;
-  std::optional<ActorMesh> last_;
+  std::unique_ptr<MotionTarget> last_;  // the last mesh and its target structure
   std::optional<MeshMotion> last_motion_;
 };
 
