@@ -6,7 +6,7 @@
 //  - quality against truth: a held-out camera that feeds nothing; the preview from its pose vs
 //    the simulator's image of that camera over the union of the true and rendered silhouettes,
 //    PSNR of nearest-camera texturing and of the blend: the blend beats nearest (the issue's
-//    28 dB is not reached yet: see the test).
+//    28 dB is not reached with the visual hull: see the test and preview_quality_test.cc).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -167,7 +167,7 @@ struct Score {
   int frames = 0;
   // Pixels by where they fall: both silhouettes, only the rendered, only the true.
   uint64_t both = 0, rendered_only = 0, true_only = 0;
-  double squared_both = 0;
+  double squared_both = 0, squared_rendered_only = 0, squared_true_only = 0;
   double psnr() const { return 10 * std::log10(255.0 * 255.0 / (squared / double(samples))); }
 };
 
@@ -204,6 +204,7 @@ Score score(const std::vector<Record>& records, const std::filesystem::path& dir
           s.squared_both += e;
         } else {
           ++(rendered ? s.rendered_only : s.true_only);
+          (rendered ? s.squared_rendered_only : s.squared_true_only) += e;
         }
       }
   }
@@ -229,7 +230,7 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
         mode, "preview/studio-preview",
         {"--headless", "--config", preview_config(mode, 1000), "--viewpoint", to_string(view),
          "--texturing", mode, "--size", std::to_string(kWidth) + "x" + std::to_string(kHeight),
-         "--frames", "20", "--timeout", "120", "--record", (dir_ / mode).string(), "--screenshot",
+         "--frames", "30", "--timeout", "120", "--record", (dir_ / mode).string(), "--screenshot",
          (dir_ / (mode + ".png")).string()});
   for (auto& [mode, p] : previews) {
     const auto code = p->wait_exit(std::chrono::seconds(150));
@@ -246,20 +247,25 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
       "held-out camera, union of silhouettes: nearest %.2f dB (%d frames), blend %.2f dB "
       "(%d frames)\n",
       nearest.psnr(), nearest.frames, blend.psnr(), blend.frames);
+  // Where the error is: the share of the summed squared error in each part of the union.
   for (const Score* sc : {&nearest, &blend})
     std::printf(
-        "  pixels in both silhouettes %llu (%.2f dB there), only rendered %llu, only true "
-        "%llu\n",
+        "  pixels in both silhouettes %llu (%.2f dB there, %.0f %% of the error), only rendered "
+        "%llu (%.0f %%), only true %llu (%.0f %%)\n",
         (unsigned long long)sc->both,
         10 * std::log10(255.0 * 255 / (sc->squared_both / (3.0 * sc->both))),
-        (unsigned long long)sc->rendered_only, (unsigned long long)sc->true_only);
+        100 * sc->squared_both / sc->squared, (unsigned long long)sc->rendered_only,
+        100 * sc->squared_rendered_only / sc->squared, (unsigned long long)sc->true_only,
+        100 * sc->squared_true_only / sc->squared);
   ASSERT_GE(nearest.frames, 10);
   ASSERT_GE(blend.frames, 10);
   EXPECT_GT(blend.psnr(), nearest.psnr());
-  // Issue 16 asks for >= 28 dB; measured here ~19.5 dB for the blend (~24.5 dB inside both
-  // silhouettes): the visual hull's excess over the actor (drawn in actor colours where the
-  // held-out camera sees the backing) and its misregistration cost the rest. Not reached yet:
-  // the number is printed above and reported, not asserted.
+  // Issue 16 asks >= 28 dB; measured 19-21 dB here (run to run: the poses differ). Not reached:
+  // ~60-70 % of the error is in pixels of one silhouette only, the visual hull's geometry (the
+  // hull of ring cameras 45 degrees apart exceeds a round body between cameras; its facets cut
+  // inside it elsewhere). preview_quality_test separates geometry from texturing: with the
+  // actor's true surface the same blend reaches 27.5 dB. Printed above and reported, not
+  // asserted.
 }
 
 }  // namespace

@@ -27,6 +27,7 @@ struct ViewPipeline::Impl {
   std::chrono::steady_clock::time_point pending_since;
   std::vector<std::string> pending_cameras;
   std::vector<float> pending_weights;
+  double pending_threshold = 0, current_threshold = 0;
   bool have_current = false, current_textured = false;
   FrameReport current;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -82,6 +83,7 @@ struct ViewPipeline::Impl {
     bo.cameras = std::min(bo.cameras, ActorTexturer::kMaxCameras);
     const auto chosen = options.blend ? preview::blend(poses, view.eye, centre, bo)
                                       : preview::nearest(poses, view.eye, centre);
+    pending_threshold = preview::blend_threshold(poses, view.eye, centre, bo);
     pending = std::move(*m);
     pending_since = std::chrono::steady_clock::now();
     pending_cameras.clear();
@@ -128,6 +130,7 @@ struct ViewPipeline::Impl {
     current.source_frame = pending->source_frame;
     current.cameras = pending_cameras;
     current.weights = pending_weights;
+    current_threshold = pending_threshold;
     have_current = true;
     ++counts.meshes;
     ++(textured ? counts.textured : counts.untextured);
@@ -167,7 +170,11 @@ FrameReport ViewPipeline::render(const Viewpoint& view, int width, int height, b
     std::array<float, ActorTexturer::kMaxCameras> w{};
     for (std::size_t i = 0; i < r.current.weights.size() && i < w.size(); ++i)
       w[i] = r.current.weights[i];
-    r.texturer.draw(v.clip_from_cam * v.cam_from_world, w, r.current.textured, width, height);
+    const TextureMode mode = !r.current.textured ? TextureMode::flat
+                             : r.options.blend   ? TextureMode::blend
+                                                 : TextureMode::nearest;
+    r.texturer.draw({v.clip_from_cam * v.cam_from_world, view.eye, width, height}, mode, w,
+                    r.current_threshold);
   }
   return report;
 }
