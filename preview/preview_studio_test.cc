@@ -49,27 +49,40 @@ Eigen::Matrix4d clip_from_world(const Viewpoint& v, int w, int h) {
 }
 
 // The frame code read from a rendered preview image (BGR), or nullopt when a band is hidden from
-// the viewpoint (by the true body at that frame) or does not read as a digit.
+// the viewpoint (by the true body at that frame) or does not read as one digit. Robust to the
+// blend mixing neighbouring bands where cameras disagree on where a band is (red and green mix
+// to yellow at a band's edge): each band is read at three heights (a quarter, half and three
+// quarters of it) over 3x3 pixels each, every pixel classified on its own; the band's digit is
+// the majority of the 27 when it has more than half of them and at least three times the votes
+// of any other digit, else the band (and the frame) is unread: counted, never a mismatch.
 std::optional<int> decode_preview(const cv::Mat& bgr, const Viewpoint& view,
                                   const sim::ActorBody& body) {
   const Eigen::Matrix4d clip = clip_from_world(view, bgr.cols, bgr.rows);
   std::vector<int> digits;
   for (int b = 0; b < sim::frame_code::kBands; ++b) {
-    const Eigen::Vector3d x = sim::frame_code::band_point(body, b, view.eye);
-    const auto hit = body.ray_hit(view.eye, (x - view.eye).normalized());
-    if (!hit || hit->part != int(sim::PartId::torso) || (hit->point - x).norm() > 0.01)
-      return std::nullopt;
-    bool ok = false;
-    const Eigen::Vector2d p = scene::project_to_pixel(clip, x, bgr.cols, bgr.rows, &ok);
-    const int u = int(p.x()), v = int(p.y());
-    if (!ok || u < 2 || v < 2 || u >= bgr.cols - 2 || v >= bgr.rows - 2) return std::nullopt;
-    double sum[3] = {0, 0, 0};
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const cv::Vec3b px = bgr.at<cv::Vec3b>(v + dy, u + dx);
-        for (int k = 0; k < 3; ++k) sum[k] += px[2 - k];  // BGR → RGB
-      }
-    digits.push_back(sim::frame_code::classify(sum[0] / 9, sum[1] / 9, sum[2] / 9));
+    int votes[3] = {0, 0, 0};
+    for (const double along : {0.25, 0.5, 0.75}) {
+      const Eigen::Vector3d x = sim::frame_code::band_point(body, b, view.eye, along);
+      const auto hit = body.ray_hit(view.eye, (x - view.eye).normalized());
+      if (!hit || hit->part != int(sim::PartId::torso) || (hit->point - x).norm() > 0.01)
+        return std::nullopt;
+      bool ok = false;
+      const Eigen::Vector2d p = scene::project_to_pixel(clip, x, bgr.cols, bgr.rows, &ok);
+      const int u = int(p.x()), v = int(p.y());
+      if (!ok || u < 2 || v < 2 || u >= bgr.cols - 2 || v >= bgr.rows - 2) return std::nullopt;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const cv::Vec3b px = bgr.at<cv::Vec3b>(v + dy, u + dx);
+          const int d = sim::frame_code::classify(px[2], px[1], px[0]);  // BGR → RGB
+          if (d >= 0) ++votes[d];
+        }
+    }
+    const int best = int(std::max_element(votes, votes + 3) - votes);
+    int runner_up = 0;
+    for (int d = 0; d < 3; ++d)
+      if (d != best) runner_up = std::max(runner_up, votes[d]);
+    if (2 * votes[best] <= 27 || votes[best] < 3 * runner_up) return std::nullopt;
+    digits.push_back(best);
   }
   return sim::frame_code::decode(digits);
 }
