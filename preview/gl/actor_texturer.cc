@@ -366,7 +366,12 @@ void ActorTexturer::draw(const DrawView& view, TextureMode mode,
   glViewport(0, 0, view.width, view.height);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
-  glDisable(GL_CULL_FACE);
+  // The mesh is closed and wound counter-clockwise seen from outside (hull/segment_mesh.h): its
+  // back faces are never the nearest surface, and culling them halves the fragments that run
+  // the texturing shader (its discard turns off the early depth test).
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CCW);
   glDisable(GL_BLEND);
   const GLuint p = r.draw_program;
   glUseProgram(p);
@@ -402,6 +407,7 @@ void ActorTexturer::draw(const DrawView& view, TextureMode mode,
     glUniform1i(at("depth" + std::to_string(i)), 2 * i + 1);
   }
   r.draw_mesh();
+  glDisable(GL_CULL_FACE);
   glActiveTexture(GL_TEXTURE0);
 }
 
