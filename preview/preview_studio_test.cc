@@ -16,11 +16,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <regex>
+#include <thread>
 
 #include "preview/viewpoint.h"
 #include "scene/view.h"
 #include "sim/frame_code.h"
 #include "sim/studio.h"
+#include "wire/endpoint.h"
+#include "wire/sample.h"
 #include "testing/studio_fixture.h"
 
 namespace studio::preview::testing {
@@ -112,6 +115,37 @@ TEST_F(PreviewStudioTest, BadInputIsOneLineAndExitTwo) {
   Process& help = spawn("help", "preview/studio-preview", {"--help"});
   EXPECT_EQ(help.wait_exit(std::chrono::seconds(20)), 0);
   EXPECT_NE(help.log().find("--headless"), std::string::npos);
+}
+
+// Like every service, the preview publishes studio/service/status: service "preview", its
+// instance, RUNNING with its counters while it runs, STOPPING at the end (so the other
+// previews' and studioctl's services panels list it).
+TEST_F(PreviewStudioTest, PublishesItsServiceStatus) {
+  auto participant = wire::Participant::create().value();
+  auto topic = wire::Topic<studio_ServiceStatus>::create(participant).value();
+  auto reader = wire::Reader<studio_ServiceStatus>::create(participant, topic).value();
+  Process& p = spawn("preview", "preview/studio-preview",
+                     {"--headless", "--config", preview_config("operator"), "--size", "64x48",
+                      "--duration", "4", "--screenshot", (dir_ / "s.png").string()});
+  bool running = false, stopping = false, counters = false;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (std::chrono::steady_clock::now() < deadline && !stopping) {
+    for (auto& s : reader.take()) {
+      if (!s.meta.valid_data) continue;
+      EXPECT_STREQ(s.data->service, "preview");
+      EXPECT_STREQ(s.data->instance, "operator");
+      EXPECT_EQ(s.data->pid, p.pid());
+      running |= s.data->state == studio_SERVICE_RUNNING;
+      stopping |= s.data->state == studio_SERVICE_STOPPING;
+      for (const auto& c : wire::view(s.data->counters))
+        counters |= std::string(c.name) == "meshes_in";
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_TRUE(running);
+  EXPECT_TRUE(stopping);
+  EXPECT_TRUE(counters) << "the node's counters are in the status";
+  EXPECT_EQ(p.wait_exit(30s), 0) << p.log();
 }
 
 TEST_F(PreviewStudioTest, TexturesEveryMeshWithTheImagesOfItsOwnFrame) {
