@@ -1,9 +1,11 @@
 # Helpers shared by every component's CMakeLists.txt.
 
-# studio_test(NAME name SOURCES a.cc b.cc LIBS lib... [LABELS unit|integration|gl|dataset] [TIMEOUT s])
+# studio_test(NAME name SOURCES a.cc b.cc LIBS lib... [LABELS unit|integration|gl|dataset] [TIMEOUT s] [SERIAL])
 # One gtest binary per call; tests are discovered individually so ctest reports each case.
 function(studio_test)
-  cmake_parse_arguments(T "" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  # SERIAL: ctest runs the binary's tests alone (RUN_SERIAL), for tests whose bounds need the
+  # machine's whole share (a running studio that must keep up with its capture rings).
+  cmake_parse_arguments(T "SERIAL" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT T_LABELS)
     set(T_LABELS unit)
   endif()
@@ -19,8 +21,14 @@ function(studio_test)
     STUDIO_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     STUDIO_SHARED_DATA="${STUDIO_SHARED_DATA}"
     STUDIO_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  # Before LABELS: a multi-valued LABELS ("integration;gl") is flattened into the property
+  # list, so the pairs after it do not reach ctest.
+  set(serial "")
+  if(T_SERIAL)
+    set(serial RUN_SERIAL TRUE)
+  endif()
   gtest_discover_tests(${T_NAME}
-    PROPERTIES LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT}
+    PROPERTIES ${serial} LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT}
     DISCOVERY_TIMEOUT 60)
   foreach(label ${T_LABELS})
     set_property(GLOBAL APPEND PROPERTY STUDIO_TESTS_${label} ${T_NAME})

@@ -30,6 +30,19 @@ TEST(CameraSelect, ViewAngleAtTheTarget) {
   EXPECT_DOUBLE_EQ(view_angle(t, at_azimuth(0), t), std::numbers::pi);  // degenerate
 }
 
+TEST(CameraSelect, BlendThresholdIsTheNextCamerasAngle) {
+  const Eigen::Vector3d t(0, 1, 0);
+  // The eye at 10 degrees: cameras at 0, 60, 300 (= -60), 120, ... The 4th nearest is 120
+  // degrees (110 from the eye); with two cameras the 3rd (-60: 70 degrees).
+  const double deg = std::numbers::pi / 180;
+  EXPECT_NEAR(blend_threshold(ring(), at_azimuth(10), t, {.cameras = 3}), 110 * deg, 1e-9);
+  EXPECT_NEAR(blend_threshold(ring(), at_azimuth(10), t, {.cameras = 2}), 70 * deg, 1e-9);
+  // At most k cameras: pi.
+  auto few = ring();
+  few.resize(3);
+  EXPECT_DOUBLE_EQ(blend_threshold(few, at_azimuth(10), t, {.cameras = 3}), std::numbers::pi);
+}
+
 TEST(CameraSelect, NearestIsTheSmallestAngleNotTheClosestCamera) {
   auto cams = ring();
   cams[2].centre *= 0.3;  // cam2 much closer to the target, same direction (120 degrees)

@@ -86,9 +86,11 @@ Fixture& fixture() {
 }
 
 // The view between cam0 and cam1, 4.5 m out.
+const Eigen::Vector3d kEye(1.6, 1.7, 4.2);
+constexpr double kThreshold = 1.6;  // the blend's threshold angle (radians), ~ the 4th camera's
 scene_render::View view() {
   scene_render::View v;
-  v.cam_from_world = scene::look_at({1.6, 1.7, 4.2}, {0, 1.0, 0});
+  v.cam_from_world = scene::look_at(kEye, {0, 1.0, 0});
   v.clip_from_cam = scene::perspective(50 * std::numbers::pi / 180, double(kW) / kH, 0.05, 200);
   return v;
 }
@@ -116,7 +118,10 @@ void BM_PreviewFrame(benchmark::State& state) {
   for (auto _ : state) {
     f.target.bind();
     f.renderer.draw(f.scene, v);
-    if (cameras > 0) f.texturer.draw(v.clip_from_cam * v.cam_from_world, w, true, kW, kH);
+    if (cameras > 0)
+      f.texturer.draw({v.clip_from_cam * v.cam_from_world, kEye, kW, kH},
+                      cameras == 1 ? preview::TextureMode::nearest : preview::TextureMode::blend, w,
+                      kThreshold);
     glFinish();
   }
   state.counters["fps"] =

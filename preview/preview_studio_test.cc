@@ -6,7 +6,7 @@
 //  - quality against truth: a held-out camera that feeds nothing; the preview from its pose vs
 //    the simulator's image of that camera over the union of the true and rendered silhouettes,
 //    PSNR of nearest-camera texturing and of the blend: the blend beats nearest (the issue's
-//    28 dB is not reached yet: see the test).
+//    28 dB is not reached with the visual hull: see the test and preview_quality_test.cc).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,11 +16,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <regex>
+#include <thread>
 
 #include "preview/viewpoint.h"
 #include "scene/view.h"
 #include "sim/frame_code.h"
 #include "sim/studio.h"
+#include "wire/endpoint.h"
+#include "wire/sample.h"
 #include "testing/studio_fixture.h"
 
 namespace studio::preview::testing {
@@ -49,27 +52,40 @@ Eigen::Matrix4d clip_from_world(const Viewpoint& v, int w, int h) {
 }
 
 // The frame code read from a rendered preview image (BGR), or nullopt when a band is hidden from
-// the viewpoint (by the true body at that frame) or does not read as a digit.
+// the viewpoint (by the true body at that frame) or does not read as one digit. Robust to the
+// blend mixing neighbouring bands where cameras disagree on where a band is (red and green mix
+// to yellow at a band's edge): each band is read at three heights (a quarter, half and three
+// quarters of it) over 3x3 pixels each, every pixel classified on its own; the band's digit is
+// the majority of the 27 when it has more than half of them and at least three times the votes
+// of any other digit, else the band (and the frame) is unread: counted, never a mismatch.
 std::optional<int> decode_preview(const cv::Mat& bgr, const Viewpoint& view,
                                   const sim::ActorBody& body) {
   const Eigen::Matrix4d clip = clip_from_world(view, bgr.cols, bgr.rows);
   std::vector<int> digits;
   for (int b = 0; b < sim::frame_code::kBands; ++b) {
-    const Eigen::Vector3d x = sim::frame_code::band_point(body, b, view.eye);
-    const auto hit = body.ray_hit(view.eye, (x - view.eye).normalized());
-    if (!hit || hit->part != int(sim::PartId::torso) || (hit->point - x).norm() > 0.01)
-      return std::nullopt;
-    bool ok = false;
-    const Eigen::Vector2d p = scene::project_to_pixel(clip, x, bgr.cols, bgr.rows, &ok);
-    const int u = int(p.x()), v = int(p.y());
-    if (!ok || u < 2 || v < 2 || u >= bgr.cols - 2 || v >= bgr.rows - 2) return std::nullopt;
-    double sum[3] = {0, 0, 0};
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const cv::Vec3b px = bgr.at<cv::Vec3b>(v + dy, u + dx);
-        for (int k = 0; k < 3; ++k) sum[k] += px[2 - k];  // BGR → RGB
-      }
-    digits.push_back(sim::frame_code::classify(sum[0] / 9, sum[1] / 9, sum[2] / 9));
+    int votes[3] = {0, 0, 0};
+    for (const double along : {0.25, 0.5, 0.75}) {
+      const Eigen::Vector3d x = sim::frame_code::band_point(body, b, view.eye, along);
+      const auto hit = body.ray_hit(view.eye, (x - view.eye).normalized());
+      if (!hit || hit->part != int(sim::PartId::torso) || (hit->point - x).norm() > 0.01)
+        return std::nullopt;
+      bool ok = false;
+      const Eigen::Vector2d p = scene::project_to_pixel(clip, x, bgr.cols, bgr.rows, &ok);
+      const int u = int(p.x()), v = int(p.y());
+      if (!ok || u < 2 || v < 2 || u >= bgr.cols - 2 || v >= bgr.rows - 2) return std::nullopt;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const cv::Vec3b px = bgr.at<cv::Vec3b>(v + dy, u + dx);
+          const int d = sim::frame_code::classify(px[2], px[1], px[0]);  // BGR → RGB
+          if (d >= 0) ++votes[d];
+        }
+    }
+    const int best = int(std::max_element(votes, votes + 3) - votes);
+    int runner_up = 0;
+    for (int d = 0; d < 3; ++d)
+      if (d != best) runner_up = std::max(runner_up, votes[d]);
+    if (2 * votes[best] <= 27 || votes[best] < 3 * runner_up) return std::nullopt;
+    digits.push_back(best);
   }
   return sim::frame_code::decode(digits);
 }
@@ -99,6 +115,37 @@ TEST_F(PreviewStudioTest, BadInputIsOneLineAndExitTwo) {
   Process& help = spawn("help", "preview/studio-preview", {"--help"});
   EXPECT_EQ(help.wait_exit(std::chrono::seconds(20)), 0);
   EXPECT_NE(help.log().find("--headless"), std::string::npos);
+}
+
+// Like every service, the preview publishes studio/service/status: service "preview", its
+// instance, RUNNING with its counters while it runs, STOPPING at the end (so the other
+// previews' and studioctl's services panels list it).
+TEST_F(PreviewStudioTest, PublishesItsServiceStatus) {
+  auto participant = wire::Participant::create().value();
+  auto topic = wire::Topic<studio_ServiceStatus>::create(participant).value();
+  auto reader = wire::Reader<studio_ServiceStatus>::create(participant, topic).value();
+  Process& p = spawn("preview", "preview/studio-preview",
+                     {"--headless", "--config", preview_config("operator"), "--size", "64x48",
+                      "--duration", "4", "--screenshot", (dir_ / "s.png").string()});
+  bool running = false, stopping = false, counters = false;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (std::chrono::steady_clock::now() < deadline && !stopping) {
+    for (auto& s : reader.take()) {
+      if (!s.meta.valid_data) continue;
+      EXPECT_STREQ(s.data->service, "preview");
+      EXPECT_STREQ(s.data->instance, "operator");
+      EXPECT_EQ(s.data->pid, p.pid());
+      running |= s.data->state == studio_SERVICE_RUNNING;
+      stopping |= s.data->state == studio_SERVICE_STOPPING;
+      for (const auto& c : wire::view(s.data->counters))
+        counters |= std::string(c.name) == "meshes_in";
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_TRUE(running);
+  EXPECT_TRUE(stopping);
+  EXPECT_TRUE(counters) << "the node's counters are in the status";
+  EXPECT_EQ(p.wait_exit(30s), 0) << p.log();
 }
 
 TEST_F(PreviewStudioTest, TexturesEveryMeshWithTheImagesOfItsOwnFrame) {
@@ -167,7 +214,7 @@ struct Score {
   int frames = 0;
   // Pixels by where they fall: both silhouettes, only the rendered, only the true.
   uint64_t both = 0, rendered_only = 0, true_only = 0;
-  double squared_both = 0;
+  double squared_both = 0, squared_rendered_only = 0, squared_true_only = 0;
   double psnr() const { return 10 * std::log10(255.0 * 255.0 / (squared / double(samples))); }
 };
 
@@ -204,6 +251,7 @@ Score score(const std::vector<Record>& records, const std::filesystem::path& dir
           s.squared_both += e;
         } else {
           ++(rendered ? s.rendered_only : s.true_only);
+          (rendered ? s.squared_rendered_only : s.squared_true_only) += e;
         }
       }
   }
@@ -229,7 +277,7 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
         mode, "preview/studio-preview",
         {"--headless", "--config", preview_config(mode, 1000), "--viewpoint", to_string(view),
          "--texturing", mode, "--size", std::to_string(kWidth) + "x" + std::to_string(kHeight),
-         "--frames", "20", "--timeout", "120", "--record", (dir_ / mode).string(), "--screenshot",
+         "--frames", "30", "--timeout", "120", "--record", (dir_ / mode).string(), "--screenshot",
          (dir_ / (mode + ".png")).string()});
   for (auto& [mode, p] : previews) {
     const auto code = p->wait_exit(std::chrono::seconds(150));
@@ -246,20 +294,25 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
       "held-out camera, union of silhouettes: nearest %.2f dB (%d frames), blend %.2f dB "
       "(%d frames)\n",
       nearest.psnr(), nearest.frames, blend.psnr(), blend.frames);
+  // Where the error is: the share of the summed squared error in each part of the union.
   for (const Score* sc : {&nearest, &blend})
     std::printf(
-        "  pixels in both silhouettes %llu (%.2f dB there), only rendered %llu, only true "
-        "%llu\n",
+        "  pixels in both silhouettes %llu (%.2f dB there, %.0f %% of the error), only rendered "
+        "%llu (%.0f %%), only true %llu (%.0f %%)\n",
         (unsigned long long)sc->both,
         10 * std::log10(255.0 * 255 / (sc->squared_both / (3.0 * sc->both))),
-        (unsigned long long)sc->rendered_only, (unsigned long long)sc->true_only);
+        100 * sc->squared_both / sc->squared, (unsigned long long)sc->rendered_only,
+        100 * sc->squared_rendered_only / sc->squared, (unsigned long long)sc->true_only,
+        100 * sc->squared_true_only / sc->squared);
   ASSERT_GE(nearest.frames, 10);
   ASSERT_GE(blend.frames, 10);
   EXPECT_GT(blend.psnr(), nearest.psnr());
-  // Issue 16 asks for >= 28 dB; measured here ~19.5 dB for the blend (~24.5 dB inside both
-  // silhouettes): the visual hull's excess over the actor (drawn in actor colours where the
-  // held-out camera sees the backing) and its misregistration cost the rest. Not reached yet:
-  // the number is printed above and reported, not asserted.
+  // Issue 16 asks >= 28 dB; measured 19-21 dB here (run to run: the poses differ). Not reached:
+  // ~60-70 % of the error is in pixels of one silhouette only, the visual hull's geometry (the
+  // hull of ring cameras 45 degrees apart exceeds a round body between cameras; its facets cut
+  // inside it elsewhere). preview_quality_test separates geometry from texturing: with the
+  // actor's true surface the same blend reaches 27.5 dB. Printed above and reported, not
+  // asserted.
 }
 
 }  // namespace

@@ -63,6 +63,24 @@ TEST(FrameCode, DigitsAndDecodeAreInverse) {
   EXPECT_EQ(frame_code::classify(30, 66, 212), -1);  // the cloth
 }
 
+TEST(FrameCode, BandPointsLieInTheirBandAtEveryHeight) {
+  auto studio = SimulatedStudio::create(ring_cameras({})).value();
+  const FrameTruth truth = studio.truth(40);
+  const Part& torso = truth.body.part(PartId::torso);
+  const Eigen::Vector3d eye(1.0, 1.6, 4.0);
+  for (int b = 0; b < frame_code::kBands; ++b)
+    for (double along : {0.05, 0.25, 0.5, 0.75, 0.95}) {
+      const Eigen::Vector3d x = frame_code::band_point(truth.body, b, eye, along);
+      const Eigen::Vector3d u =
+          (torso.axes.transpose() * (x - torso.centre)).cwiseQuotient(torso.radii);
+      EXPECT_NEAR(u.norm(), 1.0, 1e-9) << "on the torso's surface";
+      EXPECT_EQ(frame_code::band_of(u.y()), b) << b << " at " << along;
+    }
+  // The default is the centre.
+  EXPECT_TRUE(frame_code::band_point(truth.body, 1, eye)
+                  .isApprox(frame_code::band_point(truth.body, 1, eye, 0.5)));
+}
+
 TEST(FrameCode, ReadsBackFromEveryCameraImage) {
   RingOptions ring;
   ring.count = 5;

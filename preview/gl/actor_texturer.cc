@@ -28,27 +28,33 @@ constexpr const char* kDrawVs = R"(#version 330 core
 layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 normal;
 uniform mat4 clip_from_world;
+uniform float inflate;  // blend mode: the mesh pushed out along its normals (carved back below)
 out vec3 p;
 out vec3 n;
 void main() {
-  p = world;
+  p = world + inflate * normal;
   n = normal;
-  gl_Position = clip_from_world * vec4(world, 1);
+  gl_Position = clip_from_world * vec4(p, 1);
 })";
-// Slots: clip (the camera's clip_from_world), cam (cam_from_world), colour and depth textures.
-// Slots 0..2: clip (the camera's clip_from_world), cam (cam_from_world), colour and depth
-// textures (separate uniforms: GLSL 3.30 cannot index sampler arrays with a loop variable).
+// Slots 0..2: clip (the camera's clip_from_world), cam (cam_from_world), centre (world), colour
+// and depth textures (separate samplers: GLSL 3.30 cannot index sampler arrays with a loop
+// variable). mode: 0 flat, 1 nearest, 2 blend (actor_texturer.h).
 constexpr const char* kDrawFs = R"(#version 330 core
 in vec3 p;
 in vec3 n;
-uniform int textured;
+uniform int mode;
+uniform vec3 eye;
 uniform vec3 flat_colour;
 uniform vec3 unseen;
 uniform float tolerance;
 uniform float key_margin;
+uniform float carve_step;
+uniform int carve_steps;
+uniform float angle_threshold;
 uniform float weight[3];
 uniform mat4 clip[3];
 uniform mat4 cam[3];
+uniform vec3 centre[3];
 uniform sampler2D colour0, colour1, colour2;
 uniform sampler2D depth0, depth1, depth2;
 out vec4 frag;
@@ -58,32 +64,75 @@ vec3 shade(vec3 c) {
   return c * l;
 }
 // The cyclorama's key (keyer/: blue exceeds red and green by a margin): a camera whose pixel
-// at the point is backing blue sees past the actor there (the hull is larger than the actor).
+// at the point is backing blue sees past the actor there.
 bool backing(vec3 c) { return c.b > c.r + key_margin && c.b > c.g + key_margin; }
-void add(int i, sampler2D colour, sampler2D depth, inout vec3 sum, inout float wsum,
-         inout int keyed) {
+// Camera i's image position of x (uv, rows top first) and its depth-map position; false when x
+// is behind camera i or outside its image.
+bool project(int i, vec3 x, out vec2 uv, out vec2 st) {
+  vec4 q = clip[i] * vec4(x, 1);
+  if (q.w <= 0.0) return false;
+  vec2 ndc = q.xy / q.w;
+  if (any(greaterThan(abs(ndc), vec2(1.0)))) return false;
+  st = ndc * 0.5 + 0.5;
+  uv = vec2(st.x, 1.0 - st.y);
+  return true;
+}
+// Camera i (selected) sees the backing at x: x is outside its silhouette.
+bool outside(int i, sampler2D colour, vec3 x) {
+  if (weight[i] <= 0.0) return false;
+  vec2 uv, st;
+  if (!project(i, x, uv, st)) return false;
+  return backing(texture(colour, uv).rgb);
+}
+void add(int i, sampler2D colour, sampler2D depth, vec3 x, float tol, inout vec3 sum,
+         inout float wsum, inout int keyed) {
   if (weight[i] <= 0.0) return;
-  vec4 q = clip[i] * vec4(p, 1);
-  if (q.w <= 0.0) return;
-  vec3 ndc = q.xyz / q.w;
-  if (any(greaterThan(abs(ndc.xy), vec2(1.0)))) return;
-  float z = (cam[i] * vec4(p, 1)).z;
-  float seen = texture(depth, ndc.xy * 0.5 + 0.5).r;
-  if (z > seen + tolerance) return;  // another part of the actor is nearer to camera i
-  vec2 uv = vec2(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);  // image rows top first
+  vec2 uv, st;
+  if (!project(i, x, uv, st)) return;
+  float z = (cam[i] * vec4(x, 1)).z;
+  if (z > texture(depth, st).r + tol) return;  // another part of the actor is nearer to camera i
   vec3 c = texture(colour, uv).rgb;
   if (backing(c)) { keyed += 1; return; }
-  sum += weight[i] * c;
-  wsum += weight[i];
+  float w = weight[i];
+  if (mode == 2) {  // ULR at x: (1 - a / a_thr) / a, a = angle(novel ray, camera ray)
+    vec3 to_cam = normalize(centre[i] - x);
+    float a = acos(clamp(dot(normalize(eye - x), to_cam), -1.0, 1.0));
+    a = max(a, 1e-3);
+    w = max((1.0 - a / angle_threshold) / a, 1e-4);
+    // ULR's resolution penalty, simplest form: a camera sees x's surface foreshortened (and
+    // mixed with the backing's spill near its rim) as cos(normal, ray to camera) falls.
+    w *= max(abs(dot(normalize(n), to_cam)), 0.05);
+  }
+  sum += w * c;
+  wsum += w;
 }
 void main() {
-  if (textured == 0) { frag = vec4(shade(flat_colour), 1); return; }
+  if (mode == 0) { frag = vec4(shade(flat_colour), 1); return; }
+  vec3 x = p;
+  float carved = 0.0;
+  if (mode == 2 && carve_steps > 0) {
+    // The image-based visual hull along the novel ray: the first point inside every selected
+    // camera's silhouette.
+    vec3 d = normalize(p - eye);
+    bool found = false;
+    for (int s = 0; s < carve_steps; ++s) {
+      vec3 y = p + d * (float(s) * carve_step);
+      if (!outside(0, colour0, y) && !outside(1, colour1, y) && !outside(2, colour2, y)) {
+        x = y;
+        carved = float(s) * carve_step;
+        found = true;
+        break;
+      }
+    }
+    if (!found) discard;
+  }
   vec3 sum = vec3(0);
   float wsum = 0.0;
   int keyed = 0;
-  add(0, colour0, depth0, sum, wsum, keyed);
-  add(1, colour1, depth1, sum, wsum, keyed);
-  add(2, colour2, depth2, sum, wsum, keyed);
+  float tol = tolerance + carved;
+  add(0, colour0, depth0, x, tol, sum, wsum, keyed);
+  add(1, colour1, depth1, x, tol, sum, wsum, keyed);
+  add(2, colour2, depth2, x, tol, sum, wsum, keyed);
   if (wsum == 0.0 && keyed > 0) discard;  // every camera that sees the point sees the backing
   frag = vec4(wsum > 0.0 ? sum / wsum : shade(unseen), 1);
 })";
@@ -143,6 +192,7 @@ struct Slot {
   GLuint colour = 0, depth = 0, fbo = 0, depth_rb = 0;
   int width = 0, height = 0;
   Eigen::Matrix4d clip = Eigen::Matrix4d::Identity(), cam = Eigen::Matrix4d::Identity();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // world
 };
 
 }  // namespace
@@ -288,6 +338,7 @@ Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const u
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGB, GL_UNSIGNED_BYTE, rgb);
   s.cam = cam_from_world(camera);
+  s.centre = camera.centre_in_world();
   s.clip = clip_from_camera(camera) * s.cam;
   // Visibility: the nearest depth of the mesh along every pixel's ray of this camera.
   glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
@@ -308,39 +359,55 @@ Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const u
   return {};
 }
 
-void ActorTexturer::draw(const Eigen::Matrix4d& clip_from_world,
-                         const std::array<float, kMaxCameras>& weights, bool textured, int width,
-                         int height) {
+void ActorTexturer::draw(const DrawView& view, TextureMode mode,
+                         const std::array<float, kMaxCameras>& weights, double angle_threshold) {
   Impl& r = *impl_;
   if (r.index_count == 0) return;
-  glViewport(0, 0, width, height);
+  glViewport(0, 0, view.width, view.height);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
-  glDisable(GL_CULL_FACE);
+  // The mesh is closed and wound counter-clockwise seen from outside (hull/segment_mesh.h): its
+  // back faces are never the nearest surface, and culling them halves the fragments that run
+  // the texturing shader (its discard turns off the early depth test).
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CCW);
   glDisable(GL_BLEND);
   const GLuint p = r.draw_program;
   glUseProgram(p);
-  set_matrix(p, "clip_from_world", clip_from_world);
-  glUniform1i(glGetUniformLocation(p, "textured"), textured ? 1 : 0);
-  glUniform3fv(glGetUniformLocation(p, "flat_colour"), 1, r.options.untextured.data());
-  glUniform3fv(glGetUniformLocation(p, "unseen"), 1, r.options.unseen.data());
-  glUniform1f(glGetUniformLocation(p, "tolerance"), r.options.depth_tolerance_m);
-  glUniform1f(glGetUniformLocation(p, "key_margin"), r.options.key_margin);
+  auto at = [&](const std::string& name) { return glGetUniformLocation(p, name.c_str()); };
+  set_matrix(p, "clip_from_world", view.clip_from_world);
+  const int m = mode == TextureMode::flat ? 0 : mode == TextureMode::nearest ? 1 : 2;
+  const TexturerOptions& o = r.options;
+  glUniform1i(at("mode"), m);
+  glUniform3f(at("eye"), float(view.eye.x()), float(view.eye.y()), float(view.eye.z()));
+  glUniform1f(at("inflate"), m == 2 ? o.inflate_m : 0.0f);
+  glUniform3fv(at("flat_colour"), 1, o.untextured.data());
+  glUniform3fv(at("unseen"), 1, o.unseen.data());
+  glUniform1f(at("tolerance"), o.depth_tolerance_m + (m == 2 ? o.inflate_m : 0.0f));
+  glUniform1f(at("key_margin"), o.key_margin);
+  glUniform1f(at("carve_step"), o.carve_step_m);
+  glUniform1i(at("carve_steps"), o.carve_steps);
+  glUniform1f(at("angle_threshold"), float(angle_threshold > 0 ? angle_threshold : 3.14159265));
   for (int i = 0; i < kMaxCameras; ++i) {
     const Slot& s = r.slots[i];
     const std::string k = "[" + std::to_string(i) + "]";
-    const float w = s.colour ? weights[i] : 0.0f;
-    glUniform1f(glGetUniformLocation(p, ("weight" + k).c_str()), w);
+    float w = s.colour ? weights[i] : 0.0f;
+    if (mode == TextureMode::nearest && i > 0) w = 0;
+    glUniform1f(at("weight" + k), w);
     set_matrix(p, ("clip" + k).c_str(), s.clip);
     set_matrix(p, ("cam" + k).c_str(), s.cam);
+    const Eigen::Vector3f c = s.centre.cast<float>();
+    glUniform3f(at("centre" + k), c.x(), c.y(), c.z());
     glActiveTexture(GL_TEXTURE0 + 2 * i);
     glBindTexture(GL_TEXTURE_2D, s.colour);
-    glUniform1i(glGetUniformLocation(p, ("colour" + std::to_string(i)).c_str()), 2 * i);
+    glUniform1i(at("colour" + std::to_string(i)), 2 * i);
     glActiveTexture(GL_TEXTURE0 + 2 * i + 1);
     glBindTexture(GL_TEXTURE_2D, s.depth);
-    glUniform1i(glGetUniformLocation(p, ("depth" + std::to_string(i)).c_str()), 2 * i + 1);
+    glUniform1i(at("depth" + std::to_string(i)), 2 * i + 1);
   }
   r.draw_mesh();
+  glDisable(GL_CULL_FACE);
   glActiveTexture(GL_TEXTURE0);
 }
 

@@ -2,18 +2,31 @@
 // The live actor textured from the studio cameras (issue 16), drawn after the scene renderer
 // into the same framebuffer (depth test against the scene's depth).
 //
-// Per surface point x of the actor mesh and per selected camera i (up to kMaxCameras):
-//   visible_i(x): x projects inside camera i's image, in front of it, and no other part of the
-//                 mesh is nearer to camera i along that ray (a depth map of the mesh rendered
-//                 from camera i, tolerance `depth_tolerance_m`);
-//   backing_i(x): camera i's pixel at x is the blue backing (blue above red and green by
-//                 `key_margin`, the chroma key's rule): camera i sees past the actor there;
-//   colour(x)   = sum_i w_i v_i(x) image_i(proj_i(x)) / sum_i w_i v_i(x), v_i = visible_i and
-//                 not backing_i,
-// with the weights of camera_select.h (nearest: one camera of weight 1). A point every camera
-// that sees it sees as backing is not drawn (the visual hull's excess over the actor); a point
-// no selected camera sees is drawn in `unseen` (flat); an untextured draw (no images of the mesh's
-// frame) draws the whole mesh flat-shaded in `untextured`. Cameras are pinholes (K, cam_from_world,
+// Three modes (TextureMode):
+//   flat:    the whole mesh flat-shaded in `untextured` (no images of the mesh's frame);
+//   nearest: the paper's: every surface point x coloured from one camera (slot 0) where it sees
+//            x (visible_0 below) and not the backing there, else `unseen`; a point that camera
+//            sees as backing is not drawn;
+//   blend:   beyond the paper, image-based refinement of the hull and view-dependent blending of
+//            up to kMaxCameras cameras (unstructured lumigraph rendering, Buehler et al. 2001):
+//     1. carving (the image-based visual hull of Matusik et al. 2000, per pixel): the mesh is
+//        drawn pushed out along its normals by `inflate_m`; from each fragment the novel view's
+//        ray is marched inwards in steps of `carve_step_m` (at most `carve_steps`) to the first
+//        point x that no selected camera sees as backing (the point is inside every selected
+//        camera's silhouette, at the cameras' pixel resolution instead of the hull's voxel
+//        grid). No such point: the fragment is discarded (the hull's excess over the actor).
+//     2. per camera i: visible_i(x): x projects inside camera i's image, in front of it, and no
+//        other part of the mesh is nearer to camera i along that ray (a depth map of the mesh
+//        rendered from camera i, shadow-map style, tolerance `depth_tolerance_m` plus the
+//        carved depth); backing_i(x): camera i's pixel at x is the blue backing (blue above red
+//        and green by `key_margin`, the chroma key's rule);
+//     3. colour(x) = sum_i w_i v_i image_i(proj_i(x)) / sum_i w_i v_i, v_i = visible_i and not
+//        backing_i, with per-point ULR weights w_i = cos_i (1 - a_i / a_thr) / a_i, a_i the
+//        angle at x between the novel view's ray and camera i's ray, a_thr the blend's
+//        threshold angle (camera_select.h), cos_i = |normal . ray to camera i| (ULR's
+//        resolution penalty: a grazing view is foreshortened and spilled). A camera that cannot
+//        see x does not colour it.
+// A point no camera sees is drawn in `unseen` (flat). Cameras are pinholes (K, cam_from_world,
 // image size; the paper's radial distortion is ignored here: below a pixel for the studio's lenses
 // at the preview's scale). Needs a current OpenGL 3.3 core context; GL names are plain unsigned
 // ints.
@@ -33,8 +46,23 @@ namespace studio::preview {
 struct TexturerOptions {
   float depth_tolerance_m = 0.03f;
   float key_margin = 0.2f;  // of full scale: the backing is blue above red and green by this
+  // Blend mode's carving (above): push-out, march step and steps. The push-out recovers the
+  // hull's flat facets cutting inside a round body (the march takes it back where a camera
+  // sees the backing); 0 for a mesh that is the true surface.
+  float inflate_m = 0.005f;
+  float carve_step_m = 0.004f;
+  int carve_steps = 32;
   Eigen::Vector3f unseen{0.35f, 0.35f, 0.35f};
   Eigen::Vector3f untextured{0.75f, 0.72f, 0.68f};
+};
+
+enum class TextureMode { flat, nearest, blend };
+
+// The novel (virtual) camera: clip_from_world and its centre, and the target's size.
+struct DrawView {
+  Eigen::Matrix4d clip_from_world = Eigen::Matrix4d::Identity();
+  Eigen::Vector3d eye = Eigen::Vector3d::Zero();
+  int width = 0, height = 0;
 };
 
 class ActorTexturer {
@@ -51,10 +79,11 @@ class ActorTexturer {
   // row first). Renders the slot's visibility depth map of the current mesh: call after
   // set_mesh().
   Expected<void> set_camera(int slot, const Camera& camera, const uint8_t* rgb);
-  // Draws the mesh into the bound framebuffer. weights[slot] > 0 selects a slot; textured false:
-  // flat, untextured. Restores the viewport to (width, height).
-  void draw(const Eigen::Matrix4d& clip_from_world, const std::array<float, kMaxCameras>& weights,
-            bool textured, int width, int height);
+  // Draws the mesh into the bound framebuffer (viewport set to width x height). weights[slot] > 0
+  // selects a slot (nearest: slot 0 only); blend: per-point ULR weights with threshold angle
+  // `angle_threshold` (radians) replace the weights' values.
+  void draw(const DrawView& view, TextureMode mode, const std::array<float, kMaxCameras>& weights,
+            double angle_threshold = 0);
 
  private:
   struct Impl;

@@ -18,6 +18,7 @@
 
 #include "panels.h"
 #include "runtime/metrics.h"
+#include "status_ticker.h"
 #include "view_pipeline.h"
 #include "wire/entity.h"
 
@@ -188,6 +189,8 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
     runtime::NodeContext context{*participant, metrics, config.instance};
     PreviewNode node(context, config.instance + "-" + std::to_string(::getpid()));
     if (auto ok = node.start(); !ok) return error(ok.error().message);
+    auto service_status = StatusTicker::create(context, node);
+    if (!service_status) return error(service_status.error().message);
     PipelineOptions po;
     po.blend = config.blend;
     po.blend_options.cameras = config.blend_cameras;
@@ -204,6 +207,7 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
     std::string screenshot_path;
     while (running && !glfwWindowShouldClose(window)) {
       glfwPollEvents();
+      service_status->tick();
       int w = 0, h = 0;
       glfwGetFramebufferSize(window, &w, &h);
       if (w < 1 || h < 1) continue;
@@ -253,6 +257,7 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
       glfwSwapBuffers(window);
     }
     if (!script->ok()) status = 2;
+    service_status->stopping();
     node.stop();
   }
   ImGui_ImplOpenGL3_Shutdown();

@@ -14,6 +14,7 @@
 #include "runtime/metrics.h"
 #include "scene_render/egl_context.h"
 #include "scene_render/render_target.h"
+#include "status_ticker.h"
 #include "view_pipeline.h"
 #include "wire/entity.h"
 
@@ -56,6 +57,8 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   const std::string requester = config.instance + "-" + std::to_string(::getpid());
   PreviewNode node(node_context, requester);
   if (auto ok = node.start(); !ok) return error(ok.error().message, 1);
+  auto status = StatusTicker::create(node_context, node);
+  if (!status) return error(status.error().message, 1);
   PipelineOptions po;
   po.blend = config.blend;
   po.blend_options.cameras = config.blend_cameras;
@@ -74,6 +77,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   const auto deadline = start + std::chrono::duration<double>(limit_s);
   int drawn = 0;
   while (Clock::now() < deadline) {
+    status->tick();
     if (options.frames > 0 && !(*pipeline)->has_work()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(3));
       continue;
@@ -125,6 +129,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
         seconds, context->renderer().c_str());
   for (const auto& p : (*pipeline)->asset_problems())
     std::fprintf(stderr, "asset: %s\n", p.c_str());
+  status->stopping();
   node.stop();
   if (!written) return error("cannot write '" + options.screenshot + "'", 1);
   if (options.duration_s <= 0 && drawn < options.frames)

@@ -27,11 +27,13 @@ actor mesh (studio/actor/mesh) from any viewpoint, the actor textured from the s
 with the images of exactly the frame that built the mesh (requested from the capture servers'
 rings: studio/camera/image_request -> image_reply); panels for the cameras (CameraControl and
 read-back), capture (takes at a frame), animation (play, pause, seek, speed) and services.
+Publishes its own studio/service/status (service "preview", the config's instance).
 
 Options:
   --config FILE     preview.yaml (keys below); without it, the defaults and the environment
   --viewpoint V     eye=X,Y,Z,at=X,Y,Z[,fov=DEG] (studio frame, metres, y up)
-  --texturing T     blend (up to three cameras, visibility, ULR weights) or nearest (the paper's)
+  --texturing T     blend (up to three cameras: the hull carved per pixel by their keys,
+                    visibility by depth maps, per-point ULR weights) or nearest (the paper's)
   --size WxH        window or screenshot size
   --headless        no window: EGL surfaceless rendering (Mesa llvmpipe without a GPU)
   --screenshot PNG  headless: the last frame

@@ -55,14 +55,7 @@ struct PreviewNode::Impl {
         [this](const studio_SceneNode& s, const wire::SampleMeta& m) { return on_node(s, m); });
     loop.input<studio_ActorMesh>({.received = "meshes_received"},
                                  [this](const studio_ActorMesh& s, const wire::SampleMeta&) {
-                                   std::lock_guard lock(mutex);
-                                   auto& live = meshes[std::string(wire::str(s.actor_id))];
-                                   live.mesh = mesh_from_wire(s);
-                                   live.source_frame = s.source_frame;
-                                   live.capture_ns = s.capture_ns;
-                                   live.sequence = ++mesh_sequence;
-                                   meshes_in.add();
-                                   loop.completed(s.source_frame, s.capture_ns);
+                                   on_mesh(s);
                                    return runtime::Outcome{};
                                  });
     loop.input<studio_CameraCalibration>(
@@ -118,6 +111,8 @@ struct PreviewNode::Impl {
     ++scene_version;
     return {};
   }
+
+  void on_mesh(const studio_ActorMesh& s);
 
   void on_state(const studio_CameraState& s) {
     CameraStateView v;
@@ -188,10 +183,44 @@ struct PreviewNode::Impl {
   std::map<std::pair<std::string, uint64_t>, bool> asked;
   uint64_t request_id = 0;
   uint64_t command_id = 0;
+  Prefetch prefetch;
+  PreviewNode* owner = nullptr;
 };
 
+void PreviewNode::Impl::on_mesh(const studio_ActorMesh& s) {
+  Prefetch f;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  {
+    std::lock_guard lock(mutex);
+    auto& live = meshes[std::string(wire::str(s.actor_id))];
+    live.mesh = mesh_from_wire(s);
+    live.source_frame = s.source_frame;
+    live.capture_ns = s.capture_ns;
+    live.sequence = ++mesh_sequence;
+    f = prefetch;
+    if (f && !live.mesh.vertices.empty()) {
+      Eigen::Vector3f lo = live.mesh.vertices[0], hi = lo;
+      for (const auto& v : live.mesh.vertices) {
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+      }
+      centre = (0.5f * (lo + hi)).cast<double>();
+    }
+  }
+  meshes_in.add();
+  loop.completed(s.source_frame, s.capture_ns);
+  if (f) owner->request_images(s.source_frame, f(s.source_frame, centre));
+}
+
 PreviewNode::PreviewNode(runtime::NodeContext& context, std::string requester)
-    : impl_(std::make_unique<Impl>(context, std::move(requester))) {}
+    : impl_(std::make_unique<Impl>(context, std::move(requester))) {
+  impl_->owner = this;
+}
+
+void PreviewNode::set_prefetch(Prefetch prefetch) {
+  std::lock_guard lock(impl_->mutex);
+  impl_->prefetch = std::move(prefetch);
+}
 PreviewNode::~PreviewNode() { stop(); }
 Expected<void> PreviewNode::start() { return impl_->loop.start(); }
 void PreviewNode::stop() { impl_->loop.stop(); }
@@ -255,23 +284,24 @@ std::vector<ServiceView> PreviewNode::services() const {
 }
 
 void PreviewNode::request_images(uint64_t frame, const std::vector<std::string>& cameras) {
-  std::vector<std::string> wanted;
+  // Called from the render thread and (prefetch) the loop thread: ids are taken under the lock.
+  std::vector<std::pair<std::string, uint64_t>> wanted;
   {
     std::lock_guard lock(impl_->mutex);
     for (const auto& c : cameras)
       if (!impl_->images.count({c, frame}) && !impl_->asked.count({c, frame})) {
         impl_->asked[{c, frame}] = true;
-        wanted.push_back(c);
+        wanted.emplace_back(c, ++impl_->request_id);
       }
     while (impl_->asked.size() > 4 * kKeptImages) impl_->asked.erase(Impl::oldest(impl_->asked));
   }
-  for (const auto& c : wanted) {
+  for (const auto& [c, id] : wanted) {
     wire::Owned<studio_ImageRequest> r;
     wire::set(r->requester, impl_->requester);
     wire::set(r->camera_id, c);
     r->frame = frame;
     r->capture_ns = realtime_ns();
-    r->request_id = ++impl_->request_id;
+    r->request_id = id;
     (void)impl_->requests.write(*r);
   }
 }

@@ -21,6 +21,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <expected>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -89,6 +90,13 @@ class PreviewNode : public runtime::Node {
 
   // Requests the images of `frame` from the named cameras (those not already here).
   void request_images(uint64_t frame, const std::vector<std::string>& cameras);
+  // Called on the loop thread for every new mesh (its source frame and the centre of its
+  // bounds), outside the node's lock: the cameras whose images to request at once (the
+  // renderer's choice for its current viewpoint), so the request does not wait for the next
+  // drawn frame (the capture rings keep one second). Empty function: none.
+  using Prefetch =
+      std::function<std::vector<std::string>(uint64_t frame, const Eigen::Vector3d& centre)>;
+  void set_prefetch(Prefetch prefetch);
   // The images of exactly `frame` of every named camera, once all have arrived; waits up to
   // `wait`. Missing: `refused` (a capture server answered EVICTED or NOT_YET) or late (no reply
   // yet).

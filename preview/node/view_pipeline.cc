@@ -1,6 +1,7 @@
 #include "view_pipeline.h"
 
 #include <filesystem>
+#include <mutex>
 #include <numbers>
 #include <set>
 
@@ -11,6 +12,45 @@
 #include "scene_render/renderer.h"
 
 namespace studio::preview {
+namespace {
+
+struct Choice {
+  std::vector<std::string> cameras;
+  std::vector<float> weights;
+  double threshold = 0;
+};
+
+// The texturing cameras for a mesh centred at `centre` seen from `eye` (camera_select.h).
+Choice choose(const std::map<std::string, Camera>& cams, bool blend, BlendOptions bo,
+              const Eigen::Vector3d& eye, const Eigen::Vector3d& centre) {
+  std::vector<StudioCameraPose> poses;
+  std::vector<std::string> ids;
+  for (const auto& [id, c] : cams) {
+    poses.push_back({id, c.centre_in_world()});
+    ids.push_back(id);
+  }
+  bo.cameras = std::min(bo.cameras, ActorTexturer::kMaxCameras);
+  const auto chosen =
+      blend ? preview::blend(poses, eye, centre, bo) : preview::nearest(poses, eye, centre);
+  Choice out;
+  out.threshold = preview::blend_threshold(poses, eye, centre, bo);
+  for (const auto& w : chosen) {
+    out.cameras.push_back(ids[w.index]);
+    out.weights.push_back(float(w.weight));
+  }
+  return out;
+}
+
+// What the node's prefetch (on its loop thread) needs of the render thread: the viewpoint of the
+// last drawn frame and the texturing mode. Shared, so it outlives the pipeline if a callback runs.
+struct PrefetchState {
+  std::mutex mutex;
+  bool have_eye = false, blend = true;
+  Eigen::Vector3d eye = Eigen::Vector3d::Zero();
+  BlendOptions options;
+};
+
+}  // namespace
 
 struct ViewPipeline::Impl {
   PreviewNode* node = nullptr;
@@ -27,10 +67,12 @@ struct ViewPipeline::Impl {
   std::chrono::steady_clock::time_point pending_since;
   std::vector<std::string> pending_cameras;
   std::vector<float> pending_weights;
+  double pending_threshold = 0, current_threshold = 0;
   bool have_current = false, current_textured = false;
   FrameReport current;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   PipelineCounts counts;
+  std::shared_ptr<PrefetchState> prefetch = std::make_shared<PrefetchState>();
 
   Impl(PreviewNode& n, const PipelineOptions& o, scene_render::Renderer r, ActorTexturer t)
       : node(&n), options(o), renderer(std::move(r)), texturer(std::move(t)) {}
@@ -71,25 +113,12 @@ struct ViewPipeline::Impl {
       hi = hi.cwiseMax(v.cast<double>());
     }
     if (!m->mesh.vertices.empty()) centre = 0.5 * (lo + hi);
-    const auto cams = node->cameras();
-    std::vector<StudioCameraPose> poses;
-    std::vector<std::string> ids;
-    for (const auto& [id, c] : cams) {
-      poses.push_back({id, c.centre_in_world()});
-      ids.push_back(id);
-    }
-    BlendOptions bo = options.blend_options;
-    bo.cameras = std::min(bo.cameras, ActorTexturer::kMaxCameras);
-    const auto chosen = options.blend ? preview::blend(poses, view.eye, centre, bo)
-                                      : preview::nearest(poses, view.eye, centre);
+    Choice c = choose(node->cameras(), options.blend, options.blend_options, view.eye, centre);
+    pending_threshold = c.threshold;
     pending = std::move(*m);
     pending_since = std::chrono::steady_clock::now();
-    pending_cameras.clear();
-    pending_weights.clear();
-    for (const auto& w : chosen) {
-      pending_cameras.push_back(ids[w.index]);
-      pending_weights.push_back(float(w.weight));
-    }
+    pending_cameras = std::move(c.cameras);
+    pending_weights = std::move(c.weights);
     node->request_images(pending->source_frame, pending_cameras);
   }
 
@@ -128,6 +157,7 @@ struct ViewPipeline::Impl {
     current.source_frame = pending->source_frame;
     current.cameras = pending_cameras;
     current.weights = pending_weights;
+    current_threshold = pending_threshold;
     have_current = true;
     ++counts.meshes;
     ++(textured ? counts.textured : counts.untextured);
@@ -138,7 +168,7 @@ struct ViewPipeline::Impl {
 };
 
 ViewPipeline::ViewPipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-ViewPipeline::~ViewPipeline() = default;
+ViewPipeline::~ViewPipeline() { impl_->node->set_prefetch({}); }
 
 Expected<std::unique_ptr<ViewPipeline>> ViewPipeline::create(PreviewNode& node,
                                                              const PipelineOptions& options) {
@@ -147,12 +177,34 @@ Expected<std::unique_ptr<ViewPipeline>> ViewPipeline::create(PreviewNode& node,
   if (!r) return std::unexpected(r.error());
   auto t = ActorTexturer::create();
   if (!t) return std::unexpected(t.error());
-  return std::unique_ptr<ViewPipeline>(
-      new ViewPipeline(std::make_unique<Impl>(node, options, std::move(*r), std::move(*t))));
+  auto impl = std::make_unique<Impl>(node, options, std::move(*r), std::move(*t));
+  impl->prefetch->blend = options.blend;
+  impl->prefetch->options = options.blend_options;
+  // A new mesh's images are requested on arrival, for the last drawn viewpoint; the render
+  // thread's own request for its choice then finds them asked (or here).
+  node.set_prefetch([state = impl->prefetch, n = &node](uint64_t, const Eigen::Vector3d& centre) {
+    bool blend;
+    BlendOptions bo;
+    Eigen::Vector3d eye;
+    {
+      std::lock_guard lock(state->mutex);
+      if (!state->have_eye) return std::vector<std::string>{};
+      blend = state->blend;
+      bo = state->options;
+      eye = state->eye;
+    }
+    return choose(n->cameras(), blend, bo, eye, centre).cameras;
+  });
+  return std::unique_ptr<ViewPipeline>(new ViewPipeline(std::move(impl)));
 }
 
 FrameReport ViewPipeline::render(const Viewpoint& view, int width, int height, bool block) {
   Impl& r = *impl_;
+  {
+    std::lock_guard lock(r.prefetch->mutex);
+    r.prefetch->eye = view.eye;
+    r.prefetch->have_eye = true;
+  }
   r.refresh_scene();
   r.take_new_mesh(view);
   const bool fresh = r.promote(block);
@@ -167,7 +219,11 @@ FrameReport ViewPipeline::render(const Viewpoint& view, int width, int height, b
     std::array<float, ActorTexturer::kMaxCameras> w{};
     for (std::size_t i = 0; i < r.current.weights.size() && i < w.size(); ++i)
       w[i] = r.current.weights[i];
-    r.texturer.draw(v.clip_from_cam * v.cam_from_world, w, r.current.textured, width, height);
+    const TextureMode mode = !r.current.textured ? TextureMode::flat
+                             : r.options.blend   ? TextureMode::blend
+                                                 : TextureMode::nearest;
+    r.texturer.draw({v.clip_from_cam * v.cam_from_world, view.eye, width, height}, mode, w,
+                    r.current_threshold);
   }
   return report;
 }
@@ -178,7 +234,11 @@ bool ViewPipeline::has_work() const {
 }
 std::vector<std::string> ViewPipeline::asset_problems() const { return impl_->problems; }
 Eigen::Vector3d ViewPipeline::actor_centre() const { return impl_->centre; }
-void ViewPipeline::set_blend(bool blend) { impl_->options.blend = blend; }
+void ViewPipeline::set_blend(bool blend) {
+  impl_->options.blend = blend;
+  std::lock_guard lock(impl_->prefetch->mutex);
+  impl_->prefetch->blend = blend;
+}
 bool ViewPipeline::blend() const { return impl_->options.blend; }
 
 }  // namespace studio::preview

@@ -41,6 +41,14 @@ std::vector<CameraWeight> nearest(const std::vector<StudioCameraPose>& cameras,
   return all;
 }
 
+double blend_threshold(const std::vector<StudioCameraPose>& cameras, const Eigen::Vector3d& eye,
+                       const Eigen::Vector3d& target, const BlendOptions& options) {
+  const auto all = by_angle(cameras, eye, target);
+  const std::size_t k = std::max(0, options.cameras);
+  // The (k+1)-th camera's angle; with only k cameras, pi (behind the actor).
+  return all.size() > k ? all[k].angle : std::numbers::pi;
+}
+
 std::vector<CameraWeight> blend(const std::vector<StudioCameraPose>& cameras,
                                 const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                                 const BlendOptions& options) {
@@ -53,8 +61,7 @@ std::vector<CameraWeight> blend(const std::vector<StudioCameraPose>& cameras,
     all[0].weight = 1;
     return all;
   }
-  // The (k+1)-th camera's angle is the threshold; with only k cameras, pi (behind the actor).
-  const double thr = all.size() > k ? all[k].angle : std::numbers::pi;
+  const double thr = blend_threshold(cameras, eye, target, options);
   std::vector<CameraWeight> out;
   double sum = 0;
   for (std::size_t i = 0; i < k; ++i) {

@@ -48,9 +48,10 @@ std::optional<int> decode(std::span<const int> digits) {
   return v;
 }
 
-Eigen::Vector3d band_point(const ActorBody& body, int band, const Eigen::Vector3d& eye) {
+Eigen::Vector3d band_point(const ActorBody& body, int band, const Eigen::Vector3d& eye,
+                           double along) {
   const Part& torso = body.part(PartId::torso);
-  const double uy = kLow + (band + 0.5) * (kHigh - kLow) / kBands;
+  const double uy = kLow + (band + along) * (kHigh - kLow) / kBands;
   // Direction to the eye in the torso's unit-sphere frame, without its axial part.
   const Eigen::Vector3d local = torso.axes.transpose() * (eye - torso.centre);
   Eigen::Vector3d dir = local.cwiseQuotient(torso.radii);  // unit-sphere coordinates of the eye

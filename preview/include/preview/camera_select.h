@@ -48,5 +48,9 @@ std::vector<CameraWeight> nearest(const std::vector<StudioCameraPose>& cameras,
 std::vector<CameraWeight> blend(const std::vector<StudioCameraPose>& cameras,
                                 const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                                 const BlendOptions& options = {});
+// The blend's threshold angle a_thr (radians): the (k+1)-th camera's angle at the target, pi
+// when there are at most k cameras. The renderer evaluates the same penalty per surface point.
+double blend_threshold(const std::vector<StudioCameraPose>& cameras, const Eigen::Vector3d& eye,
+                       const Eigen::Vector3d& target, const BlendOptions& options = {});
 
 }  // namespace studio::preview

@@ -37,8 +37,10 @@ int classify(double r, double g, double b);
 // frame mod kModulus from kBands digits (band order); nullopt when one is -1.
 std::optional<int> decode(std::span<const int> digits);
 
-// World point at the centre of band `band` on the torso's surface, on the side facing `eye`
-// (the direction from the torso's axis to the eye, perpendicular to the axis).
-Eigen::Vector3d band_point(const ActorBody& body, int band, const Eigen::Vector3d& eye);
+// World point of band `band` on the torso's surface, on the side facing `eye` (the direction
+// from the torso's axis to the eye, perpendicular to the axis), at `along` of the band's height
+// (0 its lower edge, 0.5 its centre, 1 its upper edge).
+Eigen::Vector3d band_point(const ActorBody& body, int band, const Eigen::Vector3d& eye,
+                           double along = 0.5);
 
 }  // namespace studio::sim::frame_code
