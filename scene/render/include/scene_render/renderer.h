@@ -97,10 +97,12 @@ class Renderer {
 
   // Clears colour and depth of the bound framebuffer and draws the scene.
   void draw(const scene::Scene& scene, const View& view);
-  // The actor mask of the projector: the actor's mesh in one flat colour (black), depth test
-  // off, every vertex moved `inflate_m` metres along its normal (the security margin). The
-  // colour's alpha is written too (draw() writes alpha 1): a mask drawn with alpha 0 can be told
-  // from black scene pixels in the read-back.
+  // The actor mask of the projector: the actor's mesh in one flat colour (black) over whatever
+  // is drawn (the image of depth test off, each pixel shaded once however often the mesh
+  // overlaps itself: the depth buffer is cleared and left 0 where the mesh covers), every vertex
+  // moved `inflate_m` metres along its normal (the security margin). The colour's alpha is
+  // written too (draw() writes alpha 1): a mask drawn with alpha 0 can be told from black scene
+  // pixels in the read-back.
   void draw_actor_flat(const std::string& actor_id, const View& view, float inflate_m = 0.0f,
                        const Eigen::Vector4f& colour = Eigen::Vector4f(0, 0, 0, 1));
   // The same mesh as an occluder: flat `colour`, written at depth 0 (the near plane) whatever
