@@ -273,6 +273,28 @@ struct Renderer::Impl {
     glUniform1fv(u.light_range, count, range);
   }
 
+  // An actor mesh (studio frame) in one unlit colour, alpha written, every vertex moved
+  // inflate_m along its normal; the caller sets the depth state.
+  void draw_flat(const GpuMesh& m, const View& view, float inflate_m,
+                 const Eigen::Vector4f& colour) {
+    glUseProgram(program);
+    const Eigen::Matrix4f clip_from_world =
+        (view.clip_from_cam * view.cam_from_world).cast<float>();
+    glUniformMatrix4fv(u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+    set_clip_plane(u.clip_plane, std::nullopt);
+    set_matrices(Eigen::Matrix4d::Identity());
+    glUniform1f(u.inflate, inflate_m);
+    glUniform4fv(u.base, 1, colour.data());
+    glUniform1f(u.alpha, colour[3]);
+    const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
+    glUniform3fv(u.emissive, 1, zero.data());
+    glUniform1i(u.unlit, 1);
+    glUniform1i(u.textured, 0);
+    draw_mesh(m);
+    glUniform1f(u.inflate, 0.0f);
+    glBindVertexArray(0);
+  }
+
   void draw_mesh(const GpuMesh& m) { draw_range(m, 0, static_cast<std::uint32_t>(m.index_count)); }
   void draw_range(const GpuMesh& m, std::uint32_t first, std::uint32_t count) {
     glBindVertexArray(m.vao);
@@ -611,21 +633,7 @@ void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, fl
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glDepthRange(0.0, 0.0);
-  glUseProgram(r.program);
-  const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
-  glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
-  set_clip_plane(r.u.clip_plane, std::nullopt);
-  r.set_matrices(Eigen::Matrix4d::Identity());  // actor meshes are in the studio frame
-  glUniform1f(r.u.inflate, inflate_m);
-  glUniform4fv(r.u.base, 1, colour.data());
-  glUniform1f(r.u.alpha, colour[3]);
-  const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
-  glUniform3fv(r.u.emissive, 1, zero.data());
-  glUniform1i(r.u.unlit, 1);
-  glUniform1i(r.u.textured, 0);
-  r.draw_mesh(it->second);
-  glUniform1f(r.u.inflate, 0.0f);
-  glBindVertexArray(0);
+  r.draw_flat(it->second, view, inflate_m, colour);
   glDepthRange(0.0, 1.0);
 }
 
@@ -637,20 +645,7 @@ void Renderer::draw_actor_occluder(const std::string& actor_id, const View& view
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_ALWAYS);
   glDepthRange(0.0, 0.0);  // every fragment at the near plane: nothing drawn later passes GL_LESS
-  glUseProgram(r.program);
-  const Eigen::Matrix4f clip_from_world = (view.clip_from_cam * view.cam_from_world).cast<float>();
-  glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
-  set_clip_plane(r.u.clip_plane, std::nullopt);
-  r.set_matrices(Eigen::Matrix4d::Identity());
-  glUniform1f(r.u.inflate, 0.0f);
-  glUniform4fv(r.u.base, 1, colour.data());
-  glUniform1f(r.u.alpha, colour[3]);
-  const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
-  glUniform3fv(r.u.emissive, 1, zero.data());
-  glUniform1i(r.u.unlit, 1);
-  glUniform1i(r.u.textured, 0);
-  r.draw_mesh(it->second);
-  glBindVertexArray(0);
+  r.draw_flat(it->second, view, 0.0f, colour);
   glDepthRange(0.0, 1.0);
   glDepthFunc(GL_LESS);
 }
