@@ -365,6 +365,34 @@ TEST(MaskGeometry, GrownMeshClearsTheOriginalByTheMargin) {
   EXPECT_NEAR(*r, 0.02 * 2010 / 3.9, 1e-3);
 }
 
+TEST(MaskGeometry, DenseMeshIsSimplifiedAndStillClearsTheOriginalByTheMargin) {
+  // A hull-like dense mesh (~20k triangles): grown from at most max_triangles, the simplifier's
+  // error added to the push, so every point 19 mm outside the original is still covered.
+  std::mt19937 rng(11);
+  const ActorMesh dense = sphere({0, 1.2, 0}, 0.3, Eigen::Matrix3d::Identity(), 72, 144);
+  ASSERT_GT(dense.triangles.size(), 20000u);
+  auto grown = grow_mesh(dense, 0.02);
+  ASSERT_TRUE(grown);
+  EXPECT_LE(grown->triangles.size(), GrowOptions{}.max_triangles);
+  std::normal_distribution<double> n(0, 1);
+  int uncovered = 0, far_covered = 0;
+  for (int k = 0; k < 300; ++k) {
+    const Eigen::Vector3d d = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+    if (winding(*grown, Eigen::Vector3d(0, 1.2, 0) + (0.3 + 0.019) * d) < 0.5) ++uncovered;
+    if (winding(*grown, Eigen::Vector3d(0, 1.2, 0) + (0.3 + 0.02 + 0.06) * d) > 0.5) ++far_covered;
+  }
+  EXPECT_EQ(uncovered, 0);
+  // The extra push stays small: the error (<= 1.5 x 1 % of the extent) and min_cosine's
+  // allowance at the simplified mesh's sharper vertices.
+  EXPECT_EQ(far_covered, 0);
+  // Without simplification the same mesh is kept whole.
+  GrowOptions whole;
+  whole.max_triangles = 0;
+  auto full = grow_mesh(dense, 0.02, whole);
+  ASSERT_TRUE(full);
+  EXPECT_EQ(full->triangles.size(), dense.triangles.size());
+}
+
 TEST(MaskGeometry, RefusesMalformedMeshes) {
   ActorMesh good = box({0, 1, 0}, {0.2, 0.3, 0.1}, 2);
   ASSERT_TRUE(good.validate());

@@ -1,16 +1,56 @@
 #include "projector/mask_geometry.h"
 
+#include <meshoptimizer.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <utility>
 
 namespace studio::projector {
 
-Expected<ActorMesh> grow_mesh(const ActorMesh& mesh, double margin_m, const GrowOptions& options) {
-  if (auto v = mesh.validate(); !v) return std::unexpected(v.error());
+namespace {
+
+// The mesh with at most max_triangles triangles (meshoptimizer's edge collapse: the vertices
+// kept are original ones) and how far its surface may lie from the original's (metres, the
+// simplifier's error times a safety factor); the mesh itself when it is small enough.
+std::pair<ActorMesh, double> simplified(const ActorMesh& mesh, const GrowOptions& options) {
+  if (options.max_triangles == 0 || mesh.triangles.size() <= options.max_triangles)
+    return {mesh, 0.0};
+  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
+  static_assert(sizeof(std::array<uint32_t, 3>) == 3 * sizeof(uint32_t));
+  const float* xyz = mesh.vertices.front().data();
+  const uint32_t* in = mesh.triangles.front().data();
+  const std::size_t stride = sizeof(Eigen::Vector3f);
+  std::vector<uint32_t> out(mesh.triangles.size() * 3);
+  float error = 0;
+  const std::size_t n =
+      meshopt_simplify(out.data(), in, out.size(), xyz, mesh.vertices.size(), stride,
+                       options.max_triangles * 3, static_cast<float>(options.max_error), 0, &error);
+  if (n == 0 || n >= out.size()) return {mesh, 0.0};
+  ActorMesh s = mesh;
+  s.triangles.resize(n / 3);
+  for (std::size_t t = 0; t < n / 3; ++t)
+    s.triangles[t] = {out[3 * t], out[3 * t + 1], out[3 * t + 2]};
+  const double scale = meshopt_simplifyScale(xyz, mesh.vertices.size(), stride);
+  return {std::move(s), options.error_safety * error * scale};
+}
+
+}  // namespace
+
+Expected<ActorMesh> grow_mesh(const ActorMesh& input, double margin_m, const GrowOptions& options) {
+  if (auto v = input.validate(); !v) return std::unexpected(v.error());
   if (!(margin_m >= 0) || !std::isfinite(margin_m)) return fail("grow mask: margin must be >= 0");
   if (!(options.min_cosine > 0 && options.min_cosine <= 1))
     return fail("grow mask: min_cosine must be in (0, 1]");
+  if (!(options.max_error >= 0 && options.error_safety >= 1))
+    return fail("grow mask: max_error must be >= 0 and error_safety >= 1");
+  // Fewer, larger triangles first: pushed out by the margin, each small triangle of a hull mesh
+  // grows to the margin's size, and a renderer rasterises all of them over one another. The
+  // simplification's error is added to the push, so the mask still covers the mesh.
+  auto [mesh, error_m] = simplified(input, options);
+  margin_m += error_m;
   const std::vector<Eigen::Vector3f> normals = vertex_normals(mesh);
   std::vector<float> min_cos(mesh.vertices.size(), 1.0f);
   for (const auto& t : mesh.triangles) {

@@ -12,6 +12,8 @@
 //   the projector's larger focal length and z_min the nearest mesh vertex's depth in the projector
 //   frame (conservative: the radius of the nearest part, applied everywhere).
 
+#include <cstddef>
+
 #include "core/camera.h"
 #include "core/error.h"
 #include "projector/actor_mesh.h"
@@ -20,6 +22,12 @@ namespace studio::projector {
 
 struct GrowOptions {
   double min_cosine = 0.3;  // limits the push at needle-sharp vertices to margin / 0.3
+  // A mesh of more triangles is simplified to this many first (0: never); its surface error
+  // (the simplifier's, times error_safety) is added to the margin. max_error bounds that error,
+  // relative to the mesh's extent (0.01 of a 2 m actor: 2 cm).
+  std::size_t max_triangles = 3000;
+  double max_error = 0.01;
+  double error_safety = 1.5;
 };
 
 // Errors: invalid mesh, negative or non-finite margin.
