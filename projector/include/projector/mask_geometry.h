@@ -5,8 +5,11 @@
 // - grow_mesh(): every vertex pushed out along its area-weighted normal by margin / c, where c is
 //   the smallest cosine between the vertex normal and the normals of its triangles (clamped at
 //   min_cosine), so every triangle's plane moves out by at least the margin, also at the box-like
-//   edges and corners a hull mesh has. Same triangles; draw it like the mesh (no depth test, black,
-//   both faces). Self-overlaps in concave places are harmless: the mask is a union.
+//   edges and corners a hull mesh has. A mesh of more than GrowOptions::max_triangles is first
+//   simplified to that many (the simplifier's error, x error_safety, added to the push), so a
+//   dense hull mesh does not become thousands of margin-sized triangles drawn over one another.
+//   Draw it like the mesh (no depth test, black, both faces). Self-overlaps in concave places are
+//   harmless: the mask is a union.
 // - dilation_radius_px(): the margin as a screen-space radius in projector pixels, for a renderer
 //   that dilates the mesh's silhouette (a max filter or a wide outline): margin * f / z_min with f
 //   the projector's larger focal length and z_min the nearest mesh vertex's depth in the projector
