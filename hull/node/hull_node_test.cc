@@ -67,17 +67,51 @@ class HullNodeTest : public testing::ProcessTest {
     }
   }
 
-  // The actor0 mesh the node should publish for `frame` with every camera's true mask: segment
-  // marching cubes of the largest component, half-cell (plain) and with exact crossings.
-  std::pair<Mesh, Mesh> local_meshes(int64_t frame, const HullNodeOptions& o) {
-    std::vector<RunMask> runs(cameras_.size());
+  // Every camera's true mask of `frame` as runs, and the views over them (pointing into runs:
+  // a moved vector keeps its elements where they are).
+  struct TrueMasks {
+    std::vector<RunMask> runs;
     std::vector<View> views;
+  };
+  TrueMasks true_masks(int64_t frame) {
+    TrueMasks t;
+    t.runs.resize(cameras_.size());
     for (std::size_t c = 0; c < cameras_.size(); ++c) {
       Mask truth;
       studio_->render(int(c), frame, nullptr, &truth);
-      runs[c] = RunMask::from_mask(truth.view());
-      views.push_back({&cameras_[c], &runs[c]});
+      t.runs[c] = RunMask::from_mask(truth.view());
     }
+    for (std::size_t c = 0; c < cameras_.size(); ++c) t.views.push_back({&cameras_[c], &t.runs[c]});
+    return t;
+  }
+
+  std::vector<int> all_cameras() const {
+    std::vector<int> all(cameras_.size());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+    return all;
+  }
+
+  // The hull config of the projector-mask tests, and the library's viewpoint-cut mask the node
+  // should publish for `projector` and `frame` with every camera's true mask.
+  static constexpr const char* kProjectorMaskSection =
+      "  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 64\n  deadline_ms: 300\n"
+      "  projector_masks: true\n  projector_mask_step: 2\n";
+  RunMask library_projector_mask(const Camera& projector, int64_t frame) {
+    const TrueMasks truth = true_masks(frame);
+    ProjectorMaskOptions po;
+    po.step = 2;
+    return projector_mask(
+               projector,
+               Eigen::AlignedBox3d(Eigen::Vector3d(-1.5, 0, -1.5), Eigen::Vector3d(1.5, 2.2, 1.5)),
+               truth.views, po)
+        .value();
+  }
+
+  // The actor0 mesh the node should publish for `frame` with every camera's true mask: segment
+  // marching cubes of the largest component, half-cell (plain) and with exact crossings.
+  std::pair<Mesh, Mesh> local_meshes(int64_t frame, const HullNodeOptions& o) {
+    const TrueMasks truth = true_masks(frame);
+    const std::vector<View>& views = truth.views;
     auto local = visual_hull(o.grid_spec(), views);
     EXPECT_TRUE(local.has_value());
     if (!local) return {};
@@ -116,8 +150,7 @@ void HullNodeTest::masks_in_segments_and_mesh_out(bool refine) {
   HullNodeOptions options;
   options.box = {-1.5, 0, -1.5, 1.5, 2.2, 1.5};
   options.grid = 96;
-  std::vector<int> all(cameras_.size());
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+  const std::vector<int> all = all_cameras();
   const int64_t frame = 40, capture_ns = 1'700'000'000'000'000'000;
   std::optional<hull::SegmentSet> set;
   std::optional<wire::Owned<studio_ActorMesh>> mesh;
@@ -347,33 +380,11 @@ TEST_F(HullNodeTest, ProjectorMasksOut) {
   auto masks = wire::Writer<studio_AlphaMask>::create(p, mask_topic).value();
   auto pm_topic = wire::Topic<studio_ProjectorMask>::create(p).value();
   auto pms = wire::Reader<studio_ProjectorMask>::create(p, pm_topic).value();
-  auto& hull = spawn("hull", "hull/studio-hull",
-                     {"--config", write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 64\n"
-                                               "  deadline_ms: 300\n  projector_masks: true\n"
-                                               "  projector_mask_step: 2\n")});
+  auto& hull = spawn("hull", "hull/studio-hull", {"--config", write_config(kProjectorMaskSection)});
   ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
   ASSERT_TRUE(masks.wait_for_readers(1, 10s));
 
-  // The library's mask for a frame with every camera's true mask.
-  auto local = [&](int64_t frame) {
-    std::vector<RunMask> runs(cameras_.size());
-    std::vector<View> views;
-    for (std::size_t c = 0; c < cameras_.size(); ++c) {
-      Mask truth;
-      studio_->render(int(c), frame, nullptr, &truth);
-      runs[c] = RunMask::from_mask(truth.view());
-      views.push_back({&cameras_[c], &runs[c]});
-    }
-    ProjectorMaskOptions po;
-    po.step = 2;
-    return projector_mask(
-               proj.camera,
-               Eigen::AlignedBox3d(Eigen::Vector3d(-1.5, 0, -1.5), Eigen::Vector3d(1.5, 2.2, 1.5)),
-               views, po)
-        .value();
-  };
-  std::vector<int> all(cameras_.size());
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+  const std::vector<int> all = all_cameras();
   const int64_t frame = 40, capture_ns = 1'700'000'000'000'000'000;
   bool matched = false;
   int received = 0;
@@ -392,7 +403,7 @@ TEST_F(HullNodeTest, ProjectorMasksOut) {
         ASSERT_EQ(core->width(), 1920);
         ASSERT_EQ(core->height(), 1080);
         // Only a mask made from every camera's mask (best-effort masks may be lost).
-        if (*core == local(int64_t(s.data->frame))) matched = true;
+        if (*core == library_projector_mask(proj.camera, int64_t(s.data->frame))) matched = true;
       }
       std::this_thread::sleep_for(20ms);
     }
@@ -423,10 +434,7 @@ TEST_F(HullNodeTest, ProjectorCalibrationFromTheWireJoinsTheMasks) {
   wire::Owned<studio_ProjectorCalibration> c;
   ASSERT_TRUE(wire::from_core(proj, Eigen::Matrix3d::Identity(), *c).has_value());
   ASSERT_TRUE(cals.write(*c).has_value());
-  auto& hull = spawn("hull", "hull/studio-hull",
-                     {"--config", write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 64\n"
-                                               "  deadline_ms: 300\n  projector_masks: true\n"
-                                               "  projector_mask_step: 2\n")});
+  auto& hull = spawn("hull", "hull/studio-hull", {"--config", write_config(kProjectorMaskSection)});
   ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
   ASSERT_TRUE(masks.wait_for_readers(1, 10s));
   wire::Owned<studio_ProjectorCalibration> bad;
@@ -435,25 +443,7 @@ TEST_F(HullNodeTest, ProjectorCalibrationFromTheWireJoinsTheMasks) {
   bad->t[0] = NAN;
   ASSERT_TRUE(cals.write(*bad).has_value());
 
-  auto local = [&](int64_t frame) {
-    std::vector<RunMask> runs(cameras_.size());
-    std::vector<View> views;
-    for (std::size_t i = 0; i < cameras_.size(); ++i) {
-      Mask truth;
-      studio_->render(int(i), frame, nullptr, &truth);
-      runs[i] = RunMask::from_mask(truth.view());
-      views.push_back({&cameras_[i], &runs[i]});
-    }
-    ProjectorMaskOptions po;
-    po.step = 2;
-    return projector_mask(
-               proj.camera,
-               Eigen::AlignedBox3d(Eigen::Vector3d(-1.5, 0, -1.5), Eigen::Vector3d(1.5, 2.2, 1.5)),
-               views, po)
-        .value();
-  };
-  std::vector<int> all(cameras_.size());
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+  const std::vector<int> all = all_cameras();
   const int64_t frame = 60, capture_ns = 1'700'000'000'000'000'000;
   bool matched = false;
   for (int attempt = 0; attempt < 20 && !matched; ++attempt) {
@@ -466,7 +456,9 @@ TEST_F(HullNodeTest, ProjectorCalibrationFromTheWireJoinsTheMasks) {
         auto core = wire::to_core(*s.data);
         ASSERT_TRUE(core.has_value()) << core.error().message;
         ASSERT_EQ(core->width(), 640);
-        if (core->area() > 1000 && *core == local(int64_t(s.data->frame))) matched = true;
+        if (core->area() > 1000 &&
+            *core == library_projector_mask(proj.camera, int64_t(s.data->frame)))
+          matched = true;
       }
       std::this_thread::sleep_for(20ms);
     }
