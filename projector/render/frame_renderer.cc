@@ -68,6 +68,23 @@ FrameRenderer::FrameRenderer(FrameRenderer&&) noexcept = default;
 FrameRenderer& FrameRenderer::operator=(FrameRenderer&&) noexcept = default;
 FrameRenderer::~FrameRenderer() = default;
 
+scene::ActorMesh screen_surround(const projector::Screen& screen, const std::string& actor_id) {
+  const auto c = screen.corners();
+  const Eigen::Vector3d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+  scene::ActorMesh frame;
+  frame.actor_id = actor_id;
+  for (const auto& k : c) frame.vertices.push_back(k.cast<float>());
+  for (const auto& k : c)
+    frame.vertices.push_back((centre + (k - centre).normalized() * 50.0).cast<float>());
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    const std::uint32_t j = (i + 1) % 4;
+    frame.triangles.push_back({i, j, 4 + j});
+    frame.triangles.push_back({i, 4 + j, 4 + i});
+  }
+  frame.normals.assign(frame.vertices.size(), screen.normal.cast<float>());
+  return frame;
+}
+
 Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& view,
                                               const FrameRendererOptions& options) {
   if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
@@ -83,23 +100,8 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
   // Outside the screen: the screen's plane around the rectangle, out to 50 m, drawn black from
   // the projector after a single pass (whose projection extends past the cloth; the two-pass warp
   // is black there by construction).
-  {
-    const projector::Screen& sc = view.screen();
-    const auto c = sc.corners();
-    const Eigen::Vector3d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
-    scene::ActorMesh frame;
-    frame.actor_id = kFrameId;
-    for (const auto& k : c) frame.vertices.push_back(k.cast<float>());
-    for (const auto& k : c)
-      frame.vertices.push_back((centre + (k - centre).normalized() * 50.0).cast<float>());
-    for (std::uint32_t i = 0; i < 4; ++i) {
-      const std::uint32_t j = (i + 1) % 4;
-      frame.triangles.push_back({i, j, 4 + j});
-      frame.triangles.push_back({i, 4 + j, 4 + i});
-    }
-    frame.normals.assign(frame.vertices.size(), sc.normal.cast<float>());
-    if (auto ok = renderer->set_actor_mesh(frame); !ok) return std::unexpected(ok.error());
-  }
+  if (auto ok = renderer->set_actor_mesh(screen_surround(view.screen(), kFrameId)); !ok)
+    return std::unexpected(ok.error());
   auto target = scene_render::RenderTarget::create(cam.width, cam.height);
   if (!target) return std::unexpected(target.error());
   std::optional<scene_render::RenderTarget> eye_target;

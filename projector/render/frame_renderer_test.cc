@@ -263,19 +263,7 @@ TEST(FrameRenderer, SinglePassShadingOnlyTheScreenKeepsTheFrame) {
     ASSERT_TRUE(plain->upload(*a));
   }
   // The black frame: the screen's plane around the rectangle out to 50 m.
-  scene::ActorMesh frame;
-  frame.actor_id = "frame";
-  const auto c = view.screen().corners();
-  const Eigen::Vector3d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
-  for (const auto& k : c) frame.vertices.push_back(k.cast<float>());
-  for (const auto& k : c)
-    frame.vertices.push_back((centre + (k - centre).normalized() * 50.0).cast<float>());
-  for (std::uint32_t i = 0; i < 4; ++i) {
-    const std::uint32_t j = (i + 1) % 4;
-    frame.triangles.push_back({i, j, 4 + j});
-    frame.triangles.push_back({i, 4 + j, 4 + i});
-  }
-  ASSERT_TRUE(plain->set_actor_mesh(frame));
+  ASSERT_TRUE(plain->set_actor_mesh(screen_surround(view.screen(), "frame")));
   // A box-shaped actor mask between the eye and the screen.
   projector::ActorMesh mask;
   for (int k = 0; k < 8; ++k)

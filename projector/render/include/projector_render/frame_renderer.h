@@ -56,6 +56,10 @@ struct Readback {
   int thumb_width = 0, thumb_height = 0;
 };
 
+// The black outside the cloth: the screen's plane around the rectangle, out to 50 m from its
+// centre, as an actor mesh (normals the screen's) that the single pass lays first.
+scene::ActorMesh screen_surround(const projector::Screen& screen, const std::string& actor_id);
+
 class FrameRenderer {
  public:
   // Errors: invalid options, a two-pass projector with lens distortion, GL resources that cannot
