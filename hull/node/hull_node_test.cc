@@ -295,7 +295,7 @@ TEST_F(HullNodeTest, TrackedCameraIsCutWithThePoseOfItsFrame) {
   auto segs = wire::Reader<studio_SegmentSet>::create(p, seg_topic).value();
   auto& hull = spawn("hull", "hull/studio-hull",
                      {"--config", write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 96\n"
-                                               "  deadline_ms: 300\n  refine: false\n")});
+                                               "  deadline_ms: 1000\n  refine: false\n")});
   ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
   ASSERT_TRUE(masks.wait_for_readers(1, 10s));
   ASSERT_TRUE(cals.wait_for_readers(1, 10s));
@@ -308,27 +308,32 @@ TEST_F(HullNodeTest, TrackedCameraIsCutWithThePoseOfItsFrame) {
     c->tracked = true;
     ASSERT_TRUE(cals.write(*c).has_value());
   };
-  auto send_masks = [&](int64_t f) {
-    for (std::size_t c = 0; c < cameras_.size(); ++c) {
-      Mask m;
-      (f % 2 && c == 0 ? swung_studio : *studio_).render(int(c), f, nullptr, &m);
-      wire::Owned<studio_AlphaMask> s;
-      wire::set(s->camera_id, cameras_[c].id);
-      s->frame = uint64_t(f);
-      s->capture_ns = f;
-      wire::from_core(RunMask::from_mask(m.view()), studio_MASK_CODEC, *s);
-      ASSERT_TRUE(masks.write(*s).has_value());
-    }
-  };
-  auto local_volume = [&](int64_t f) {
+  // Every camera's mask of frame f, rendered before any is sent: rendering them between writes
+  // spread one frame's masks over more than the deadline on a loaded CI machine, and the frame
+  // went out partial (a larger volume than the local cut's).
+  auto render_masks = [&](int64_t f) {
     std::vector<RunMask> runs(cameras_.size());
-    std::vector<View> views;
     for (std::size_t c = 0; c < cameras_.size(); ++c) {
       Mask m;
       (f % 2 && c == 0 ? swung_studio : *studio_).render(int(c), f, nullptr, &m);
       runs[c] = RunMask::from_mask(m.view());
-      views.push_back({&pose_of(f)[c], &runs[c]});
     }
+    return runs;
+  };
+  auto send_masks = [&](int64_t f, const std::vector<RunMask>& runs) {
+    for (std::size_t c = 0; c < cameras_.size(); ++c) {
+      wire::Owned<studio_AlphaMask> s;
+      wire::set(s->camera_id, cameras_[c].id);
+      s->frame = uint64_t(f);
+      s->capture_ns = f;
+      wire::from_core(runs[c], studio_MASK_CODEC, *s);
+      ASSERT_TRUE(masks.write(*s).has_value());
+    }
+  };
+  auto local_volume = [&](int64_t f) {
+    const std::vector<RunMask> runs = render_masks(f);
+    std::vector<View> views;
+    for (std::size_t c = 0; c < cameras_.size(); ++c) views.push_back({&pose_of(f)[c], &runs[c]});
     HullNodeOptions o;
     o.box = {-1.5, 0, -1.5, 1.5, 2.2, 1.5};
     o.grid = 96;
@@ -342,14 +347,35 @@ TEST_F(HullNodeTest, TrackedCameraIsCutWithThePoseOfItsFrame) {
   // there when the node is slow to take it (under ASan at full load it was not, before).
   // N and N+1 written back to back did not both reach the node in a quick check (the keep-last-1
   // writer may replace N before sending it; not investigated), so they are 50 ms apart.
+  // The writer seeing the node's reader does not mean the node's reader has seen the writer: a
+  // pose written before that is dropped, and the keep-last-1 writer has replaced it by the time
+  // the node asks for it again (frame 41 was cut with pose 42 on a loaded CI machine). So frame
+  // 40's pose (the rig's) is sent until the node's status counts a calibration in.
+  auto status_topic = wire::Topic<studio_ServiceStatus>::create(p).value();
+  auto status = wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
+  double calibrations_in = 0;
+  for (const auto until = std::chrono::steady_clock::now() + 20s;
+       calibrations_in < 1 && std::chrono::steady_clock::now() < until;) {
+    send_calibration(40);
+    for (int k = 0; k < 10 && calibrations_in < 1; ++k) {
+      std::this_thread::sleep_for(100ms);
+      for (auto& s : status.take())
+        if (s.meta.valid_data)
+          for (const auto& c : wire::view(s.data->counters))
+            if (std::string(c.name) == "calibrations_in") calibrations_in = c.value;
+    }
+  }
+  ASSERT_GE(calibrations_in, 1) << hull.log();
+
   std::map<int64_t, double> got;
   for (int64_t f = 41; f < 41 + 2 * 12 && got.size() < 3; f += 2) {
+    const std::vector<RunMask> runs = render_masks(f);
     send_calibration(f);
     std::this_thread::sleep_for(50ms);  // on the wire before N+1 replaces it in the writer
     send_calibration(f + 1);
     std::this_thread::sleep_for(150ms);  // both poses arrive before the masks
-    send_masks(f);
-    const auto until = std::chrono::steady_clock::now() + 1s;
+    send_masks(f, runs);
+    const auto until = std::chrono::steady_clock::now() + 3s;
     while (std::chrono::steady_clock::now() < until && !got.count(f)) {
       for (auto& s : segs.take())
         if (s.meta.valid_data && std::string(s.data->actor_id) == "actor0" &&
