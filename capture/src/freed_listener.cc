@@ -6,12 +6,14 @@
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <condition_variable>
 #include <cstring>
+#include <ctime>
 #include <deque>
 #include <map>
 #include <mutex>
@@ -22,6 +24,18 @@ namespace {
 
 
 std::string errno_text() { return std::strerror(errno); }
+
+// The SO_TIMESTAMPNS receive time of a datagram read with recvmsg, or now when the kernel gave
+// none (it always does once the option is set; the fallback keeps a packet rather than drop it).
+int64_t kernel_receive_ns(msghdr& msg) {
+  for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c))
+    if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+      timespec ts;
+      std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
+      return int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+    }
+  return realtime_ns();
+}
 
 }  // namespace
 
@@ -99,6 +113,14 @@ Expected<std::unique_ptr<FreeDListener>> FreeDListener::create(
     if (setsockopt(state->socket_fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mreq, sizeof mreq) != 0)
       return fail("free-d listener: join " + options.group + ": " + errno_text());
   }
+  // The kernel's receive time (CLOCK_REALTIME, as realtime_ns()) decides a packet's frame, not the
+  // time this thread got round to reading it: a listener delayed by a loaded machine must not move
+  // a pose into the next frame's window (handle_datagram maps arrival time to frame).
+  {
+    const int one = 1;
+    if (setsockopt(state->socket_fd, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof one) != 0)
+      return fail("free-d listener: SO_TIMESTAMPNS: " + errno_text());
+  }
   socklen_t len = sizeof addr;
   getsockname(state->socket_fd, reinterpret_cast<sockaddr*>(&addr), &len);
   state->port = ntohs(addr.sin_port);
@@ -121,12 +143,19 @@ Expected<std::unique_ptr<FreeDListener>> FreeDListener::create(
       }
       if (fds[1].revents) return;  // stop requested
       if (!(fds[0].revents & POLLIN)) continue;
-      const ssize_t n = recv(s.socket_fd, buffer, sizeof buffer, MSG_TRUNC | MSG_DONTWAIT);
+      iovec iov{buffer, sizeof buffer};
+      alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
+      msghdr msg{};
+      msg.msg_iov = &iov;
+      msg.msg_iovlen = 1;
+      msg.msg_control = control;
+      msg.msg_controllen = sizeof control;
+      const ssize_t n = recvmsg(s.socket_fd, &msg, MSG_TRUNC | MSG_DONTWAIT);
       if (n < 0) continue;
-      // MSG_TRUNC makes recv report a longer datagram's true size; the decoder then sees the
+      // MSG_TRUNC makes recvmsg report a longer datagram's true size; the decoder then sees the
       // 2 KiB that fit, which it rejects as wrong_length like any other size but 29.
       const std::size_t size = std::min(std::size_t(n), sizeof buffer);
-      self->handle_datagram(std::span<const uint8_t>(buffer, size), realtime_ns());
+      self->handle_datagram(std::span<const uint8_t>(buffer, size), kernel_receive_ns(msg));
     }
   });
   return listener;
