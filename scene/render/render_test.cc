@@ -5,6 +5,7 @@
 
 #include <numbers>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "scene/view.h"
@@ -223,6 +224,51 @@ TEST_F(DefaultScene, RenderToTextureFeedsAnotherPass) {
   cv::Mat flipped;
   cv::flip(first, flipped, 0);
   EXPECT_LE(cv::norm(read(*second), flipped, cv::NORM_INF), 1.0);
+}
+
+// Untextured meshes are drawn by the lit program's untextured variant (no sampler: llvmpipe would
+// fetch and filter for every fragment under a false uniform branch). It must give the picture
+// the textured variant gives with a white texture: the ceiling and the exhibits (untextured in
+// the museum) given a white 64x64 texture through their node material: 0 values differ, with
+// both shadings. Positive control: a grey texture on the same nodes darkens the red sphere, so
+// the textured variant really drew them.
+TEST_F(DefaultScene, UntexturedVariantDrawsWhatAWhiteTextureDraws) {
+  const std::string white = ::testing::TempDir() + "/render_test_white.png",
+                    grey = ::testing::TempDir() + "/render_test_grey.png";
+  ASSERT_TRUE(cv::imwrite(white, cv::Mat(64, 64, CV_8UC3, cv::Scalar(255, 255, 255))));
+  ASSERT_TRUE(cv::imwrite(grey, cv::Mat(64, 64, CV_8UC3, cv::Scalar(128, 128, 128))));
+  std::vector<std::string> untextured = {"set/ceiling"};
+  for (const char* e : kExhibits) untextured.push_back(std::string("set/") + e);
+  auto with_texture = [&](const std::string& path) {
+    scene::Scene s = scene_;
+    for (const std::string& id : untextured) {
+      const scene::Node* n = s.find(id);
+      EXPECT_NE(n, nullptr) << id;
+      if (!n) continue;
+      scene::Material m = n->material;
+      EXPECT_TRUE(m.texture.empty()) << id;
+      m.texture = path;
+      EXPECT_TRUE(s.apply({0, scene::SetMaterial{id, m}}));
+    }
+    return s;
+  };
+  const scene::Scene white_scene = with_texture(white), grey_scene = with_texture(grey);
+  const cv::Rect sphere = box_of("exhibit_red_sphere");
+  for (const auto shading : {RendererOptions::Shading::fast, RendererOptions::Shading::reference}) {
+    RendererOptions ro;
+    ro.shading = shading;
+    auto r = Renderer::create(ro);
+    ASSERT_TRUE(r) << r.error().message;
+    for (const auto& [path, a] : cache_.all()) ASSERT_TRUE(r->upload(*a));
+    auto draw = [&](const scene::Scene& s) {
+      target_->bind();
+      r->draw(s, view_);
+      return read(*target_);
+    };
+    const cv::Mat plain = draw(scene_), textured = draw(white_scene), darker = draw(grey_scene);
+    EXPECT_EQ(cv::norm(plain, textured, cv::NORM_INF), 0.0);
+    EXPECT_LT(cv::mean(darker(sphere))[2], 0.8 * cv::mean(plain(sphere))[2]);
+  }
 }
 
 // The fast shading (lighting per vertex, the default) against the reference (per fragment) on
