@@ -4,7 +4,9 @@
 // single pass (the paper's) and two pass (eye texture + warp; the warp's extra cost is the
 // difference). Baselines in the same run: clear only, and the same scene drawn once from a plain
 // perspective camera at the eye (what any renderer of the scene pays). `Readback` adds what the
-// node does per published frame: read back, blackout mask to runs, thumbnail. `GrowMask` is the
+// node does per published frame: read back, blackout mask to runs, thumbnail. `Pipelined` is
+// the single pass with one frame in flight (fence on the previous frame instead of glFinish):
+// the throughput when binning of a frame overlaps the shading of the one before. `GrowMask` is the
 // CPU part of the mask alone (grow_mesh per frame, on the calling thread, inside the frame cases).
 // Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the overdraw
 // llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame).
@@ -62,7 +64,15 @@ Fixture& fixture() {
   return *f;
 }
 
-enum class Work { clear, grow_mask, plain, single_pass, two_pass, single_pass_readback };
+enum class Work {
+  clear,
+  grow_mask,
+  plain,
+  single_pass,
+  single_pass_pipelined,
+  two_pass,
+  single_pass_readback
+};
 
 // Fragments that passed the depth test (llvmpipe shades those: early depth test) in one frame,
 // over the frame's pixel count: 1.0 = every pixel shaded once.
@@ -98,6 +108,7 @@ void run(benchmark::State& state, Work work) {
   std::vector<projector::ActorMesh> masks(1);
   std::int64_t frame = 0;
   std::uint64_t blackout = 0;
+  GLsync previous = nullptr;  // pipelined: the fence after the previous frame
   for (auto _ : state) {
     (void)f.scene.apply({frame++, scene::Tick{}});  // the flyer moves every frame
     if (work == Work::grow_mask) {
@@ -119,9 +130,23 @@ void run(benchmark::State& state, Work work) {
     if (work == Work::single_pass_readback) {
       fr->read(rb);
       blackout = rb.blackout.area();
+    } else if (work == Work::single_pass_pipelined) {
+      // One frame in flight: llvmpipe's threads shade frame N while this thread bins frame N+1;
+      // wait for frame N-1 (its fence) before queueing more.
+      const GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+      glFlush();
+      if (previous) {
+        glClientWaitSync(previous, GL_SYNC_FLUSH_COMMANDS_BIT, GL_TIMEOUT_IGNORED);
+        glDeleteSync(previous);
+      }
+      previous = fence;
     } else {
       glFinish();
     }
+  }
+  if (previous) {
+    glClientWaitSync(previous, GL_SYNC_FLUSH_COMMANDS_BIT, GL_TIMEOUT_IGNORED);
+    glDeleteSync(previous);
   }
   if (work == Work::plain) {
     target->bind();
@@ -146,6 +171,7 @@ void BM_Clear(benchmark::State& s) { run(s, Work::clear); }
 void BM_GrowMask(benchmark::State& s) { run(s, Work::grow_mask); }
 void BM_PlainScene(benchmark::State& s) { run(s, Work::plain); }
 void BM_SinglePass(benchmark::State& s) { run(s, Work::single_pass); }
+void BM_SinglePassPipelined(benchmark::State& s) { run(s, Work::single_pass_pipelined); }
 void BM_TwoPass(benchmark::State& s) { run(s, Work::two_pass); }
 void BM_SinglePassReadback(benchmark::State& s) { run(s, Work::single_pass_readback); }
 #define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(2.0)
@@ -153,6 +179,7 @@ BENCHMARK(BM_Clear) OPTS;
 BENCHMARK(BM_GrowMask) OPTS;
 BENCHMARK(BM_PlainScene) OPTS;
 BENCHMARK(BM_SinglePass) OPTS;
+BENCHMARK(BM_SinglePassPipelined) OPTS;
 BENCHMARK(BM_TwoPass) OPTS;
 BENCHMARK(BM_SinglePassReadback) OPTS;
 }  // namespace
