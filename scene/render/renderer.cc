@@ -179,7 +179,7 @@ struct Renderer::Impl {
   std::array<LitProgram, 2> lit;  // [0] untextured, [1] textured (scene_programs.h)
   FlatProgram flat;
   GLuint quad_program = 0, quad_vao = 0;
-  GLint quad_texture = -1, quad_tex_from_screen = -1;
+  GLint quad_texture = -1, quad_tex_from_screen = -1, quad_corners = -1, quad_viewport = -1;
   GLuint sampler = 0;  // fast shading: one mip level, bilinear (0: the textures' own filter)
   std::unordered_map<std::string, GpuAsset> assets;
   std::unordered_map<std::string, GpuMesh> actors;
@@ -329,6 +329,8 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
   impl->quad_program = *quad;
   impl->quad_texture = glGetUniformLocation(impl->quad_program, "u_texture");
   impl->quad_tex_from_screen = glGetUniformLocation(impl->quad_program, "u_tex_from_screen");
+  impl->quad_corners = glGetUniformLocation(impl->quad_program, "u_corners[0]");
+  impl->quad_viewport = glGetUniformLocation(impl->quad_program, "u_viewport");
   glGenVertexArrays(1, &impl->quad_vao);
   if (fast) {  // the nearest mip level, sampled bilinearly: half the texel reads of trilinear
     glGenSamplers(1, &impl->sampler);
@@ -644,7 +646,8 @@ void Renderer::draw_actor_occluder(const std::string& actor_id, const View& view
   glDepthFunc(GL_LESS);
 }
 
-void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen) {
+void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen,
+                            const std::optional<std::array<Eigen::Vector2f, 4>>& region) {
   Impl& r = *impl_;
   glDisable(GL_DEPTH_TEST);
   glUseProgram(r.quad_program);
@@ -652,8 +655,19 @@ void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_sc
   glBindTexture(GL_TEXTURE_2D, texture);
   glUniform1i(r.quad_texture, 0);
   glUniformMatrix3fv(r.quad_tex_from_screen, 1, GL_FALSE, tex_from_screen.data());
+  GLfloat corners[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+  if (region)
+    for (int i = 0; i < 4; ++i) {
+      corners[2 * i] = (*region)[static_cast<std::size_t>(i)].x();
+      corners[2 * i + 1] = (*region)[static_cast<std::size_t>(i)].y();
+    }
+  glUniform2fv(r.quad_corners, 4, corners);
+  GLint viewport[4] = {0, 0, 1, 1};
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  glUniform4f(r.quad_viewport, float(viewport[0]), float(viewport[1]), float(viewport[2]),
+              float(viewport[3]));
   glBindVertexArray(r.quad_vao);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDrawArrays(GL_TRIANGLES, 0, 6);
   glBindVertexArray(0);
   glEnable(GL_DEPTH_TEST);
 }

@@ -174,23 +174,27 @@ uniform vec4 u_colour;
 void main() { o_colour = u_colour; }
 )";
 
-// Full-screen textured pass with a homography on the texture coordinates.
+// Textured pass with a homography on the texture coordinates, over a convex quad of the
+// framebuffer (u_corners, normalised coordinates in [0, 1]^2; the whole frame by default): two
+// triangles, 6 vertices from gl_VertexID. The pixel's normalised position comes from
+// gl_FragCoord and the viewport, not from interpolation, so a pixel gets the same colour
+// whatever quad covers it.
 inline constexpr const char* kQuadVertex = R"(#version 330 core
-out vec2 v_screen;
+uniform vec2 u_corners[4];
 void main() {
-  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));  // (0,0) (2,0) (0,2)
-  v_screen = p;
-  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+  const int corner[6] = int[6](0, 1, 2, 0, 2, 3);
+  gl_Position = vec4(u_corners[corner[gl_VertexID]] * 2.0 - 1.0, 0.0, 1.0);
 }
 )";
 
 inline constexpr const char* kQuadFragment = R"(#version 330 core
-in vec2 v_screen;
 out vec4 o_colour;
 uniform sampler2D u_texture;
 uniform mat3 u_tex_from_screen;
+uniform vec4 u_viewport;  // x, y, width, height
 void main() {
-  vec3 t = u_tex_from_screen * vec3(v_screen, 1.0);
+  vec2 screen = (gl_FragCoord.xy - u_viewport.xy) / u_viewport.zw;
+  vec3 t = u_tex_from_screen * vec3(screen, 1.0);
   vec2 uv = t.xy / t.z;
   if (t.z <= 0.0 || any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) {
     o_colour = vec4(0.0, 0.0, 0.0, 1.0);

@@ -44,6 +44,10 @@ struct FrameRendererOptions {
   Eigen::Vector2i eye_texture_size = Eigen::Vector2i::Zero();
   projector::OffAxisOptions off_axis;
   scene_render::RendererOptions renderer;
+  // Two pass: the warp is drawn only over the screen rectangle's image (its corners in the
+  // projector, 2 px out), the rest cleared black; false: over the whole frame (the baseline,
+  // black outside the screen by the warp's own test). The same frame either way.
+  bool warp_screen_only = true;
   int thumb_width = 160;  // 0: no thumbnail
   int thumb_height = 90;
   Expected<void> validate() const;
