@@ -6,10 +6,11 @@
 // perspective camera at the eye (what any renderer of the scene pays). `Readback` adds what the
 // node does per published frame: read back, blackout mask to runs, thumbnail. `Pipelined` is
 // the single pass with one frame in flight (fence on the previous frame instead of glFinish):
-// the throughput when binning of a frame overlaps the shading of the one before. `GrowMask` is the
-// CPU part of the mask alone (grow_mesh per frame, on the calling thread, inside the frame cases).
-// Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the overdraw
-// llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame).
+// the throughput when binning of a frame overlaps the shading of the one before. `TwoPassFullWarp`
+// is the two pass with the warp over the whole frame (the baseline of warp_screen_only). `GrowMask`
+// is the CPU part of the mask alone (grow_mesh per frame, on the calling thread, inside the frame
+// cases). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
+// overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame).
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -71,6 +72,7 @@ enum class Work {
   single_pass,
   single_pass_pipelined,
   two_pass,
+  two_pass_full_warp,
   single_pass_readback
 };
 
@@ -93,7 +95,9 @@ void run(benchmark::State& state, Work work) {
   Fixture& f = fixture();
   auto view = projector::ProjectorView::create(f.projector);
   FrameRendererOptions fo;
-  fo.form = work == Work::two_pass ? Form::two_pass : Form::single_pass;
+  const bool two_pass = work == Work::two_pass || work == Work::two_pass_full_warp;
+  fo.form = two_pass ? Form::two_pass : Form::single_pass;
+  fo.warp_screen_only = work != Work::two_pass_full_warp;
   auto fr = FrameRenderer::create(*view, fo);
   if (!fr) {
     state.SkipWithError(fr.error().message.c_str());
@@ -173,6 +177,7 @@ void BM_PlainScene(benchmark::State& s) { run(s, Work::plain); }
 void BM_SinglePass(benchmark::State& s) { run(s, Work::single_pass); }
 void BM_SinglePassPipelined(benchmark::State& s) { run(s, Work::single_pass_pipelined); }
 void BM_TwoPass(benchmark::State& s) { run(s, Work::two_pass); }
+void BM_TwoPassFullWarp(benchmark::State& s) { run(s, Work::two_pass_full_warp); }
 void BM_SinglePassReadback(benchmark::State& s) { run(s, Work::single_pass_readback); }
 #define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(2.0)
 BENCHMARK(BM_Clear) OPTS;
@@ -181,6 +186,7 @@ BENCHMARK(BM_PlainScene) OPTS;
 BENCHMARK(BM_SinglePass) OPTS;
 BENCHMARK(BM_SinglePassPipelined) OPTS;
 BENCHMARK(BM_TwoPass) OPTS;
+BENCHMARK(BM_TwoPassFullWarp) OPTS;
 BENCHMARK(BM_SinglePassReadback) OPTS;
 }  // namespace
 
