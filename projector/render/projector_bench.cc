@@ -7,7 +7,9 @@
 // node does per published frame: read back, blackout mask to runs, thumbnail. `Pipelined` is
 // the single pass with one frame in flight (fence on the previous frame instead of glFinish):
 // the throughput when binning of a frame overlaps the shading of the one before. `TwoPassFullWarp`
-// is the two pass with the warp over the whole frame (the baseline of warp_screen_only). `GrowMask`
+// is the two pass with the warp over the whole frame (the baseline of warp_screen_only);
+// `SinglePassBilinear` samples textures bilinearly (the baseline of the projector's nearest
+// texels). The plain scene is drawn with the projector's renderer options. `GrowMask`
 // is the CPU part of the mask alone (grow_mesh per frame, on the calling thread, inside the frame
 // cases). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
 // overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame).
@@ -70,6 +72,7 @@ enum class Work {
   grow_mask,
   plain,
   single_pass,
+  single_pass_bilinear,
   single_pass_pipelined,
   two_pass,
   two_pass_full_warp,
@@ -98,6 +101,8 @@ void run(benchmark::State& state, Work work) {
   const bool two_pass = work == Work::two_pass || work == Work::two_pass_full_warp;
   fo.form = two_pass ? Form::two_pass : Form::single_pass;
   fo.warp_screen_only = work != Work::two_pass_full_warp;
+  if (work == Work::single_pass_bilinear)
+    fo.renderer.texture_filter = scene_render::RendererOptions::TextureFilter::bilinear;
   auto fr = FrameRenderer::create(*view, fo);
   if (!fr) {
     state.SkipWithError(fr.error().message.c_str());
@@ -175,6 +180,7 @@ void BM_Clear(benchmark::State& s) { run(s, Work::clear); }
 void BM_GrowMask(benchmark::State& s) { run(s, Work::grow_mask); }
 void BM_PlainScene(benchmark::State& s) { run(s, Work::plain); }
 void BM_SinglePass(benchmark::State& s) { run(s, Work::single_pass); }
+void BM_SinglePassBilinear(benchmark::State& s) { run(s, Work::single_pass_bilinear); }
 void BM_SinglePassPipelined(benchmark::State& s) { run(s, Work::single_pass_pipelined); }
 void BM_TwoPass(benchmark::State& s) { run(s, Work::two_pass); }
 void BM_TwoPassFullWarp(benchmark::State& s) { run(s, Work::two_pass_full_warp); }
@@ -184,6 +190,7 @@ BENCHMARK(BM_Clear) OPTS;
 BENCHMARK(BM_GrowMask) OPTS;
 BENCHMARK(BM_PlainScene) OPTS;
 BENCHMARK(BM_SinglePass) OPTS;
+BENCHMARK(BM_SinglePassBilinear) OPTS;
 BENCHMARK(BM_SinglePassPipelined) OPTS;
 BENCHMARK(BM_TwoPass) OPTS;
 BENCHMARK(BM_TwoPassFullWarp) OPTS;

@@ -332,10 +332,12 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
   impl->quad_corners = glGetUniformLocation(impl->quad_program, "u_corners[0]");
   impl->quad_viewport = glGetUniformLocation(impl->quad_program, "u_viewport");
   glGenVertexArrays(1, &impl->quad_vao);
-  if (fast) {  // the nearest mip level, sampled bilinearly: half the texel reads of trilinear
+  const bool nearest = options.texture_filter == RendererOptions::TextureFilter::nearest;
+  if (fast || nearest) {  // the nearest mip level, sampled bilinearly (or its nearest texel)
     glGenSamplers(1, &impl->sampler);
-    glSamplerParameteri(impl->sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
-    glSamplerParameteri(impl->sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_MIN_FILTER,
+                        nearest ? GL_NEAREST_MIPMAP_NEAREST : GL_LINEAR_MIPMAP_NEAREST);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_MAG_FILTER, nearest ? GL_NEAREST : GL_LINEAR);
     glSamplerParameteri(impl->sampler, GL_TEXTURE_WRAP_S, GL_REPEAT);
     glSamplerParameteri(impl->sampler, GL_TEXTURE_WRAP_T, GL_REPEAT);
   }

@@ -51,6 +51,13 @@ struct RendererOptions {
   // (mesh_lod.h); draw() takes the coarsest whose geometric error, projected at the mesh's
   // nearest point, stays within this many pixels. 0: always the full mesh (set before upload).
   double lod_pixel_error = 0.5;
+  // How textures are sampled. bilinear: fast shading reads the nearest mip level bilinearly
+  // (GL_LINEAR_MIPMAP_NEAREST), the reference shading trilinearly. nearest: the nearest texel of
+  // the nearest mip level (GL_NEAREST_MIPMAP_NEAREST / GL_NEAREST), both shadings: on llvmpipe
+  // the filter is most of a textured fragment's cost (docs/renderer.md), a 1080p frame of the
+  // default scene costs about a sixth less CPU; texels show as small squares close up.
+  enum class TextureFilter { bilinear, nearest };
+  TextureFilter texture_filter = TextureFilter::bilinear;
   Expected<void> validate() const;
 };
 
