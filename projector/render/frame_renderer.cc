@@ -58,6 +58,9 @@ struct FrameRenderer::Impl {
   // The screen rectangle's bounding box in the projector target (GL window coordinates: x, y
   // from the bottom left, width, height); the single pass draws the scene only there.
   std::array<int, 4> screen_box;
+  // The screen rectangle's corners in the projector target, 2 px out from their centre,
+  // normalised (x right, y up); none when a corner is not in front of the projector.
+  std::optional<std::array<Eigen::Vector2f, 4>> screen_quad;
   std::vector<std::string> mask_ids;
   scene::ActorMesh scratch;
   std::vector<std::uint8_t> rgba;
@@ -115,13 +118,22 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
   scene_render::View mask_view;
   mask_view.clip_from_cam = projector::clip_from_world(cam, 0.05, 100.0);
   std::array<int, 4> box{0, 0, cam.width, cam.height};
+  std::optional<std::array<Eigen::Vector2f, 4>> quad;
   {  // the corners' pixels, 2 px of slack around them (pixel centre conventions, rounding)
     Eigen::AlignedBox2d b;
     bool all = true;
-    for (const auto& c : view.screen().corners()) {
-      Eigen::Vector2d px;
-      all = all && cam.project(c, &px);
-      b.extend(px);
+    std::array<Eigen::Vector2d, 4> px;
+    for (int i = 0; i < 4; ++i) {
+      all = all && cam.project(view.screen().corners()[static_cast<std::size_t>(i)], &px[i]);
+      b.extend(px[i]);
+    }
+    if (all) {
+      const Eigen::Vector2d centre = 0.25 * (px[0] + px[1] + px[2] + px[3]);
+      quad.emplace();
+      for (std::size_t i = 0; i < 4; ++i) {
+        const Eigen::Vector2d out = px[i] + 2.0 * (px[i] - centre).normalized();
+        (*quad)[i] = Eigen::Vector2f(float(out.x() / cam.width), float(1.0 - out.y() / cam.height));
+      }
     }
     if (all) {
       const int x0 = std::clamp(int(std::floor(b.min().x())) - 2, 0, cam.width);
@@ -138,6 +150,7 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
                                                       std::move(eye_target),
                                                       mask_view,
                                                       box,
+                                                      quad,
                                                       {},
                                                       {},
                                                       {}}));
@@ -186,8 +199,16 @@ Expected<int> FrameRenderer::render(const scene::Scene& scene, const Eigen::Vect
     // The quad's coordinates p in [0, 1]^2 are NDC (2p - 1): texture = texture_from_ndc * ndc.
     Eigen::Matrix3d ndc_from_unit;
     ndc_from_unit << 2, 0, -1, 0, 2, -1, 0, 0, 1;
-    r.renderer.draw_texture(r.eye_target->colour_texture(),
-                            (pass->texture_from_ndc * ndc_from_unit).cast<float>());
+    const Eigen::Matrix3f tex_from_unit = (pass->texture_from_ndc * ndc_from_unit).cast<float>();
+    if (r.options.warp_screen_only && r.screen_quad) {
+      // Outside the screen's image the warp would write black: clear to it instead and warp
+      // only the quad (a quarter of the frame less to filter on llvmpipe).
+      glClearColor(0, 0, 0, 1);
+      glClear(GL_COLOR_BUFFER_BIT);
+      r.renderer.draw_texture(r.eye_target->colour_texture(), tex_from_unit, r.screen_quad);
+    } else {
+      r.renderer.draw_texture(r.eye_target->colour_texture(), tex_from_unit);
+    }
   }
   int drawn = 0;
   for (std::size_t i = 0; i < masks.size(); ++i) {

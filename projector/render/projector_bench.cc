@@ -4,8 +4,18 @@
 // single pass (the paper's) and two pass (eye texture + warp; the warp's extra cost is the
 // difference). Baselines in the same run: clear only, and the same scene drawn once from a plain
 // perspective camera at the eye (what any renderer of the scene pays). `Readback` adds what the
-// node does per published frame: read back, blackout mask to runs, thumbnail.
+// node does per published frame: read back, blackout mask to runs, thumbnail. `Pipelined` is
+// the single pass with one frame in flight (fence on the previous frame instead of glFinish):
+// the throughput when binning of a frame overlaps the shading of the one before. `TwoPassFullWarp`
+// is the two pass with the warp over the whole frame (the baseline of warp_screen_only);
+// `SinglePassBilinear` samples textures bilinearly (the baseline of the projector's nearest
+// texels). The plain scene is drawn with the projector's renderer options. `GrowMask`
+// is the CPU part of the mask alone (grow_mesh per frame, on the calling thread, inside the frame
+// cases). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
+// overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame).
+#define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
+#include <GL/glext.h>
 #include <benchmark/benchmark.h>
 
 #include <numbers>
@@ -57,13 +67,42 @@ Fixture& fixture() {
   return *f;
 }
 
-enum class Work { clear, plain, single_pass, two_pass, single_pass_readback };
+enum class Work {
+  clear,
+  grow_mask,
+  plain,
+  single_pass,
+  single_pass_bilinear,
+  single_pass_pipelined,
+  two_pass,
+  two_pass_full_warp,
+  single_pass_readback
+};
+
+// Fragments that passed the depth test (llvmpipe shades those: early depth test) in one frame,
+// over the frame's pixel count: 1.0 = every pixel shaded once.
+template <class Draw>
+double shaded_per_pixel(Draw&& draw) {
+  GLuint query = 0;
+  glGenQueries(1, &query);
+  glBeginQuery(GL_SAMPLES_PASSED, query);
+  draw();
+  glEndQuery(GL_SAMPLES_PASSED);
+  GLuint64 samples = 0;
+  glGetQueryObjectui64v(query, GL_QUERY_RESULT, &samples);
+  glDeleteQueries(1, &query);
+  return static_cast<double>(samples) / (1920.0 * 1080.0);
+}
 
 void run(benchmark::State& state, Work work) {
   Fixture& f = fixture();
   auto view = projector::ProjectorView::create(f.projector);
   FrameRendererOptions fo;
-  fo.form = work == Work::two_pass ? Form::two_pass : Form::single_pass;
+  const bool two_pass = work == Work::two_pass || work == Work::two_pass_full_warp;
+  fo.form = two_pass ? Form::two_pass : Form::single_pass;
+  fo.warp_screen_only = work != Work::two_pass_full_warp;
+  if (work == Work::single_pass_bilinear)
+    fo.renderer.texture_filter = scene_render::RendererOptions::TextureFilter::bilinear;
   auto fr = FrameRenderer::create(*view, fo);
   if (!fr) {
     state.SkipWithError(fr.error().message.c_str());
@@ -78,8 +117,14 @@ void run(benchmark::State& state, Work work) {
   std::vector<projector::ActorMesh> masks(1);
   std::int64_t frame = 0;
   std::uint64_t blackout = 0;
+  GLsync previous = nullptr;  // pipelined: the fence after the previous frame
   for (auto _ : state) {
     (void)f.scene.apply({frame++, scene::Tick{}});  // the flyer moves every frame
+    if (work == Work::grow_mask) {
+      masks[0] = projector::grow_mesh(f.actor, 0.02).value();
+      benchmark::DoNotOptimize(masks[0].vertices.data());
+      continue;
+    }
     if (work == Work::clear) {
       target->bind();
       glClearColor(0, 0, 0, 1);
@@ -94,10 +139,34 @@ void run(benchmark::State& state, Work work) {
     if (work == Work::single_pass_readback) {
       fr->read(rb);
       blackout = rb.blackout.area();
+    } else if (work == Work::single_pass_pipelined) {
+      // One frame in flight: llvmpipe's threads shade frame N while this thread bins frame N+1;
+      // wait for frame N-1 (its fence) before queueing more.
+      const GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+      glFlush();
+      if (previous) {
+        glClientWaitSync(previous, GL_SYNC_FLUSH_COMMANDS_BIT, GL_TIMEOUT_IGNORED);
+        glDeleteSync(previous);
+      }
+      previous = fence;
     } else {
       glFinish();
     }
   }
+  if (previous) {
+    glClientWaitSync(previous, GL_SYNC_FLUSH_COMMANDS_BIT, GL_TIMEOUT_IGNORED);
+    glDeleteSync(previous);
+  }
+  if (work == Work::plain) {
+    target->bind();
+    state.counters["shaded_per_px"] =
+        shaded_per_pixel([&] { fr->renderer().draw(f.scene, plain); });
+  } else if (work != Work::clear && work != Work::grow_mask) {
+    state.counters["shaded_per_px"] =
+        shaded_per_pixel([&] { (void)fr->render(f.scene, kEye, masks); });
+  }
+  if (work != Work::clear && work != Work::grow_mask)
+    state.counters["triangles"] = double(fr->renderer().triangles_last_frame());
   state.counters["fps"] =
       benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   if (work == Work::single_pass_readback) state.counters["blackout_px"] = double(blackout);
@@ -108,15 +177,23 @@ void run(benchmark::State& state, Work work) {
 
 namespace {
 void BM_Clear(benchmark::State& s) { run(s, Work::clear); }
+void BM_GrowMask(benchmark::State& s) { run(s, Work::grow_mask); }
 void BM_PlainScene(benchmark::State& s) { run(s, Work::plain); }
 void BM_SinglePass(benchmark::State& s) { run(s, Work::single_pass); }
+void BM_SinglePassBilinear(benchmark::State& s) { run(s, Work::single_pass_bilinear); }
+void BM_SinglePassPipelined(benchmark::State& s) { run(s, Work::single_pass_pipelined); }
 void BM_TwoPass(benchmark::State& s) { run(s, Work::two_pass); }
+void BM_TwoPassFullWarp(benchmark::State& s) { run(s, Work::two_pass_full_warp); }
 void BM_SinglePassReadback(benchmark::State& s) { run(s, Work::single_pass_readback); }
 #define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(2.0)
 BENCHMARK(BM_Clear) OPTS;
+BENCHMARK(BM_GrowMask) OPTS;
 BENCHMARK(BM_PlainScene) OPTS;
 BENCHMARK(BM_SinglePass) OPTS;
+BENCHMARK(BM_SinglePassBilinear) OPTS;
+BENCHMARK(BM_SinglePassPipelined) OPTS;
 BENCHMARK(BM_TwoPass) OPTS;
+BENCHMARK(BM_TwoPassFullWarp) OPTS;
 BENCHMARK(BM_SinglePassReadback) OPTS;
 }  // namespace
 

@@ -13,6 +13,7 @@
 #include "gl.h"
 #include "gl_program.h"
 #include "mesh_lod.h"
+#include "scene_programs.h"
 #include "shaders.h"
 
 namespace studio::scene_render {
@@ -157,12 +158,6 @@ void fill(GpuMesh& mesh, const std::vector<float>& vertices,
   glBindVertexArray(0);
 }
 
-struct Uniforms {
-  GLint clip_from_world, world_from_model, normal_matrix, inflate, base, textured, texture,
-      emissive, unlit, eye, ambient, light_count, light_position, light_radiance, light_spot,
-      light_spot_inner, light_range, clip_plane, alpha;
-};
-
 // Sets the clip plane (gl_ClipDistance[0] >= 0 is kept); none: everything is kept.
 void set_clip_plane(GLint location, const std::optional<Eigen::Vector4d>& plane) {
   const Eigen::Vector4f p = plane ? plane->cast<float>() : Eigen::Vector4f(0, 0, 0, 1);
@@ -181,9 +176,10 @@ Expected<void> RendererOptions::validate() const {
 
 struct Renderer::Impl {
   RendererOptions options;
-  GLuint program = 0, quad_program = 0, quad_vao = 0;
-  Uniforms u{};
-  GLint quad_texture = -1, quad_tex_from_screen = -1;
+  std::array<LitProgram, 2> lit;  // [0] untextured, [1] textured (scene_programs.h)
+  FlatProgram flat;
+  GLuint quad_program = 0, quad_vao = 0;
+  GLint quad_texture = -1, quad_tex_from_screen = -1, quad_corners = -1, quad_viewport = -1;
   GLuint sampler = 0;  // fast shading: one mip level, bilinear (0: the textures' own filter)
   std::unordered_map<std::string, GpuAsset> assets;
   std::unordered_map<std::string, GpuMesh> actors;
@@ -209,7 +205,9 @@ struct Renderer::Impl {
     for (auto& [p, a] : assets) release(a);
     for (auto& [id, m] : actors) release(m);
     for (auto& [p, t] : override_textures) glDeleteTextures(1, &t);
-    if (program) glDeleteProgram(program);
+    for (const LitProgram& p : lit)
+      if (p.id) glDeleteProgram(p.id);
+    if (flat.id) glDeleteProgram(flat.id);
     if (quad_program) glDeleteProgram(quad_program);
     if (quad_vao) glDeleteVertexArrays(1, &quad_vao);
     if (sampler) glDeleteSamplers(1, &sampler);
@@ -228,13 +226,16 @@ struct Renderer::Impl {
     return t;
   }
 
-  void set_matrices(const Eigen::Matrix4d& world_from_model) {
+  // On the program in use (p).
+  static void set_matrices(const LitProgram& p, const Eigen::Matrix4d& world_from_model) {
+    const LitUniforms& u = p.u;
     const Eigen::Matrix4f m = world_from_model.cast<float>();
     const Eigen::Matrix3f n = m.topLeftCorner<3, 3>().inverse().transpose();
     glUniformMatrix4fv(u.world_from_model, 1, GL_FALSE, m.data());
     glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, n.data());
   }
 
+  // On both lit programs (leaves lit[1] in use).
   void set_lights(const scene::Scene& scene) {
     GLfloat position[kMaxLights * 4], radiance[kMaxLights * 3], spot[kMaxLights * 4],
         inner[kMaxLights], range[kMaxLights];
@@ -264,34 +265,32 @@ struct Renderer::Impl {
       range[count] = l.range;
       ++count;
     }
-    glUniform1i(u.light_count, count);
-    if (count == 0) return;
-    glUniform4fv(u.light_position, count, position);
-    glUniform3fv(u.light_radiance, count, radiance);
-    glUniform4fv(u.light_spot, count, spot);
-    glUniform1fv(u.light_spot_inner, count, inner);
-    glUniform1fv(u.light_range, count, range);
+    for (const LitProgram& p : lit) {
+      const LitUniforms& u = p.u;
+      glUseProgram(p.id);
+      glUniform1i(u.light_count, count);
+      if (count == 0) continue;
+      glUniform4fv(u.light_position, count, position);
+      glUniform3fv(u.light_radiance, count, radiance);
+      glUniform4fv(u.light_spot, count, spot);
+      glUniform1fv(u.light_spot_inner, count, inner);
+      glUniform1fv(u.light_range, count, range);
+    }
   }
 
-  // An actor mesh (studio frame) in one unlit colour, alpha written, every vertex moved
-  // inflate_m along its normal; the caller sets the depth state.
+  // An actor mesh (studio frame) in one colour (its vertex colours ignored), alpha written, every
+  // vertex moved inflate_m along its normal, by the flat program; the caller sets the depth state.
   void draw_flat(const GpuMesh& m, const View& view, float inflate_m,
                  const Eigen::Vector4f& colour) {
-    glUseProgram(program);
+    glUseProgram(flat.id);
+    glDisable(GL_CLIP_DISTANCE0);  // the flat vertex shader writes no clip distance
     const Eigen::Matrix4f clip_from_world =
         (view.clip_from_cam * view.cam_from_world).cast<float>();
-    glUniformMatrix4fv(u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
-    set_clip_plane(u.clip_plane, std::nullopt);
-    set_matrices(Eigen::Matrix4d::Identity());
-    glUniform1f(u.inflate, inflate_m);
-    glUniform4fv(u.base, 1, colour.data());
-    glUniform1f(u.alpha, colour[3]);
-    const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
-    glUniform3fv(u.emissive, 1, zero.data());
-    glUniform1i(u.unlit, 1);
-    glUniform1i(u.textured, 0);
+    glUniformMatrix4fv(flat.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+    glUniform1f(flat.inflate, inflate_m);
+    const Eigen::Vector4f c = colour.cwiseMax(0.0f).cwiseMin(1.0f);
+    glUniform4fv(flat.colour, 1, c.data());
     draw_mesh(m);
-    glUniform1f(u.inflate, 0.0f);
     glBindVertexArray(0);
   }
 
@@ -317,42 +316,28 @@ Expected<Renderer> Renderer::create(const RendererOptions& options) {
   auto impl = std::make_unique<Impl>();
   impl->options = options;
   const bool fast = options.shading == RendererOptions::Shading::fast;
-  auto program =
-      fast ? build_program(shaders::kFastVertex.c_str(), shaders::kFastFragment, "scene (fast)")
-           : build_program(shaders::kSceneVertex, shaders::kSceneFragment.c_str(), "scene");
-  if (!program) return std::unexpected(program.error());
-  impl->program = *program;
+  for (int textured = 0; textured < 2; ++textured) {
+    auto p = build_lit_program(fast, textured == 1);
+    if (!p) return std::unexpected(p.error());
+    impl->lit[static_cast<std::size_t>(textured)] = *p;
+  }
+  auto flat = build_flat_program();
+  if (!flat) return std::unexpected(flat.error());
+  impl->flat = *flat;
   auto quad = build_program(shaders::kQuadVertex, shaders::kQuadFragment, "texture quad");
   if (!quad) return std::unexpected(quad.error());
   impl->quad_program = *quad;
-  const GLuint p = impl->program;
-  auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
-  impl->u = Uniforms{loc("u_clip_from_world"),
-                     loc("u_world_from_model"),
-                     loc("u_normal_matrix"),
-                     loc("u_inflate"),
-                     loc("u_base"),
-                     loc("u_textured"),
-                     loc("u_texture"),
-                     loc("u_emissive"),
-                     loc("u_unlit"),
-                     loc("u_eye"),
-                     loc("u_ambient"),
-                     loc("u_light_count"),
-                     loc("u_light_position[0]"),
-                     loc("u_light_radiance[0]"),
-                     loc("u_light_spot[0]"),
-                     loc("u_light_spot_inner[0]"),
-                     loc("u_light_range[0]"),
-                     loc("u_clip_plane"),
-                     loc("u_alpha")};
   impl->quad_texture = glGetUniformLocation(impl->quad_program, "u_texture");
   impl->quad_tex_from_screen = glGetUniformLocation(impl->quad_program, "u_tex_from_screen");
+  impl->quad_corners = glGetUniformLocation(impl->quad_program, "u_corners[0]");
+  impl->quad_viewport = glGetUniformLocation(impl->quad_program, "u_viewport");
   glGenVertexArrays(1, &impl->quad_vao);
-  if (fast) {  // the nearest mip level, sampled bilinearly: half the texel reads of trilinear
+  const bool nearest = options.texture_filter == RendererOptions::TextureFilter::nearest;
+  if (fast || nearest) {  // the nearest mip level, sampled bilinearly (or its nearest texel)
     glGenSamplers(1, &impl->sampler);
-    glSamplerParameteri(impl->sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
-    glSamplerParameteri(impl->sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_MIN_FILTER,
+                        nearest ? GL_NEAREST_MIPMAP_NEAREST : GL_LINEAR_MIPMAP_NEAREST);
+    glSamplerParameteri(impl->sampler, GL_TEXTURE_MAG_FILTER, nearest ? GL_NEAREST : GL_LINEAR);
     glSamplerParameteri(impl->sampler, GL_TEXTURE_WRAP_S, GL_REPEAT);
     glSamplerParameteri(impl->sampler, GL_TEXTURE_WRAP_T, GL_REPEAT);
   }
@@ -459,7 +444,6 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
   glFrontFace(GL_CCW);
   r.culling = false;
   glDisable(GL_BLEND);
-  glUseProgram(r.program);
 
   scene.world_from_nodes(r.world);
   const auto& order = scene.order();
@@ -475,14 +459,17 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
       view.eye_in_world ? *view.eye_in_world
                         : Eigen::Vector3d(view.cam_from_world.inverse().col(3).head<3>());
   const Eigen::Vector3f eye = eye_d.cast<float>();
-  glUniformMatrix4fv(r.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
   glEnable(GL_CLIP_DISTANCE0);
-  set_clip_plane(r.u.clip_plane, view.clip_plane_world);
-  glUniform1f(r.u.alpha, 1.0f);
-  glUniform3fv(r.u.eye, 1, eye.data());
-  glUniform3fv(r.u.ambient, 1, r.options.ambient.data());
-  glUniform1f(r.u.inflate, 0.0f);
-  glUniform1i(r.u.texture, 0);
+  for (const LitProgram& p : r.lit) {
+    glUseProgram(p.id);
+    glUniformMatrix4fv(p.u.clip_from_world, 1, GL_FALSE, clip_from_world.data());
+    set_clip_plane(p.u.clip_plane, view.clip_plane_world);
+    glUniform1f(p.u.alpha, 1.0f);
+    glUniform3fv(p.u.eye, 1, eye.data());
+    glUniform3fv(p.u.ambient, 1, r.options.ambient.data());
+    glUniform1f(p.u.inflate, 0.0f);
+    glUniform1i(p.u.texture, 0);
+  }
   glActiveTexture(GL_TEXTURE0);
   glBindSampler(0, r.sampler);
   r.set_lights(scene);
@@ -565,22 +552,33 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
     std::stable_sort(r.items.begin(), r.items.end(),
                      [](const Impl::Item& a, const Impl::Item& b) { return a.key < b.key; });
 
-  std::size_t matrices_of = order.size();  // node whose matrices are set
+  // The program in use (untextured or textured variant) and, per program, the node whose
+  // matrices it holds.
+  int in_use = -1;
+  std::array<std::size_t, 2> matrices_of{order.size(), order.size()};
+  auto use = [&](int textured, std::size_t node) {
+    const LitProgram& p = r.lit[static_cast<std::size_t>(textured)];
+    if (in_use != textured) {
+      glUseProgram(p.id);
+      in_use = textured;
+    }
+    if (matrices_of[static_cast<std::size_t>(textured)] != node) {
+      Impl::set_matrices(p, r.world[node]);
+      matrices_of[static_cast<std::size_t>(textured)] = node;
+    }
+    return p.u;
+  };
   for (const Impl::Item& item : r.items) {
     const std::size_t i = item.node;
     const scene::Node& n = *order[i];
-    if (matrices_of != i) {
-      r.set_matrices(r.world[i]);
-      matrices_of = i;
-    }
-    if (item.mesh < 0) {                       // an actor's mesh
+    if (item.mesh < 0) {  // an actor's mesh
+      const LitUniforms u = use(0, i);
       if (r.culling) glDisable(GL_CULL_FACE);  // actor meshes are drawn two-sided
       r.culling = false;
-      glUniform4fv(r.u.base, 1, n.material.colour.data());
+      glUniform4fv(u.base, 1, n.material.colour.data());
       const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
-      glUniform3fv(r.u.emissive, 1, zero.data());
-      glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
-      glUniform1i(r.u.textured, 0);
+      glUniform3fv(u.emissive, 1, zero.data());
+      glUniform1i(u.unlit, n.material.high_contrast ? 1 : 0);
       r.draw_mesh(r.actors.find(n.actor_id)->second);
       continue;
     }
@@ -601,11 +599,11 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
       cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
       r.culling = cull;
     }
-    glUniform4fv(r.u.base, 1, base.data());
+    const LitUniforms u = use(texture ? 1 : 0, i);
+    glUniform4fv(u.base, 1, base.data());
     if (n.material.high_contrast) emissive.setZero();  // unlit: base colour only
-    glUniform3fv(r.u.emissive, 1, emissive.data());
-    glUniform1i(r.u.unlit, n.material.high_contrast ? 1 : 0);
-    glUniform1i(r.u.textured, texture ? 1 : 0);
+    glUniform3fv(u.emissive, 1, emissive.data());
+    glUniform1i(u.unlit, n.material.high_contrast ? 1 : 0);
     if (texture) glBindTexture(GL_TEXTURE_2D, texture);
     r.draw_range(mesh, item.first, item.count);
   }
@@ -650,7 +648,8 @@ void Renderer::draw_actor_occluder(const std::string& actor_id, const View& view
   glDepthFunc(GL_LESS);
 }
 
-void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen) {
+void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_screen,
+                            const std::optional<std::array<Eigen::Vector2f, 4>>& region) {
   Impl& r = *impl_;
   glDisable(GL_DEPTH_TEST);
   glUseProgram(r.quad_program);
@@ -658,8 +657,19 @@ void Renderer::draw_texture(unsigned texture, const Eigen::Matrix3f& tex_from_sc
   glBindTexture(GL_TEXTURE_2D, texture);
   glUniform1i(r.quad_texture, 0);
   glUniformMatrix3fv(r.quad_tex_from_screen, 1, GL_FALSE, tex_from_screen.data());
+  GLfloat corners[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+  if (region)
+    for (int i = 0; i < 4; ++i) {
+      corners[2 * i] = (*region)[static_cast<std::size_t>(i)].x();
+      corners[2 * i + 1] = (*region)[static_cast<std::size_t>(i)].y();
+    }
+  glUniform2fv(r.quad_corners, 4, corners);
+  GLint viewport[4] = {0, 0, 1, 1};
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  glUniform4f(r.quad_viewport, float(viewport[0]), float(viewport[1]), float(viewport[2]),
+              float(viewport[3]));
   glBindVertexArray(r.quad_vao);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDrawArrays(GL_TRIANGLES, 0, 6);
   glBindVertexArray(0);
   glEnable(GL_DEPTH_TEST);
 }

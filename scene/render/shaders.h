@@ -33,6 +33,8 @@ vec3 light_towards(int i, vec3 p, out float attenuation) {
 )";
 
 // Lit pass: per-fragment Blinn-Phong over up to 8 lights, base colour x texture x vertex colour.
+// The fragment shaders are built twice (scene_programs.h): TEXTURED defined 1 or 0 after the
+// #version line.
 inline constexpr const char* kSceneVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
@@ -65,7 +67,6 @@ in vec2 v_uv;
 in vec3 v_colour;
 out vec4 o_colour;
 uniform vec4 u_base;
-uniform bool u_textured;
 uniform sampler2D u_texture;
 uniform vec3 u_emissive;
 uniform bool u_unlit;
@@ -74,7 +75,9 @@ uniform vec3 u_eye;
 uniform vec3 u_ambient;
 )") + kLights + R"(void main() {
   vec4 base = u_base * vec4(v_colour, 1.0);
-  if (u_textured) base *= texture(u_texture, v_uv);
+#if TEXTURED
+  base *= texture(u_texture, v_uv);
+#endif
   if (u_unlit) { o_colour = vec4(base.rgb, u_alpha); return; }
   vec3 n = normalize(v_normal);
   vec3 v = normalize(u_eye - v_world);
@@ -143,34 +146,55 @@ in vec3 v_light;
 in vec3 v_specular;
 out vec4 o_colour;
 uniform vec4 u_base;
-uniform bool u_textured;
 uniform sampler2D u_texture;
 uniform vec3 u_emissive;  // zero when unlit
 uniform float u_alpha;
 void main() {
   vec3 base = u_base.rgb;
-  if (u_textured) base *= texture(u_texture, v_uv).rgb;
+#if TEXTURED
+  base *= texture(u_texture, v_uv).rgb;
+#endif
   o_colour = vec4(clamp(base * v_light + v_specular + u_emissive, 0.0, 1.0), u_alpha);
 }
 )";
 
-// Full-screen textured pass with a homography on the texture coordinates.
+// Flat pass (the projector's black surround and actor masks): one colour, alpha included, every
+// vertex moved u_inflate along its normal; nothing interpolated, no clip plane.
+inline constexpr const char* kFlatVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+uniform mat4 u_clip_from_world;
+uniform float u_inflate;
+void main() { gl_Position = u_clip_from_world * vec4(a_position + u_inflate * a_normal, 1.0); }
+)";
+
+inline constexpr const char* kFlatFragment = R"(#version 330 core
+out vec4 o_colour;
+uniform vec4 u_colour;
+void main() { o_colour = u_colour; }
+)";
+
+// Textured pass with a homography on the texture coordinates, over a convex quad of the
+// framebuffer (u_corners, normalised coordinates in [0, 1]^2; the whole frame by default): two
+// triangles, 6 vertices from gl_VertexID. The pixel's normalised position comes from
+// gl_FragCoord and the viewport, not from interpolation, so a pixel gets the same colour
+// whatever quad covers it.
 inline constexpr const char* kQuadVertex = R"(#version 330 core
-out vec2 v_screen;
+uniform vec2 u_corners[4];
 void main() {
-  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));  // (0,0) (2,0) (0,2)
-  v_screen = p;
-  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+  const int corner[6] = int[6](0, 1, 2, 0, 2, 3);
+  gl_Position = vec4(u_corners[corner[gl_VertexID]] * 2.0 - 1.0, 0.0, 1.0);
 }
 )";
 
 inline constexpr const char* kQuadFragment = R"(#version 330 core
-in vec2 v_screen;
 out vec4 o_colour;
 uniform sampler2D u_texture;
 uniform mat3 u_tex_from_screen;
+uniform vec4 u_viewport;  // x, y, width, height
 void main() {
-  vec3 t = u_tex_from_screen * vec3(v_screen, 1.0);
+  vec2 screen = (gl_FragCoord.xy - u_viewport.xy) / u_viewport.zw;
+  vec3 t = u_tex_from_screen * vec3(screen, 1.0);
   vec2 uv = t.xy / t.z;
   if (t.z <= 0.0 || any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) {
     o_colour = vec4(0.0, 0.0, 0.0, 1.0);

@@ -18,6 +18,7 @@
 // by check_assets() (what a renderer reports in its status).
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -50,6 +51,13 @@ struct RendererOptions {
   // (mesh_lod.h); draw() takes the coarsest whose geometric error, projected at the mesh's
   // nearest point, stays within this many pixels. 0: always the full mesh (set before upload).
   double lod_pixel_error = 0.5;
+  // How textures are sampled. bilinear: fast shading reads the nearest mip level bilinearly
+  // (GL_LINEAR_MIPMAP_NEAREST), the reference shading trilinearly. nearest: the nearest texel of
+  // the nearest mip level (GL_NEAREST_MIPMAP_NEAREST / GL_NEAREST), both shadings: on llvmpipe
+  // the filter is most of a textured fragment's cost (docs/renderer.md), a 1080p frame of the
+  // default scene costs about a sixth less CPU; texels show as small squares close up.
+  enum class TextureFilter { bilinear, nearest };
+  TextureFilter texture_filter = TextureFilter::bilinear;
   Expected<void> validate() const;
 };
 
@@ -110,11 +118,14 @@ class Renderer {
   void draw_actor_occluder(const std::string& actor_id, const View& view,
                            const Eigen::Vector4f& colour = Eigen::Vector4f(0, 0, 0, 1));
   // Draws a texture (e.g. a RenderTarget's colour texture) over the whole bound framebuffer;
-  // the output pixel at normalised coordinates p in [0,1]^2 samples the texture at
-  // dehomogenised tex_from_screen * (p, 1) (identity: a plain copy; the projector passes its
-  // homography). Depth test off.
+  // the output pixel at normalised coordinates p in [0,1]^2 (x right, y up) samples the texture
+  // at dehomogenised tex_from_screen * (p, 1) (identity: a plain copy; the projector passes its
+  // homography), black where that falls outside [0,1]^2. `region`: only the pixels inside this
+  // convex quad (4 corners in order, normalised coordinates) are drawn, the rest of the
+  // framebuffer is kept (the projector's warp covers only the screen's image). Depth test off.
   void draw_texture(unsigned texture,
-                    const Eigen::Matrix3f& tex_from_screen = Eigen::Matrix3f::Identity());
+                    const Eigen::Matrix3f& tex_from_screen = Eigen::Matrix3f::Identity(),
+                    const std::optional<std::array<Eigen::Vector2f, 4>>& region = std::nullopt);
 
   int draw_calls_last_frame() const;
   // Triangles submitted since the last draw() began (its levels of detail, culling).
