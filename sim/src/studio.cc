@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <thread>
 
@@ -279,6 +280,26 @@ struct SimulatedStudio::Impl {
       }
     }
     build_background(options, projection, &cache);
+    if (options.shadow > 0) build_floor(&cache);  // make_shadow: no map without a shadow
+  }
+
+  // cache.floor_xz: the floor point of every floor pixel, as the shadow needs it (the same
+  // arithmetic apply_shadow did per frame: the ray in the world, scaled to reach y = 0).
+  static void build_floor(CameraCache* cache) {
+    const int W = cache->camera.width, H = cache->camera.height;
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    cache->floor_xz.assign(static_cast<std::size_t>(W) * H, Eigen::Vector2d(kNaN, kNaN));
+    const Eigen::Matrix3d Rt = cache->R.transpose();
+    const Eigen::Vector3d& C = cache->centre;
+    for (int y = 0; y < H; ++y) {
+      for (int x = 0; x < W; ++x) {
+        if (cache->surface(x, y) != detail::kFloor) continue;
+        const Eigen::Vector3d dir = Rt * cache->ray(x, y);
+        if (dir.y() >= 0) continue;
+        const double t = -C.y() / dir.y();
+        cache->floor_xz[static_cast<std::size_t>(y) * W + x] = {C.x() + t * dir.x(), C.z() + t * dir.z()};
+      }
+    }
   }
 
   explicit Impl(const StudioOptions& o) : options(o), actor(o.actor) {}
