@@ -34,10 +34,11 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
   --keep-take        keep the take's raw frames (6 x 1.2 MB per frame) in OUT/takes
   --scheduling S     realtime (default when permitted): the services run SCHED_FIFO at the
                      priorities of their systemd units, in pipeline order (capture 52, keyer
-                     54, hull 56, tracker 58, scene 50; the probe's receive path 45), as
-                     installed; the projector (nice 5) and the preview time-sharing, as their
-                     units run them;
-                     normal: time-sharing
+                     54, hull 56, tracker 58, scene 50; the probe's receive path 45, its
+                     scoring 41), as installed; the projector SCHED_FIFO 40, below all of
+                     them (its unit: nice 5; time-sharing starved it beside other work); the
+                     preview time-sharing, as its unit;
+                     normal: time-sharing (the projector at nice 5)
   --sweep-frames N   frames of the projector mask's margin sweep (default 100; 0: none), run
                      after the services stopped, offline (studio-demo-probe sweep: the fast
                      arm swing through the hull library and the projector's MaskPlanner, at
@@ -208,10 +209,17 @@ if have $scene_bin scene.yaml; then
   say "starting the scene server"
   start scene 50 "$scene_bin" --config "$cfg/scene.yaml"
 fi
+# The projector: SCHED_FIFO 40 in realtime mode, below every pipeline stage (50..58) and the
+# probe's receive path (45), so it never delays a mask, mesh or head, but above everything
+# time-sharing, so the CPU the pipeline leaves is the projector's (at its unit's nice 5 it shared
+# that with whatever else runs: 1.6 meshes/s reached a projector frame beside other builds at load
+# 13, 12.5 as FIFO 40; BENCHMARKS.md, demo). normal mode: nice 5, as its systemd unit.
+projector_priority=nice:5
+[ "$scheduling" = realtime ] && projector_priority=40
 for ((p = 1; p <= projectors; p++)); do  # the example studio's projectors are proj1, proj2, ...
   if have $projector_bin "projector-proj$p.yaml"; then
     say "starting projector proj$p (projector-proj$p.yaml)"
-    start "proj$p" nice:5 "$projector_bin" --config "$cfg/projector-proj$p.yaml"
+    start "proj$p" "$projector_priority" "$projector_bin" --config "$cfg/projector-proj$p.yaml"
   fi
 done
 if have $preview_bin preview.yaml; then

@@ -116,6 +116,23 @@ def main():
           f"head_error_m {r.get('head_error_m')} > 0.03")
     check(r.get("masks_lost") == 0, f"masks_lost {r.get('masks_lost')} != 0")
 
+    # The CPU budget (report.json cpu_budget): every local service's CPU ms per frame period,
+    # summed per stage, against the cores' budget; held_back_by.cpu names it in one line.
+    b = r.get("cpu_budget") or {}
+    stages = b.get("stages_ms_per_frame") or {}
+    per = b.get("per_service") or {}
+    for stage in ("capture", "hull", "tracker"):
+        check((stages.get(stage) or 0) > 0, f"cpu_budget: no CPU measured for stage {stage}: {stages}")
+    check(sum(1 for k in per if k.startswith("capture:")) == 6,
+          f"cpu_budget: expected the 6 capture servers, got {sorted(per)}")
+    check(abs(sum(stages.values()) + (b.get("probe_ms_per_frame") or 0) - (b.get("used_ms_per_frame") or -1)) < 1e-3,
+          f"cpu_budget: stages {stages} + probe do not add up to used {b.get('used_ms_per_frame')}")
+    check(b.get("cores") == os.cpu_count() and abs((b.get("available_ms_per_frame") or 0) - os.cpu_count() * 1000 / 25) < 1e-6,
+          f"cpu_budget: available {b.get('available_ms_per_frame')} ms for {b.get('cores')} cores at 25 fps")
+    check(str((r.get("held_back_by") or {}).get("cpu", "")).startswith(f"{b.get('used_ms_per_frame', 0):.1f} of "),
+          f"held_back_by.cpu does not state the budget: {(r.get('held_back_by') or {}).get('cpu')}")
+
+    print("cpu per frame:", (r.get("held_back_by") or {}).get("cpu"))
     print("load average start/end:", (r.get("machine") or {}).get("load_average"))
     print("held back by:", json.dumps(r.get("held_back_by")))
     print("lit actor:", r.get("lit_actor_px"), json.dumps(r.get("lit_actor_detail")))
