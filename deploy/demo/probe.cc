@@ -40,8 +40,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// SCHED_FIFO priority of the scoring threads of a real-time probe: above the projector's 40 in
-// deploy/demo.sh, below the probe's receive path (45) and every pipeline stage (50..58).
+// SCHED_FIFO priority of the scoring threads of a real-time probe: below the probe's receive
+// path (45) and every pipeline stage (50..58), above every time-sharing process.
 constexpr int kScoringPriority = 41;
 
 void read_loadavg(double out[3]) {
@@ -508,10 +508,11 @@ class Recorder {
 
   // Scoring (truth rendering) is the probe's heavy work and not latency-critical: when the
   // probe runs real-time (deploy/demo.sh: SCHED_FIFO 45), its scoring threads drop to
-  // kScoringPriority, below every pipeline stage but above the projector (deploy/demo.sh runs it
-  // SCHED_FIFO 40), which would otherwise take all the CPU they need (a starved scorer scores no
-  // frame: hull_iou null); their load is bounded (score_rate_hz meshes, the frames the projector
-  // renders). A time-sharing probe keeps its scoring threads time-sharing.
+  // kScoringPriority, below every pipeline stage but above all time-sharing work and a
+  // real-time projector (deploy/demo.sh --projector-priority, 1..40), which would otherwise take
+  // the CPU they need (a starved scorer scores no frame: hull_iou null). Their load is bounded:
+  // score_rate_hz meshes, the frames the projector renders. A time-sharing probe keeps its
+  // scoring threads time-sharing.
   static void lower_to_scoring_priority() {
     int policy = SCHED_OTHER;
     sched_param param{};
