@@ -326,9 +326,8 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   j.field("rss_mb", c.probe_end ? c.probe_end->rss_mb : kNaN);
   j.field("note", "the probe's own cost (truth rendering for scoring), on the same cores");
   j.end_object();
-  const CpuBudget budget =
-      cpu_budget(c, rate, int(std::max(1u, std::thread::hardware_concurrency())),
-                 delivered_by_service);
+  const CpuBudget budget = cpu_budget(
+      c, rate, int(std::max(1u, std::thread::hardware_concurrency())), delivered_by_service);
   write_cpu_budget(j, budget);
   j.key("load_average").begin_object();
   j.key("start")

@@ -297,7 +297,8 @@ struct SimulatedStudio::Impl {
         const Eigen::Vector3d dir = Rt * cache->ray(x, y);
         if (dir.y() >= 0) continue;
         const double t = -C.y() / dir.y();
-        cache->floor_xz[static_cast<std::size_t>(y) * W + x] = {C.x() + t * dir.x(), C.z() + t * dir.z()};
+        cache->floor_xz[static_cast<std::size_t>(y) * W + x] = {C.x() + t * dir.x(),
+                                                                C.z() + t * dir.z()};
       }
     }
   }
