@@ -146,10 +146,16 @@ void build_background(const StudioOptions& o, const Image<Rgb8>& projection, Cam
   const Eigen::Matrix3d Rt = cam->R.transpose();
   const Eigen::Vector3d C = cam->centre;
   const double d_ref = std::max(1.0, C.norm());
+  // The floor point of every floor pixel, for the per-frame shadow (make_shadow: no map without
+  // a shadow): the world ray scaled to reach y = 0, the arithmetic the shadow did per frame.
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  cam->floor_xz.assign(o.shadow > 0 ? static_cast<std::size_t>(W) * H : 0,
+                       Eigen::Vector2d(kNaN, kNaN));
   for (int v = 0; v < H; ++v) {
     for (int u = 0; u < W; ++u) {
       const Eigen::Vector3d d_cam = cam->ray(u, v);
-      const Eigen::Vector3d dir = (Rt * d_cam).normalized();
+      const Eigen::Vector3d world = Rt * d_cam;
+      const Eigen::Vector3d dir = world.normalized();
       // Nearest of the floor and the four walls, within their extents.
       double best = 1e300;
       int surface = detail::kNone;
@@ -176,6 +182,11 @@ void build_background(const StudioOptions& o, const Image<Rgb8>& projection, Cam
         }
       }
       cam->surface(u, v) = static_cast<uint8_t>(surface);
+      if (surface == detail::kFloor && !cam->floor_xz.empty() && world.y() < 0) {
+        const double t = -C.y() / world.y();
+        cam->floor_xz[static_cast<std::size_t>(v) * W + u] = {C.x() + t * world.x(),
+                                                              C.z() + t * world.z()};
+      }
       if (surface == detail::kNone) {
         const uint8_t g = static_cast<uint8_t>(std::clamp(28.0 + 10 * dir.y(), 0.0, 255.0));
         cam->background(u, v) = {g, g, static_cast<uint8_t>(g + 4)};
@@ -280,27 +291,6 @@ struct SimulatedStudio::Impl {
       }
     }
     build_background(options, projection, &cache);
-    if (options.shadow > 0) build_floor(&cache);  // make_shadow: no map without a shadow
-  }
-
-  // cache.floor_xz: the floor point of every floor pixel, as the shadow needs it (the same
-  // arithmetic apply_shadow did per frame: the ray in the world, scaled to reach y = 0).
-  static void build_floor(CameraCache* cache) {
-    const int W = cache->camera.width, H = cache->camera.height;
-    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-    cache->floor_xz.assign(static_cast<std::size_t>(W) * H, Eigen::Vector2d(kNaN, kNaN));
-    const Eigen::Matrix3d Rt = cache->R.transpose();
-    const Eigen::Vector3d& C = cache->centre;
-    for (int y = 0; y < H; ++y) {
-      for (int x = 0; x < W; ++x) {
-        if (cache->surface(x, y) != detail::kFloor) continue;
-        const Eigen::Vector3d dir = Rt * cache->ray(x, y);
-        if (dir.y() >= 0) continue;
-        const double t = -C.y() / dir.y();
-        cache->floor_xz[static_cast<std::size_t>(y) * W + x] = {C.x() + t * dir.x(),
-                                                                C.z() + t * dir.z()};
-      }
-    }
   }
 
   explicit Impl(const StudioOptions& o) : options(o), actor(o.actor) {}
