@@ -16,7 +16,7 @@ usage() {
 usage: deploy/demo.sh [--seconds S] [--cameras N] [--projectors N] [--gui] [--out DIR]
                       [--keyer inprocess|separate] [--offline-grid N] [--take-frames N]
                       [--keep-take] [--scheduling realtime|normal] [--sweep-frames N]
-                      [--build DIR]
+                      [--projector-priority P] [--build DIR]
 
 Runs the studio end to end from deploy/examples/studio/ (usually through ./studio demo).
   --seconds S        measurement window (default 20), after the pipeline is up and 3 s warm-up
@@ -34,10 +34,16 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
   --keep-take        keep the take's raw frames (6 x 1.2 MB per frame) in OUT/takes
   --scheduling S     realtime (default when permitted): the services run SCHED_FIFO at the
                      priorities of their systemd units, in pipeline order (capture 52, keyer
-                     54, hull 56, tracker 58, scene 50; the probe's receive path 45), as
-                     installed; the projector (nice 5) and the preview time-sharing, as their
-                     units run them;
+                     54, hull 56, tracker 58, scene 50; the probe's receive path 45, its
+                     scoring 41), as installed; the projector (see --projector-priority)
+                     and the preview time-sharing, as their units run them;
                      normal: time-sharing
+  --projector-priority P
+                     nice:N (default nice:5, the projector's systemd unit) or, with realtime
+                     scheduling, a SCHED_FIFO priority 1..40: below every pipeline stage and
+                     the probe, above all time-sharing work (other sessions' builds cannot
+                     take its CPU, but the real-time total can then reach the kernel's 95 %
+                     throttle, which pauses the whole pipeline: BENCHMARKS.md, demo)
   --sweep-frames N   frames of the projector mask's margin sweep (default 100; 0: none), run
                      after the services stopped, offline (studio-demo-probe sweep: the fast
                      arm swing through the hull library and the projector's MaskPlanner, at
@@ -52,6 +58,7 @@ TXT
 
 seconds=20 cameras=6 projectors=1 gui=0 out=out/demo keyer=inprocess offline_grid=256
 take_frames=50 keep_take=0 build=build/release scheduling=auto sweep_frames=100
+projector_priority=nice:5
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds=${2:?}; shift 2 ;;
@@ -66,6 +73,7 @@ while [ $# -gt 0 ]; do
     --scheduling) scheduling=${2:?}; shift 2 ;;
     --sweep-frames) sweep_frames=${2:?}; shift 2 ;;
     --build) build=${2:?}; shift 2 ;;
+    --projector-priority) projector_priority=${2:?}; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "demo: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -84,6 +92,12 @@ case "$scheduling" in
   normal) ;;
   *) echo "demo: --scheduling: expected realtime or normal" >&2; exit 2 ;;
 esac
+if [[ "$projector_priority" =~ ^nice:-?[0-9]+$ ]]; then :
+elif [[ "$projector_priority" =~ ^[0-9]+$ ]] && [ "$projector_priority" -ge 1 ] && [ "$projector_priority" -le 40 ]; then
+  [ "$scheduling" = realtime ] || { echo "demo: --projector-priority $projector_priority: a SCHED_FIFO priority needs --scheduling realtime" >&2; exit 2; }
+else
+  echo "demo: --projector-priority: expected nice:N or a SCHED_FIFO priority 1..40" >&2; exit 2
+fi
 case "$build" in /*) ;; *) build="$root/$build" ;; esac
 case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
 
@@ -208,10 +222,11 @@ if have $scene_bin scene.yaml; then
   say "starting the scene server"
   start scene 50 "$scene_bin" --config "$cfg/scene.yaml"
 fi
+# The projector: --projector-priority (default: nice 5, as its unit).
 for ((p = 1; p <= projectors; p++)); do  # the example studio's projectors are proj1, proj2, ...
   if have $projector_bin "projector-proj$p.yaml"; then
     say "starting projector proj$p (projector-proj$p.yaml)"
-    start "proj$p" nice:5 "$projector_bin" --config "$cfg/projector-proj$p.yaml"
+    start "proj$p" "$projector_priority" "$projector_bin" --config "$cfg/projector-proj$p.yaml"
   fi
 done
 if have $preview_bin preview.yaml; then

@@ -69,7 +69,11 @@ def main():
     expect([probe, "watch", "--capture", os.path.join(ex, "capture-cam0.yaml"), bad_clock], two,
            "clock differs", one_line=True)
     for args, needle in ((["--cameras", "9"], "--cameras"), (["--seconds", "abc"], "--seconds"),
-                         (["--keyer", "gpu"], "--keyer"), (["--bogus"], "unknown option")):
+                         (["--keyer", "gpu"], "--keyer"), (["--bogus"], "unknown option"),
+                         (["--projector-priority", "45"], "--projector-priority"),
+                         (["--projector-priority", "nice:x"], "--projector-priority"),
+                         (["--scheduling", "normal", "--projector-priority", "30"],
+                          "needs --scheduling realtime")):
         expect([demo, "--build", a.build, "--out", os.path.join(tmp, "o")] + args, two, needle,
                one_line=True)
     expect([demo, "--build", os.path.join(tmp, "nobuild"), "--out", os.path.join(tmp, "o")], two,

@@ -31,14 +31,15 @@ import time
 
 
 
-# The projector is not in this test's run YET: beside 6 simulated cameras, hull and tracker on 2
-# cores, studio-projector's frames are now mesh-driven (each new mesh drawn at once, its motion
-# estimated on a fixed vertex budget in ~6 ms of CPU, stale meshes dropped), but the 1280x720
-# frame itself (llvmpipe: ~80 % of the projector's CPU, perf) does not keep up at nice 5 on a
-# loaded machine (BENCHMARKS.md, demo: 0.2-0.3 meshes/s reached a projector frame at load 15), so
-# lit_actor_px cannot be 0 yet (issue 15 open; renderer speed is projector/render's). `./studio
-# demo` runs it by default and reports lit_actor_px, actor_view.png and the margin sweep; set this
-# to 1 when the projector keeps up, and the lit_actor_px == 0 check below applies.
+# The projector is not in this test's run YET: the studio's CPU does not hold it at 20 fps on 2
+# cores. report.json cpu_budget (BENCHMARKS.md, demo, 2026-11-25 18:00 UTC): the projector spends
+# 57-76 ms of CPU per 1280x720 frame (llvmpipe), so 20 meshes/s reaching it need 46-61 ms per
+# 40 ms frame, beside capture 28, hull 11.5, tracker 1.2, scene 0.4 and the probe 3-4: 90-107 ms
+# of the 80 the cores give. Measured beside other builds it reached 1.6-2.5 meshes/s at its
+# unit's nice 5, 9.5-12.5 as SCHED_FIFO 40 (deploy/demo.sh --projector-priority 40, which then
+# delays the real-time pipeline at the kernel's throttle). `./studio demo` runs it by default and
+# reports lit_actor_px, actor_view.png and the margin sweep; set this to 1 when the projector
+# keeps up (its frame <= ~35 ms of CPU), and the lit_actor_px == 0 check below applies.
 PROJECTORS = 0
 
 def main():
@@ -116,6 +117,23 @@ def main():
           f"head_error_m {r.get('head_error_m')} > 0.03")
     check(r.get("masks_lost") == 0, f"masks_lost {r.get('masks_lost')} != 0")
 
+    # The CPU budget (report.json cpu_budget): every local service's CPU ms per frame period,
+    # summed per stage, against the cores' budget; held_back_by.cpu names it in one line.
+    b = r.get("cpu_budget") or {}
+    stages = b.get("stages_ms_per_frame") or {}
+    per = b.get("per_service") or {}
+    for stage in ("capture", "hull", "tracker"):
+        check((stages.get(stage) or 0) > 0, f"cpu_budget: no CPU measured for stage {stage}: {stages}")
+    check(sum(1 for k in per if k.startswith("capture:")) == 6,
+          f"cpu_budget: expected the 6 capture servers, got {sorted(per)}")
+    check(abs(sum(stages.values()) + (b.get("probe_ms_per_frame") or 0) - (b.get("used_ms_per_frame") or -1)) < 1e-3,
+          f"cpu_budget: stages {stages} + probe do not add up to used {b.get('used_ms_per_frame')}")
+    check(b.get("cores") == os.cpu_count() and abs((b.get("available_ms_per_frame") or 0) - os.cpu_count() * 1000 / 25) < 1e-6,
+          f"cpu_budget: available {b.get('available_ms_per_frame')} ms for {b.get('cores')} cores at 25 fps")
+    check(str((r.get("held_back_by") or {}).get("cpu", "")).startswith(f"{b.get('used_ms_per_frame', 0):.1f} of "),
+          f"held_back_by.cpu does not state the budget: {(r.get('held_back_by') or {}).get('cpu')}")
+
+    print("cpu per frame:", (r.get("held_back_by") or {}).get("cpu"))
     print("load average start/end:", (r.get("machine") or {}).get("load_average"))
     print("held back by:", json.dumps(r.get("held_back_by")))
     print("lit actor:", r.get("lit_actor_px"), json.dumps(r.get("lit_actor_detail")))

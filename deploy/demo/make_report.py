@@ -149,6 +149,7 @@ def main():
         "frames": live.get("frames"),
         "per_service": live.get("per_service"),
         "probe": live.get("probe"),
+        "cpu_budget": live.get("cpu_budget"),
         "rig_check": live.get("rig_check"),
         "held_back_by": live.get("held_back_by"),
         "take": take,
@@ -274,7 +275,8 @@ def write_markdown(r, path):
                          f"{fmt(s.get('p99'))} | {fmt(s.get('max'))} | {s.get('n')} |")
         L.append("\n![latency](latency.png)\n")
     hb = r.get("held_back_by") or {}
-    L.append(f"Held back by — rate: {hb.get('rate') or 'n/a'}; latency: {hb.get('latency') or 'n/a'}.\n")
+    L.append(f"Held back by — rate: {hb.get('rate') or 'n/a'}; latency: {hb.get('latency') or 'n/a'}; "
+             f"CPU: {hb.get('cpu') or 'n/a'}.\n")
     d = r.get("hull_iou_detail") or {}
     L.append(f"Hull IoU: {fmt(r.get('hull_iou'), 4)} over {d.get('frames_scored')} scored frames "
              f"(worst camera {fmt(d.get('worst_camera_iou'), 4)} at {d.get('worst_at')}). "
@@ -292,6 +294,18 @@ def write_markdown(r, path):
         L.append(f"| {s['service']}:{s['instance']} | {s['pid']} | {s['state']} | "
                  f"{fmt(s.get('rate_hz'))} | {fmt(s.get('delivered_hz'))} | {fmt(s.get('cpu_percent'))} | {fmt(s.get('rss_mb'))} | "
                  f"{exits.get(name, '?')} |")
+    b = r.get("cpu_budget") or {}
+    if b.get("per_service"):
+        L.append(f"\n### CPU per frame\n\nCPU ms (user + system) per {fmt(1000 / b['fps'])} ms frame period "
+                 f"in the window, load-robust: {fmt(b.get('used_ms_per_frame'))} used of "
+                 f"{fmt(b.get('available_ms_per_frame'))} the {b.get('cores')} cores give "
+                 f"(probe {fmt(b.get('probe_ms_per_frame'))}).\n")
+        L.append("| stage | CPU ms per frame |\n|---|---|")
+        for stage, ms in sorted((b.get("stages_ms_per_frame") or {}).items(), key=lambda kv: -kv[1]):
+            L.append(f"| {stage} | {fmt(ms)} |")
+        L.append("\n| service | CPU ms per frame | CPU ms per output |\n|---|---|---|")
+        for name, s in sorted(b["per_service"].items()):
+            L.append(f"| {name} | {fmt(s.get('ms_per_frame'))} | {fmt(s.get('ms_per_output'))} |")
     p = r.get("probe") or {}
     L.append(f"\nThe probe itself: {fmt(p.get('cpu_percent'))} % CPU, {fmt(p.get('rss_mb'))} MB.\n")
     t = r.get("take") or {}

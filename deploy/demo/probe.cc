@@ -40,6 +40,10 @@ namespace {
 
 using namespace std::chrono_literals;
 
+// SCHED_FIFO priority of the scoring threads of a real-time probe: below the probe's receive
+// path (45) and every pipeline stage (50..58), above every time-sharing process.
+constexpr int kScoringPriority = 41;
+
 void read_loadavg(double out[3]) {
   std::ifstream f("/proc/loadavg");
   f >> out[0] >> out[1] >> out[2];
@@ -454,8 +458,7 @@ class Recorder {
 
   // Scores every queued projector frame: the true actor at display time against its blackout.
   void projector_loop() {
-    sched_param normal{};
-    pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
+    lower_to_scoring_priority();
     while (true) {
       ProjectorJob job;
       const TruthScorer* truth = nullptr;
@@ -503,11 +506,24 @@ class Recorder {
     }
   }
 
+  // Scoring (truth rendering) is the probe's heavy work and not latency-critical: when the
+  // probe runs real-time (deploy/demo.sh: SCHED_FIFO 45), its scoring threads drop to
+  // kScoringPriority, below every pipeline stage but above all time-sharing work and a
+  // real-time projector (deploy/demo.sh --projector-priority, 1..40), which would otherwise take
+  // the CPU they need (a starved scorer scores no frame: hull_iou null). Their load is bounded:
+  // score_rate_hz meshes, the frames the projector renders. A time-sharing probe keeps its
+  // scoring threads time-sharing.
+  static void lower_to_scoring_priority() {
+    int policy = SCHED_OTHER;
+    sched_param param{};
+    if (pthread_getschedparam(pthread_self(), &policy, &param) != 0) return;
+    if (policy != SCHED_FIFO && policy != SCHED_RR) return;
+    param.sched_priority = std::min(param.sched_priority, kScoringPriority);
+    pthread_setschedparam(pthread_self(), policy, &param);
+  }
+
   void score_loop() {
-    // Scoring (truth rendering) is the probe's heavy work and not latency-critical: when the
-    // probe runs real-time (deploy/demo.sh), only its receive path keeps that priority.
-    sched_param normal{};
-    pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
+    lower_to_scoring_priority();
     while (true) {
       Job job;
       const TruthScorer* truth = nullptr;

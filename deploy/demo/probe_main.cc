@@ -53,7 +53,9 @@ watch   records masks, segments, meshes, heads and service status for a bounded 
         with per-stage timings (capture->mask, mask->segments, segments->mesh, segments->head),
         hull_iou (live meshes re-projected vs the simulator's true masks of the same frame),
         head_error_m (RMS vs the simulator's true head), masks_lost, per_service (rate from
-        studio/service/status, CPU % and RSS from /proc) and held_back_by. With projectors
+        studio/service/status, CPU % and RSS from /proc), cpu_budget (each local service's
+        CPU ms per frame period and per output, summed per stage, against cores x period: the
+        load-robust cost) and held_back_by (rate, latency, cpu). With projectors
         running (studio/projector/frame): lit_actor_px (projector pixels on the simulator's true
         actor at display time that the frame's blackout mask leaves lit, every frame of the
         window), the projector's motion-to-photon latency (then the headline latency_ms) and fps

@@ -9,7 +9,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <thread>
 
+#include "cpu_budget.h"
 #include "json_writer.h"
 #include "projector_report.h"
 
@@ -278,6 +280,7 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   j.key("per_service").begin_array();
   std::string busiest;
   double busiest_cpu = -1;
+  std::map<std::string, double> delivered_by_service;  // for the CPU budget
   for (const ServiceSeen& s : c.services) {
     j.begin_object();
     j.field("service", s.service).field("instance", s.instance).field("pid", s.pid);
@@ -299,6 +302,7 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
       delivered = double(heads) / window_s;
     }
     j.field("delivered_hz", delivered);
+    delivered_by_service[s.service + ":" + s.instance] = delivered;
     double cpu = kNaN;
     if (s.proc_start && s.proc_end) cpu = cpu_percent(*s.proc_start, *s.proc_end);
     j.field("cpu_percent", cpu).field("rss_mb", s.proc_end ? s.proc_end->rss_mb : kNaN);
@@ -322,6 +326,9 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   j.field("rss_mb", c.probe_end ? c.probe_end->rss_mb : kNaN);
   j.field("note", "the probe's own cost (truth rendering for scoring), on the same cores");
   j.end_object();
+  const CpuBudget budget = cpu_budget(
+      c, rate, int(std::max(1u, std::thread::hardware_concurrency())), delivered_by_service);
+  write_cpu_budget(j, budget);
   j.key("load_average").begin_object();
   j.key("start")
       .begin_array()
@@ -396,6 +403,7 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
   }
   j.key("held_back_by").begin_object();
   j.field("rate", rate_limit).field("latency", latency_limit);
+  j.field("cpu", cpu_budget_line(budget));
   j.end_object();
   j.end_object();
 

@@ -212,16 +212,14 @@ void apply_shadow(const CameraCache& cam, const ShadowMap& shadow, Image<Rgb8>* 
   Eigen::Vector3d corners[4];
   for (int k = 0; k < 4; ++k) corners[k] = cam.R * Eigen::Vector3d(xs[k & 1], 0, zs[k >> 1]) + cam.t;
   Rect r = cam.project_hull(corners, 4, 1);
-  const Eigen::Matrix3d Rt = cam.R.transpose();
+  const int W = cam.camera.width;
   for (int y = r.y0; y < r.y1; ++y) {
     const uint8_t* surf = &cam.surface(0, y);
+    const Eigen::Vector2d* floor = cam.floor_xz.data() + static_cast<std::size_t>(y) * W;
     Rgb8* row = &(*image)(0, y);
     for (int x = r.x0; x < r.x1; ++x) {
       if (surf[x] != kFloor) continue;
-      const Eigen::Vector3d dir = Rt * cam.ray(x, y);
-      if (dir.y() >= 0) continue;
-      const double t = -cam.centre.y() / dir.y();
-      const float f = shadow.at(cam.centre.x() + t * dir.x(), cam.centre.z() + t * dir.z());
+      const float f = shadow.at(floor[x].x(), floor[x].y());  // 1 off the map (and for NaN)
       if (f >= 1.0f) continue;
       row[x].r = static_cast<uint8_t>(row[x].r * f + 0.5f);
       row[x].g = static_cast<uint8_t>(row[x].g * f + 0.5f);

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <thread>
 
@@ -145,10 +146,16 @@ void build_background(const StudioOptions& o, const Image<Rgb8>& projection, Cam
   const Eigen::Matrix3d Rt = cam->R.transpose();
   const Eigen::Vector3d C = cam->centre;
   const double d_ref = std::max(1.0, C.norm());
+  // The floor point of every floor pixel, for the per-frame shadow (make_shadow: no map without
+  // a shadow): the world ray scaled to reach y = 0, the arithmetic the shadow did per frame.
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  cam->floor_xz.assign(o.shadow > 0 ? static_cast<std::size_t>(W) * H : 0,
+                       Eigen::Vector2d(kNaN, kNaN));
   for (int v = 0; v < H; ++v) {
     for (int u = 0; u < W; ++u) {
       const Eigen::Vector3d d_cam = cam->ray(u, v);
-      const Eigen::Vector3d dir = (Rt * d_cam).normalized();
+      const Eigen::Vector3d world = Rt * d_cam;
+      const Eigen::Vector3d dir = world.normalized();
       // Nearest of the floor and the four walls, within their extents.
       double best = 1e300;
       int surface = detail::kNone;
@@ -175,6 +182,11 @@ void build_background(const StudioOptions& o, const Image<Rgb8>& projection, Cam
         }
       }
       cam->surface(u, v) = static_cast<uint8_t>(surface);
+      if (surface == detail::kFloor && !cam->floor_xz.empty() && world.y() < 0) {
+        const double t = -C.y() / world.y();
+        cam->floor_xz[static_cast<std::size_t>(v) * W + u] = {C.x() + t * world.x(),
+                                                              C.z() + t * world.z()};
+      }
       if (surface == detail::kNone) {
         const uint8_t g = static_cast<uint8_t>(std::clamp(28.0 + 10 * dir.y(), 0.0, 255.0));
         cam->background(u, v) = {g, g, static_cast<uint8_t>(g + 4)};

@@ -32,6 +32,9 @@ struct CameraCache {
   Eigen::Vector3d centre;             // camera centre in the world
   Image<Rgb8> background;             // noiseless empty studio
   Image<uint8_t> surface;             // Surface per pixel
+  // World (x, z) where each floor pixel's ray meets the floor (y = 0); NaN off the floor. Static
+  // per camera: the per-frame shadow (apply_shadow) reads it instead of intersecting the ray.
+  std::vector<Eigen::Vector2d> floor_xz;
 
   // Ideal normalised coordinates (camera-frame ray direction with z = 1) of pixel (u, v).
   Eigen::Vector3d ray(int u, int v) const {
