@@ -47,7 +47,6 @@ uniform vec3 eye;
 uniform vec3 flat_colour;
 uniform vec3 unseen;
 uniform float tolerance;
-uniform float key_margin;
 uniform float carve_step;
 uniform int carve_steps;
 uniform float angle_threshold;
@@ -57,15 +56,17 @@ uniform mat4 cam[3];
 uniform vec3 centre[3];
 uniform sampler2D colour0, colour1, colour2;
 uniform sampler2D depth0, depth1, depth2;
+uniform float key_threshold;
 out vec4 frag;
 vec3 shade(vec3 c) {
   vec3 nn = normalize(n);
   float l = 0.45 + 0.55 * abs(dot(nn, normalize(vec3(0.4, 1.0, 0.5))));
   return c * l;
 }
-// The cyclorama's key (keyer/: blue exceeds red and green by a margin): a camera whose pixel
-// at the point is backing blue sees past the actor there.
-bool backing(vec3 c) { return c.b > c.r + key_margin && c.b > c.g + key_margin; }
+// Camera images carry their key in alpha (set_camera: 1 where the pixel is actor by keyer/'s
+// rule, blue not above red and green by a margin; 0 on the backing). Backing at x: the
+// bilinear key there is under `key_threshold` (the share of actor texels around x).
+bool backing(vec4 c) { return c.a < key_threshold; }
 // Camera i's image position of x (uv, rows top first) and its depth-map position; false when x
 // is behind camera i or outside its image.
 bool project(int i, vec3 x, out vec2 uv, out vec2 st) {
@@ -82,7 +83,7 @@ bool outside(int i, sampler2D colour, vec3 x) {
   if (weight[i] <= 0.0) return false;
   vec2 uv, st;
   if (!project(i, x, uv, st)) return false;
-  return backing(texture(colour, uv).rgb);
+  return backing(texture(colour, uv));
 }
 void add(int i, sampler2D colour, sampler2D depth, vec3 x, float tol, inout vec3 sum,
          inout float wsum, inout int keyed) {
@@ -91,8 +92,9 @@ void add(int i, sampler2D colour, sampler2D depth, vec3 x, float tol, inout vec3
   if (!project(i, x, uv, st)) return;
   float z = (cam[i] * vec4(x, 1)).z;
   if (z > texture(depth, st).r + tol) return;  // another part of the actor is nearer to camera i
-  vec3 c = texture(colour, uv).rgb;
-  if (backing(c)) { keyed += 1; return; }
+  vec4 texel = texture(colour, uv);
+  if (backing(texel)) { keyed += 1; return; }
+  vec3 c = texel.rgb;
   float w = weight[i];
   if (mode == 2) {  // ULR at x: (1 - a / a_thr) / a, a = angle(novel ray, camera ray)
     vec3 to_cam = normalize(centre[i] - x);
@@ -191,9 +193,25 @@ Eigen::Matrix4d cam_from_world(const Camera& c) {
 struct Slot {
   GLuint colour = 0, depth = 0, fbo = 0, depth_rb = 0;
   int width = 0, height = 0;
+  std::vector<uint8_t> rgba;  // the image with its key in alpha (scratch)
   Eigen::Matrix4d clip = Eigen::Matrix4d::Identity(), cam = Eigen::Matrix4d::Identity();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // world
 };
+
+// RGB8 → RGBA8 with the chroma key in alpha: 0 where blue exceeds red and green by `margin`
+// of full scale (keyer/'s rule), else 255.
+void add_key(const uint8_t* rgb, std::size_t pixels, float margin, std::vector<uint8_t>& out) {
+  out.resize(4 * pixels);
+  const int m = int(margin * 255.0f + 0.5f);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const int r = rgb[3 * i], g = rgb[3 * i + 1], b = rgb[3 * i + 2];
+    uint8_t* o = &out[4 * i];
+    o[0] = uint8_t(r);
+    o[1] = uint8_t(g);
+    o[2] = uint8_t(b);
+    o[3] = b > r + m && b > g + m ? 0 : 255;
+  }
+}
 
 }  // namespace
 
@@ -312,7 +330,7 @@ Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const u
     s.width = camera.width;
     s.height = camera.height;
     glBindTexture(GL_TEXTURE_2D, s.colour);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, s.width, s.height, 0, GL_RGB, GL_UNSIGNED_BYTE,
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, s.width, s.height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
                  nullptr);
     for (GLenum p : {GL_TEXTURE_MIN_FILTER, GL_TEXTURE_MAG_FILTER})
       glTexParameteri(GL_TEXTURE_2D, p, GL_LINEAR);
@@ -336,7 +354,9 @@ Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const u
   }
   glBindTexture(GL_TEXTURE_2D, s.colour);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGB, GL_UNSIGNED_BYTE, rgb);
+  add_key(rgb, std::size_t(s.width) * s.height, impl_->options.key_margin, s.rgba);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                  s.rgba.data());
   s.cam = cam_from_world(camera);
   s.centre = camera.centre_in_world();
   s.clip = clip_from_camera(camera) * s.cam;
@@ -385,8 +405,8 @@ void ActorTexturer::draw(const DrawView& view, TextureMode mode,
   glUniform3fv(at("flat_colour"), 1, o.untextured.data());
   glUniform3fv(at("unseen"), 1, o.unseen.data());
   glUniform1f(at("tolerance"), o.depth_tolerance_m + (m == 2 ? o.inflate_m : 0.0f));
-  glUniform1f(at("key_margin"), o.key_margin);
   glUniform1f(at("carve_step"), o.carve_step_m);
+  glUniform1f(at("key_threshold"), o.key_threshold);
   glUniform1i(at("carve_steps"), o.carve_steps);
   glUniform1f(at("angle_threshold"), float(angle_threshold > 0 ? angle_threshold : 3.14159265));
   for (int i = 0; i < kMaxCameras; ++i) {

@@ -1,9 +1,8 @@
 #include "preview_node.h"
 
-#include <algorithm>
-#include <cstring>
-
 #include "core/clock.h"
+#include "preview/camera_select.h"
+#include "preview/scene_mirror.h"
 #include "wire/convert.h"
 #include "wire/sample.h"
 #include "wire/scene_convert.h"
@@ -136,27 +135,14 @@ struct PreviewNode::Impl {
     const std::string camera(wire::str(s.camera_id));
     if (s.status != studio_IMAGE_REPLY_OK || s.format != studio_IMAGE_RGB8) {
       images_refused.add();
-      refused[{camera, s.frame}] = true;
+      store.refuse(camera, s.frame);
       changed.notify_all();
       return;
     }
-    FrameImage& img = images[{camera, s.frame}];
-    img.width = int(s.width);
-    img.height = int(s.height);
-    img.frame = s.frame;
     const auto d = wire::view(s.data);
-    img.rgb.assign(d.begin(), d.end());
+    store.add(camera, {int(s.width), int(s.height), s.frame, {d.begin(), d.end()}});
     images_in.add();
-    while (images.size() > kKeptImages) images.erase(oldest(images));
-    while (refused.size() > kKeptImages) refused.erase(oldest(refused));
     changed.notify_all();
-  }
-
-  template <class Map>
-  static typename Map::iterator oldest(Map& m) {
-    return std::min_element(m.begin(), m.end(), [](const auto& a, const auto& b) {
-      return a.first.second < b.first.second;
-    });
   }
 
   runtime::ServiceLoop loop;
@@ -178,9 +164,7 @@ struct PreviewNode::Impl {
   uint64_t scene_version = 0;
   std::map<std::string, CameraStateView> states;
   std::map<std::string, ServiceView> services;
-  std::map<std::pair<std::string, uint64_t>, FrameImage> images;
-  std::map<std::pair<std::string, uint64_t>, bool> refused;
-  std::map<std::pair<std::string, uint64_t>, bool> asked;
+  FrameImageStore store{kKeptImages};
   uint64_t request_id = 0;
   uint64_t command_id = 0;
   Prefetch prefetch;
@@ -198,14 +182,7 @@ void PreviewNode::Impl::on_mesh(const studio_ActorMesh& s) {
     live.capture_ns = s.capture_ns;
     live.sequence = ++mesh_sequence;
     f = prefetch;
-    if (f && !live.mesh.vertices.empty()) {
-      Eigen::Vector3f lo = live.mesh.vertices[0], hi = lo;
-      for (const auto& v : live.mesh.vertices) {
-        lo = lo.cwiseMin(v);
-        hi = hi.cwiseMax(v);
-      }
-      centre = (0.5f * (lo + hi)).cast<double>();
-    }
+    if (f) centre = bounds_centre(live.mesh.vertices);
   }
   meshes_in.add();
   loop.completed(s.source_frame, s.capture_ns);
@@ -249,24 +226,7 @@ std::optional<scene::Scene> PreviewNode::scene_after(uint64_t& version) const {
   std::lock_guard lock(impl_->mutex);
   if (impl_->scene_version == version) return std::nullopt;
   version = impl_->scene_version;
-  // Parents before children; a node whose parent has not arrived (yet) waits for it.
-  scene::Scene s;
-  std::vector<const scene::Node*> pending;
-  for (const auto& [id, n] : impl_->nodes) pending.push_back(&n);
-  for (bool progress = true; progress && !pending.empty();) {
-    progress = false;
-    for (auto it = pending.begin(); it != pending.end();) {
-      const scene::Node& n = **it;
-      if (!n.parent.empty() && !s.find(n.parent)) {
-        ++it;
-        continue;
-      }
-      (void)s.apply({n.frame, scene::AddNode{n}});  // an invalid node is left out
-      it = pending.erase(it);
-      progress = true;
-    }
-  }
-  return s;
+  return assemble_scene(impl_->nodes);
 }
 
 std::vector<CameraStateView> PreviewNode::camera_states() const {
@@ -288,12 +248,8 @@ void PreviewNode::request_images(uint64_t frame, const std::vector<std::string>&
   std::vector<std::pair<std::string, uint64_t>> wanted;
   {
     std::lock_guard lock(impl_->mutex);
-    for (const auto& c : cameras)
-      if (!impl_->images.count({c, frame}) && !impl_->asked.count({c, frame})) {
-        impl_->asked[{c, frame}] = true;
-        wanted.emplace_back(c, ++impl_->request_id);
-      }
-    while (impl_->asked.size() > 4 * kKeptImages) impl_->asked.erase(Impl::oldest(impl_->asked));
+    for (auto& c : impl_->store.to_request(frame, cameras))
+      wanted.emplace_back(std::move(c), ++impl_->request_id);
   }
   for (const auto& [c, id] : wanted) {
     wire::Owned<studio_ImageRequest> r;
@@ -309,21 +265,8 @@ void PreviewNode::request_images(uint64_t frame, const std::vector<std::string>&
 std::expected<std::vector<FrameImage>, PreviewNode::Missing> PreviewNode::images(
     uint64_t frame, const std::vector<std::string>& cameras, std::chrono::milliseconds wait) {
   std::unique_lock lock(impl_->mutex);
-  auto ready = [&] {
-    for (const auto& c : cameras)
-      if (!impl_->images.count({c, frame})) return false;
-    return true;
-  };
-  auto refused = [&] {
-    for (const auto& c : cameras)
-      if (impl_->refused.count({c, frame})) return true;
-    return false;
-  };
-  impl_->changed.wait_for(lock, wait, [&] { return ready() || refused(); });
-  if (!ready()) return std::unexpected(refused() ? Missing::refused : Missing::late);
-  std::vector<FrameImage> out;
-  for (const auto& c : cameras) out.push_back(impl_->images.at({c, frame}));
-  return out;
+  impl_->changed.wait_for(lock, wait, [&] { return impl_->store.settled(frame, cameras); });
+  return impl_->store.find(frame, cameras);
 }
 
 Expected<void> PreviewNode::send_control(const std::string& camera, const std::string& feature,

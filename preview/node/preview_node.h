@@ -13,7 +13,8 @@
 // Frame-exact texturing (the paper's way): for a mesh built from the masks of frame F the
 // preview requests the images of (camera, F) of the cameras it will texture from; the capture
 // servers answer from their rings (capture/node/image_ring.h). images() returns them only when
-// every one of exactly frame F has arrived; the caller waits briefly or draws untextured.
+// every one of exactly frame F has arrived (preview/frame_images.h keeps the books); the caller
+// waits briefly or draws untextured.
 //
 // Threads: the handlers run on the loop thread; every public method is thread-safe (one mutex).
 
@@ -30,17 +31,12 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "preview/frame_images.h"
 #include "runtime/service_loop.h"
 #include "scene/actor_mesh.h"
 #include "scene/scene.h"
 
 namespace studio::preview {
-
-struct FrameImage {
-  int width = 0, height = 0;
-  uint64_t frame = 0;
-  std::vector<uint8_t> rgb;
-};
 
 struct LiveMesh {
   scene::ActorMesh mesh;
@@ -100,7 +96,7 @@ class PreviewNode : public runtime::Node {
   // The images of exactly `frame` of every named camera, once all have arrived; waits up to
   // `wait`. Missing: `refused` (a capture server answered EVICTED or NOT_YET) or late (no reply
   // yet).
-  enum class Missing { late, refused };
+  using Missing = FrameImageStore::Missing;
   std::expected<std::vector<FrameImage>, Missing> images(uint64_t frame,
                                                          const std::vector<std::string>& cameras,
                                                          std::chrono::milliseconds wait);

@@ -6,6 +6,16 @@
 
 namespace studio::preview {
 
+Eigen::Vector3d bounds_centre(const std::vector<Eigen::Vector3f>& points) {
+  if (points.empty()) return Eigen::Vector3d::Zero();
+  Eigen::Vector3f lo = points[0], hi = lo;
+  for (const auto& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return (0.5f * (lo + hi)).cast<double>();
+}
+
 Expected<void> BlendOptions::validate() const {
   if (cameras < 1 || cameras > 8) return fail("blend cameras: expected 1..8");
   return {};

@@ -37,6 +37,9 @@ struct BlendOptions {
   Expected<void> validate() const;
 };
 
+// The centre of the points' bounding box (the actor's target above); zero when there are none.
+Eigen::Vector3d bounds_centre(const std::vector<Eigen::Vector3f>& points);
+
 // Angle at `target` between (eye - target) and (centre - target); pi when either is degenerate.
 double view_angle(const Eigen::Vector3d& eye, const Eigen::Vector3d& centre,
                   const Eigen::Vector3d& target);
