@@ -72,6 +72,26 @@ TEST(MaskPlanner, StillActorGetsTheFloorAndMovingActorIsPredicted) {
   EXPECT_GT(p2->margin.margin_m, plan->margin.margin_m);
 }
 
+// A mesh older at display than the measured latency (no newer mesh came): the margin covers its
+// real age, up to the cap.
+TEST(MaskPlanner, StaleMeshIsCoveredForItsAge) {
+  MaskPlannerOptions o;
+  o.margin.prediction = false;
+  o.margin.cap_m = 1.0;
+  MaskPlanner planner(o);
+  for (int k = 0; k < 3; ++k)
+    ASSERT_TRUE(planner.set_mesh("a", k, sphere({0.04f * k, 1, 0}, 0.2f, kT0 + k * kDt)));
+  const int64_t last = kT0 + 2 * kDt;
+  auto fresh = planner.plan(last + 20'000'000);  // younger than the initial 40 ms latency
+  auto stale = planner.plan(last + 300'000'000);
+  ASSERT_TRUE(fresh && stale);
+  EXPECT_NEAR(fresh->margin.latency_s, 0.04, 1e-9);
+  EXPECT_NEAR(stale->margin.latency_s, 0.30, 1e-9);
+  // 1 m/s: 0.3 s of motion is covered.
+  EXPECT_NEAR(stale->margin.margin_m, o.margin.floor_m + 0.3, 0.02);
+  EXPECT_GT(stale->margin.margin_m, fresh->margin.margin_m + 0.2);
+}
+
 TEST(MaskPlanner, RefusedMeshKeepsThePreviousAndLatencyComesFromShownFrames) {
   MaskPlanner planner;
   ASSERT_TRUE(planner.set_mesh("a", 1, sphere({0, 1, 0}, 0.2f, kT0)));

@@ -1,6 +1,7 @@
 #include "projector/mask_planner.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace studio::projector {
@@ -24,14 +25,23 @@ Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t 
   if (auto ok = mesh.validate(); !ok) return fail("actor " + actor_id + ": " + ok.error().message);
   auto it = actors_.find(actor_id);
   if (it == actors_.end())
-    it = actors_.emplace(actor_id, Actor{{}, 0, MotionTracker(options_.motion), {}, 0}).first;
+    it = actors_.emplace(actor_id, Actor{{}, {}, 0, MotionTracker(options_.motion), {}, 0}).first;
   Actor& a = it->second;
   if (!a.mesh.vertices.empty() && mesh.capture_ns <= a.mesh.capture_ns)
     return fail("actor " + actor_id + ": mesh capture time not after the previous mesh's");
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  auto base = simplify_for_mask(mesh, options_.grow);
+  if (!base) return fail("actor " + actor_id + ": " + base.error().message);
+  const auto t1 = Clock::now();
   auto motion = a.tracker.update(mesh);
+  const auto t2 = Clock::now();
   a.motion = motion ? *motion : std::nullopt;  // no motion: the margin's no-prediction term
   a.mesh = std::move(mesh);
+  a.base = std::move(*base);
   a.frame = frame;
+  last_cost_ = {std::chrono::duration<double>(t2 - t1).count(),
+                std::chrono::duration<double>(t1 - t0).count()};
   return {};
 }
 
@@ -59,7 +69,8 @@ Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
   std::vector<bool> predicted;
   bool first = true;
   for (const auto& [id, a] : actors_) {
-    auto m = security_margin(options_.margin, latency, a.head_speed_mps,
+    const double age = std::clamp((display_ns - a.mesh.capture_ns) * 1e-9, 0.0, 10.0);
+    auto m = security_margin(options_.margin, std::max(latency, age), a.head_speed_mps,
                              a.motion ? &*a.motion : nullptr);
     if (!m) return std::unexpected(m.error());
     predicted.push_back(m->predicted);
@@ -76,19 +87,20 @@ Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
   }
   std::size_t k = 0;
   for (const auto& [id, a] : actors_) {
-    const ActorMesh* mesh = &a.mesh;
-    ActorMesh moved;
+    const MaskBase* base = &a.base;
+    MaskBase moved;
     // Each actor moved forward when its own margin relies on the prediction; the margin drawn
-    // is the largest, which covers every actor's own.
+    // is the largest, which covers every actor's own. The simplified mesh keeps the mesh's
+    // vertices, so the motion (per vertex of the mesh) moves it as it would the mesh.
     if (predicted[k++] && a.motion) {
       const double horizon = std::clamp((display_ns - a.mesh.capture_ns) * 1e-9, 0.0, 1.0);
-      auto p = predict(a.mesh, *a.motion, horizon);
+      auto p = predict(a.base.mesh, *a.motion, horizon);
       if (p) {
-        moved = std::move(*p);
-        mesh = &moved;
+        moved = {std::move(*p), a.base.error_m};
+        base = &moved;
       }
     }
-    auto grown = grow_mesh(*mesh, out.margin.margin_m, options_.grow);
+    auto grown = grow_mask(*base, out.margin.margin_m, options_.grow);
     if (!grown) return std::unexpected(grown.error());
     out.masks.push_back(std::move(*grown));
   }

@@ -4,11 +4,17 @@
 // black: each moved forward by its predicted motion to the moment the frame is shown and grown
 // by the computed security margin (projector/mask_margin.h, motion.h, mask_geometry.h).
 //
-// Latency L for the margin: the configured quantile of the measured motion-to-photon latencies
-// (mesh capture_ns -> frame rendered, recorded by shown()); before any measurement,
-// `initial_latency_s`. Prediction horizon per mesh: its age when the frame is shown,
+// Latency L for the margin, per actor: the larger of the configured quantile of the measured
+// motion-to-photon latencies (mesh capture_ns -> frame shown, recorded by shown(); before any
+// measurement, `initial_latency_s`) and the age of the actor's mesh at this frame's display_ns
+// (a mesh that is late — the hull stalled, frames drawn between meshes — is covered for the
+// time it has really been moving, not for a typical latency). Prediction horizon per mesh: its age when the frame is shown,
 // display_ns - capture_ns. One margin for all actors: the largest of theirs (head speed of an
 // actor from set_head_speed(), 0 when unknown).
+//
+// Cost: set_mesh() does the per-mesh work once — the motion estimate and the mask mesh's
+// simplification (mask_geometry.h simplify_for_mask) — and times both (last_mesh_cost());
+// plan() per frame only moves the simplified mesh forward and grows it.
 //
 // Bad input is refused by set_mesh() (empty, malformed, capture time going backwards) and the
 // previous mesh of that actor stays in use; the caller counts the refusal.
@@ -43,6 +49,12 @@ struct MaskPlan {
   std::uint64_t newest_frame = 0;
 };
 
+// Wall time of set_mesh()'s two stages, seconds (steady clock).
+struct MeshCost {
+  double motion_s = 0;    // MotionTracker::update
+  double simplify_s = 0;  // simplify_for_mask
+};
+
 class MaskPlanner {
  public:
   explicit MaskPlanner(MaskPlannerOptions options = {});
@@ -56,6 +68,8 @@ class MaskPlanner {
   // under test, prediction on or off). Errors: invalid options (the old ones stay).
   Expected<void> set_margin_options(const MarginOptions& margin);
   std::size_t actors() const { return actors_.size(); }
+  // The cost of the last accepted set_mesh().
+  const MeshCost& last_mesh_cost() const { return last_cost_; }
 
   // The masks for a frame to be shown at display_ns (CLOCK_REALTIME).
   Expected<MaskPlan> plan(std::int64_t display_ns) const;
@@ -67,6 +81,7 @@ class MaskPlanner {
  private:
   struct Actor {
     ActorMesh mesh;
+    MaskBase base;  // mesh, simplified for the mask (same vertices)
     std::uint64_t frame = 0;
     MotionTracker tracker;
     std::optional<MeshMotion> motion;
@@ -75,6 +90,7 @@ class MaskPlanner {
   MaskPlannerOptions options_;
   std::map<std::string, Actor> actors_;
   LatencyWindow latencies_;
+  MeshCost last_cost_;
 };
 
 }  // namespace studio::projector
