@@ -70,7 +70,10 @@ class WindowOutputTest : public studio::testing::ProcessTest {
     auto p = studio::testing::Process::start(
         {.name = "projector-" + monitor,
          .binary = "/usr/bin/xvfb-run",
-         .args = {"-a", "-s", "-screen 0 960x540x24", "/bin/sh", "-c", script,
+         // The auth file in the test's directory (xvfb-run's own temporary one has been seen
+         // removed under a running server on the shared test machine).
+         .args = {"-a", "-f", (dir_ / "Xauthority").string(), "-s", "-ac -screen 0 960x540x24",
+                  "/bin/sh", "-c", script,
                   studio::testing::built_binary("projector/studio-projector").string(),
                   "--config", config.string()},
          .env = dds_.env(),
@@ -166,11 +169,18 @@ TEST_F(WindowOutputTest, FullScreenWindowOnTheNamedMonitorShowsTheFrame) {
   ASSERT_TRUE(frame);
   std::this_thread::sleep_for(300ms);  // a few more (identical) frames shown
   testing::XScreen x;
-  for (int attempt = 0; attempt < 50 && x.width == 0; ++attempt) {  // a loaded machine: retry
+  for (int attempt = 0; attempt < 100 && x.width == 0; ++attempt) {  // a loaded machine: retry
     if (attempt > 0) std::this_thread::sleep_for(100ms);
     x = testing::read_x_screen(display, xauthority);
   }
-  ASSERT_GT(x.width, 0) << "XOpenDisplay(" << display << ") failed, XAUTHORITY " << xauthority;
+  ASSERT_GT(x.width, 0) << "XOpenDisplay(" << display << ") failed, XAUTHORITY " << xauthority
+                        << ", socket /tmp/.X11-unix/X" << display.substr(1) << " exists: "
+                        << std::filesystem::exists("/tmp/.X11-unix/X" + display.substr(1))
+                        << ", auth file exists: " << std::filesystem::exists(xauthority)
+                        << ", projector running: " << node.running() << ", lock: "
+                        << slurp("/tmp/.X" + display.substr(1) + "-lock") << ", xdpyinfo: "
+                        << std::system(("XAUTHORITY=" + xauthority + " xdpyinfo -display " +
+                                        display + " | head -3").c_str());
   const cv::Mat screen(x.height, x.width, CV_8UC3, x.rgb.data());
   ASSERT_EQ(screen.cols, 960);
   ASSERT_EQ(screen.rows, 540);
