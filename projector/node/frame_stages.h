@@ -23,14 +23,25 @@ namespace studio::projector {
 
 class FrameStages {
  public:
-  enum Stage { wait, motion, simplify, mask, draw, finish, readback, publish, mesh_to_frame,
-              present, kCount };
+  enum Stage {
+    wait,
+    motion,
+    simplify,
+    mask,
+    draw,
+    finish,
+    readback,
+    publish,
+    mesh_to_frame,
+    present,
+    kCount
+  };
 
   explicit FrameStages(runtime::Metrics& metrics) {
     static constexpr const char* kNames[kCount] = {
-        "stage_wait_ms", "stage_motion_ms",  "stage_simplify_ms", "stage_mask_ms",   "stage_draw_ms",
-        "stage_finish_ms", "stage_readback_ms", "stage_publish_ms", "mesh_to_frame_ms",
-        "stage_present_ms"};
+        "stage_wait_ms",    "stage_motion_ms", "stage_simplify_ms", "stage_mask_ms",
+        "stage_draw_ms",    "stage_finish_ms", "stage_readback_ms", "stage_publish_ms",
+        "mesh_to_frame_ms", "stage_present_ms"};
     for (int i = 0; i < kCount; ++i) gauges_[i] = &metrics.gauge(kNames[i]);
   }
   // One measurement of a stage, seconds.

@@ -64,9 +64,9 @@ Projector side_wall_projector() {
                                       Eigen::Vector3d(kWallX, 1.0, 0.3), "proj0");
   const Camera& c = p.camera;
   std::vector<double> ys, zs;
-  for (const Eigen::Vector2d px : {Eigen::Vector2d(0, 0), Eigen::Vector2d(c.width - 1, 0),
-                                   Eigen::Vector2d(0, c.height - 1),
-                                   Eigen::Vector2d(c.width - 1, c.height - 1)}) {
+  for (const Eigen::Vector2d& px :
+       {Eigen::Vector2d(0, 0), Eigen::Vector2d(c.width - 1, 0), Eigen::Vector2d(0, c.height - 1),
+        Eigen::Vector2d(c.width - 1, c.height - 1)}) {
     const Eigen::Vector3d o = c.centre_in_world(), d = c.pixel_ray_in_world(px);
     const Eigen::Vector3d hit = o + d * ((kWallX - o.x()) / d.x());
     ys.push_back(hit.y());
@@ -111,8 +111,8 @@ class LiveMaskTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = studio::testing::make_test_dir(std::string(info->test_suite_name()) + "." +
-                                          info->name());
+    dir_ =
+        studio::testing::make_test_dir(std::string(info->test_suite_name()) + "." + info->name());
     dds_ = studio::testing::DdsDomain::unique();
     dds_.apply_to_this_process();
   }
@@ -261,18 +261,19 @@ TEST_F(LiveMaskTest, ArmSwingLeavesNoProjectorLightOnTheTrueActor) {
   uint64_t capped = 0, control_beside = 0;
   std::vector<double> latency_ms, margins;
   for (const Shown& f : shown) {
-    const Mask truth = sim::actor_at_display(actor, projector.camera,
-                                             studio_time(f.render_done_ns), display);
+    const Mask truth =
+        sim::actor_at_display(actor, projector.camera, studio_time(f.render_done_ns), display);
     const sim::LitCount c = sim::count_lit(truth, f.blackout);
     lit += c.lit_actor;
     lit_frames += c.lit_actor > 0;
     if (c.lit_actor > 0)
-      std::printf("lit %llu px: frame rendered %.3f s into the run, %.0f ms after its mesh's "
-                  "capture, margin %.3f m%s\n",
-                  (unsigned long long)c.lit_actor,
-                  double(f.render_done_ns - shown.front().render_done_ns) * 1e-9,
-                  double(f.render_done_ns - f.capture_ns) * 1e-6, f.margin_m,
-                  f.predicted ? ", predicted" : "");
+      std::printf(
+          "lit %llu px: frame rendered %.3f s into the run, %.0f ms after its mesh's "
+          "capture, margin %.3f m%s\n",
+          (unsigned long long)c.lit_actor,
+          double(f.render_done_ns - shown.front().render_done_ns) * 1e-9,
+          double(f.render_done_ns - f.capture_ns) * 1e-6, f.margin_m,
+          f.predicted ? ", predicted" : "");
     wasted += c.wasted;
     actor_px += c.actor;
     const Mask later = sim::actor_at_display(actor, projector.camera,
@@ -295,14 +296,16 @@ TEST_F(LiveMaskTest, ArmSwingLeavesNoProjectorLightOnTheTrueActor) {
   const double margin_max = *std::max_element(margins.begin(), margins.end());
   std::printf(
       "{\"frames\": %zu, \"lit_actor_px\": %llu, \"frames_with_lit\": %llu, "
-      "\"actor_px_mean\": %.0f, \"wasted_px_mean\": %.0f, \"control_lit_px\": %llu, \"control_beside_px\": %llu, "
+      "\"actor_px_mean\": %.0f, \"wasted_px_mean\": %.0f, \"control_lit_px\": %llu, "
+      "\"control_beside_px\": %llu, "
       "\"motion_to_render_ms\": {\"p50\": %.1f, \"p95\": %.1f, \"p99\": %.1f}, "
       "\"margin_m\": {\"mean\": %.4f, \"max\": %.4f, \"cap\": %.2f}, \"capped_frames\": %llu, "
       "\"predicted_frames\": %llu}\n",
       shown.size(), (unsigned long long)lit, (unsigned long long)lit_frames, double(actor_px) / n,
-      double(wasted) / n, (unsigned long long)control_lit, (unsigned long long)control_beside, quantile(latency_ms, 0.5),
-      quantile(latency_ms, 0.95), quantile(latency_ms, 0.99), margin_mean, margin_max, kMarginCapM,
-      (unsigned long long)capped, (unsigned long long)predicted);
+      double(wasted) / n, (unsigned long long)control_lit, (unsigned long long)control_beside,
+      quantile(latency_ms, 0.5), quantile(latency_ms, 0.95), quantile(latency_ms, 0.99),
+      margin_mean, margin_max, kMarginCapM, (unsigned long long)capped,
+      (unsigned long long)predicted);
   RecordProperty("lit_actor_px", std::to_string(lit));
   RecordProperty("wasted_px_mean", std::to_string(double(wasted) / n));
   RecordProperty("margin_mean_m", std::to_string(margin_mean));
@@ -328,9 +331,10 @@ TEST_F(LiveMaskTest, ArmSwingLeavesNoProjectorLightOnTheTrueActor) {
     EXPECT_LT(double(capped) / n, 0.1);
     EXPECT_GT(control_lit, 100u);
   } else {
-    std::printf("the pipeline did not keep up (motion to render p50 %.0f ms > 100 ms): margin "
-                "mean %.3f m, %.0f %% of frames at the cap; the margin bound is not checked\n",
-                p50, margin_mean, 100.0 * double(capped) / n);
+    std::printf(
+        "the pipeline did not keep up (motion to render p50 %.0f ms > 100 ms): margin "
+        "mean %.3f m, %.0f %% of frames at the cap; the margin bound is not checked\n",
+        p50, margin_mean, 100.0 * double(capped) / n);
   }
   EXPECT_GT(double(predicted) / n, 0.8);
 }

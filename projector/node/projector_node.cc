@@ -9,13 +9,12 @@
 
 #include "core/clock.h"
 #include "core/log.h"
+#include "frame_output.h"
 #include "frame_stages.h"
 #include "projector/mesh_inbox.h"
 #include "projector_wire.h"
 #include "runtime/service_loop.h"
 #include "scene_mirror.h"
-#include "scene_render/egl_context.h"
-#include "window_output.h"
 #include "wire/convert.h"
 #include "wire/sample.h"
 #include "wire/scene_convert.h"
@@ -181,7 +180,9 @@ class ProjectorNode : public runtime::Node {
     if (head_speed) planner_.set_head_speed(options_.mesh_actor, *head_speed);
     return arrived;
   }
-  static double seconds(SteadyClock::duration d) { return std::chrono::duration<double>(d).count(); }
+  static double seconds(SteadyClock::duration d) {
+    return std::chrono::duration<double>(d).count();
+  }
 
   // The eye for this frame: the followed head when fresh, else the last good eye.
   Eigen::Vector3d eye_now(SteadyClock::time_point now) {
@@ -198,8 +199,8 @@ class ProjectorNode : public runtime::Node {
   // The render thread: its own GL context (EGL surfaceless, or the full-screen window's), one
   // frame per period.
   void render_loop() {
-    Output out;  // outlives the renderer, this thread
-    auto fr = init_renderer(out);
+    FrameOutput out;  // outlives the renderer, this thread
+    auto fr = open_frame_output(options_, view_, projector_.camera.id, out);
     init_.set_value(fr ? Expected<void>{} : std::unexpected(fr.error()));
     if (!fr) return;
     Frame state;
@@ -218,38 +219,6 @@ class ProjectorNode : public runtime::Node {
       next = SteadyClock::now() + period;
       render_one(*fr, state, out.window ? &*out.window : nullptr);
     }
-  }
-
-  // Where frames go: headless (EGL surfaceless) or a full-screen window; either's GL context.
-  struct Output {
-    std::optional<scene_render::HeadlessContext> headless;
-    std::optional<WindowOutput> window;
-  };
-
-  Expected<projector_render::FrameRenderer> init_renderer(Output& out) {
-    std::string renderer;
-    if (options_.output == OutputKind::window) {
-      auto w = WindowOutput::create(options_.monitor, "studio-projector " + projector_.camera.id);
-      if (!w) return std::unexpected(w.error());
-      renderer = w->renderer() + ", full-screen window on monitor " + w->monitor() + " (" +
-                 std::to_string(w->width()) + "x" + std::to_string(w->height()) + ")";
-      out.window.emplace(std::move(*w));
-    } else {
-      auto context = scene_render::HeadlessContext::create();
-      if (!context) return std::unexpected(context.error());
-      renderer = context->renderer() + ", headless";
-      out.headless.emplace(std::move(*context));
-    }
-    projector_render::FrameRendererOptions fo;
-    fo.form = options_.form;
-    fo.eye_texture_size = {options_.eye_texture[0], options_.eye_texture[1]};
-    fo.thumb_width = options_.thumbnail[0];
-    fo.thumb_height = options_.thumbnail[1];
-    auto fr = projector_render::FrameRenderer::create(view_, fo);
-    if (!fr) return fr;
-    STUDIO_LOG(info, kLog) << "rendering " << fr->width() << "x" << fr->height() << " on "
-                           << renderer;
-    return fr;
   }
 
   // What the render thread keeps from frame to frame.

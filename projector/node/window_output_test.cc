@@ -74,8 +74,8 @@ class WindowOutputTest : public studio::testing::ProcessTest {
          // removed under a running server on the shared test machine).
          .args = {"-a", "-f", (dir_ / "Xauthority").string(), "-s", "-ac -screen 0 960x540x24",
                   "/bin/sh", "-c", script,
-                  studio::testing::built_binary("projector/studio-projector").string(),
-                  "--config", config.string()},
+                  studio::testing::built_binary("projector/studio-projector").string(), "--config",
+                  config.string()},
          .env = dds_.env(),
          .dir = dir_});
     if (!p) throw std::runtime_error(p.error().message);
@@ -92,8 +92,8 @@ TEST_F(WindowOutputTest, FullScreenWindowOnTheNamedMonitorShowsTheFrame) {
   EXPECT_NE(*code, 0);
   std::smatch m;
   const std::string log = bad.log();
-  ASSERT_TRUE(std::regex_search(log, m,
-                                std::regex(R"(monitor 'no-such-monitor' not found \(connected: ([^,)]+))")))
+  ASSERT_TRUE(std::regex_search(
+      log, m, std::regex(R"(monitor 'no-such-monitor' not found \(connected: ([^,)]+))")))
       << log;
   const std::string monitor = m[1];
   std::printf("Xvfb's monitor: %s\n", monitor.c_str());
@@ -173,14 +173,15 @@ TEST_F(WindowOutputTest, FullScreenWindowOnTheNamedMonitorShowsTheFrame) {
     if (attempt > 0) std::this_thread::sleep_for(100ms);
     x = testing::read_x_screen(display, xauthority);
   }
-  ASSERT_GT(x.width, 0) << "XOpenDisplay(" << display << ") failed, XAUTHORITY " << xauthority
-                        << ", socket /tmp/.X11-unix/X" << display.substr(1) << " exists: "
-                        << std::filesystem::exists("/tmp/.X11-unix/X" + display.substr(1))
-                        << ", auth file exists: " << std::filesystem::exists(xauthority)
-                        << ", projector running: " << node.running() << ", lock: "
-                        << slurp("/tmp/.X" + display.substr(1) + "-lock") << ", xdpyinfo: "
-                        << std::system(("XAUTHORITY=" + xauthority + " xdpyinfo -display " +
-                                        display + " | head -3").c_str());
+  ASSERT_GT(x.width, 0)
+      << "XOpenDisplay(" << display << ") failed, XAUTHORITY " << xauthority
+      << ", socket /tmp/.X11-unix/X" << display.substr(1)
+      << " exists: " << std::filesystem::exists("/tmp/.X11-unix/X" + display.substr(1))
+      << ", auth file exists: " << std::filesystem::exists(xauthority)
+      << ", projector running: " << node.running()
+      << ", lock: " << slurp("/tmp/.X" + display.substr(1) + "-lock") << ", xdpyinfo: "
+      << std::system(
+             ("XAUTHORITY=" + xauthority + " xdpyinfo -display " + display + " | head -3").c_str());
   const cv::Mat screen(x.height, x.width, CV_8UC3, x.rgb.data());
   ASSERT_EQ(screen.cols, 960);
   ASSERT_EQ(screen.rows, 540);
@@ -207,9 +208,10 @@ TEST_F(WindowOutputTest, FullScreenWindowOnTheNamedMonitorShowsTheFrame) {
         const cv::Vec3b c = screen.at<cv::Vec3b>(y, x);
         black_in_mask += c[0] == 0 && c[1] == 0 && c[2] == 0;
       }
-  std::printf("window %s: thumbnail mean |diff| %.2f (sum over RGB), screen stddev %.1f, "
-              "blackout %d px, %d of them black on the screen\n",
-              display.c_str(), mean_diff, stddev[0], in_mask, black_in_mask);
+  std::printf(
+      "window %s: thumbnail mean |diff| %.2f (sum over RGB), screen stddev %.1f, "
+      "blackout %d px, %d of them black on the screen\n",
+      display.c_str(), mean_diff, stddev[0], in_mask, black_in_mask);
   EXPECT_GT(stddev[0], 10.0) << "the screen shows a picture, not a flat colour";
   EXPECT_LT(mean_diff, 3.0);
   EXPECT_GT(in_mask, 2000);

@@ -26,8 +26,8 @@ Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t 
   if (auto ok = mesh.validate(); !ok) return fail("actor " + actor_id + ": " + ok.error().message);
   auto it = actors_.find(actor_id);
   if (it == actors_.end())
-    it = actors_.emplace(actor_id, Actor{{}, {}, 0, MotionTracker(options_.motion), {}, 0, 0})
-             .first;
+    it =
+        actors_.emplace(actor_id, Actor{{}, {}, 0, MotionTracker(options_.motion), {}, 0, 0}).first;
   Actor& a = it->second;
   if (!a.mesh.vertices.empty() && mesh.capture_ns <= a.mesh.capture_ns)
     return fail("actor " + actor_id + ": mesh capture time not after the previous mesh's");
@@ -77,7 +77,8 @@ Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
     const double L =
         overruns_.empty() ? std::max(age, options_.initial_latency_s) : age + overrun_s();
     // No estimate for this mesh: the last known speed stands in (the head's when faster).
-    const double speed = a.motion ? a.head_speed_mps : std::max(a.head_speed_mps, a.known_speed_mps);
+    const double speed =
+        a.motion ? a.head_speed_mps : std::max(a.head_speed_mps, a.known_speed_mps);
     auto m = security_margin(options_.margin, L, speed, a.motion ? &*a.motion : nullptr);
     if (!m) return std::unexpected(m.error());
     predicted.push_back(m->predicted);
@@ -117,7 +118,8 @@ Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
 bool MaskPlanner::shown(const MaskPlan& plan, std::int64_t shown_ns) {
   if (plan.newest_capture_ns == 0) return false;
   if (!latencies_.add(plan.newest_capture_ns, shown_ns)) return false;
-  if (plan.display_ns > 0) (void)overruns_.add(plan.display_ns, std::max(shown_ns, plan.display_ns));
+  if (plan.display_ns > 0)
+    (void)overruns_.add(plan.display_ns, std::max(shown_ns, plan.display_ns));
   return true;
 }
 
