@@ -169,7 +169,7 @@ TEST_F(WindowOutputTest, FullScreenWindowOnTheNamedMonitorShowsTheFrame) {
   ASSERT_TRUE(frame);
   std::this_thread::sleep_for(300ms);  // a few more (identical) frames shown
   testing::XScreen x;
-  for (int attempt = 0; attempt < 100 && x.width == 0; ++attempt) {  // a loaded machine: retry
+  for (int attempt = 0; attempt < 300 && x.width == 0; ++attempt) {  // a loaded machine: retry
     if (attempt > 0) std::this_thread::sleep_for(100ms);
     x = testing::read_x_screen(display, xauthority);
   }
