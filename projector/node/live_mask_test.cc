@@ -320,21 +320,23 @@ TEST_F(LiveMaskTest, ArmSwingLeavesNoProjectorLightOnTheTrueActor) {
   // The mask: no projector light on the true actor at display time, in any frame.
   EXPECT_EQ(lit, 0u) << lit_frames << " frames with light on the actor";
   // The margin follows the measured latency: a slow machine means a larger margin, not a
-  // failure (0 lit is asserted above whatever the latency). Where the pipeline kept up
-  // (motion to render p50 <= 100 ms: the figures are p50 25 ms, p99 40 ms), the margin
-  // must stay well below its cap and the swing half a period later must be seen lit. On the
-  // shared 2-core machine under load 10-15 the p50 was 100-180 ms and the margin at the cap in
-  // most frames (mean 0.18-0.19 m): reported, not asserted.
-  const double p50 = quantile(latency_ms, 0.5);
-  if (p50 <= 100) {
+  // failure (0 lit is asserted above whatever the latency). Where the pipeline kept up (motion
+  // to render p50 <= 100 ms and p95 <= 150 ms; the figures are p50 25 ms, p99 40 ms; the
+  // margin follows the tail), the margin must stay well below its cap and the swing half a
+  // period later must be seen lit. On the shared 2-core machine under load 10-17 the p50 was
+  // 68-234 ms, the p95 257-551 ms and the margin at the cap in 65-89 % of the frames (mean
+  // 0.17-0.19 m): reported, not asserted.
+  const double p50 = quantile(latency_ms, 0.5), p95 = quantile(latency_ms, 0.95);
+  if (p50 <= 100 && p95 <= 150) {
     EXPECT_LT(margin_mean, 0.5 * kMarginCapM);
     EXPECT_LT(double(capped) / n, 0.1);
     EXPECT_GT(control_lit, 100u);
   } else {
     std::printf(
-        "the pipeline did not keep up (motion to render p50 %.0f ms > 100 ms): margin "
-        "mean %.3f m, %.0f %% of frames at the cap; the margin bound is not checked\n",
-        p50, margin_mean, 100.0 * double(capped) / n);
+        "the pipeline did not keep up (motion to render p50 %.0f ms, p95 %.0f ms; checked at "
+        "<= 100 / 150 ms): margin mean %.3f m, %.0f %% of frames at the cap; the margin bound "
+        "is not checked\n",
+        p50, p95, margin_mean, 100.0 * double(capped) / n);
   }
   EXPECT_GT(double(predicted) / n, 0.8);
 }
