@@ -72,6 +72,55 @@ TEST(MaskPlanner, StillActorGetsTheFloorAndMovingActorIsPredicted) {
   EXPECT_GT(p2->margin.margin_m, plan->margin.margin_m);
 }
 
+// A mesh older at display than the measured latency (no newer mesh came): the margin covers its
+// real age, up to the cap.
+TEST(MaskPlanner, StaleMeshIsCoveredForItsAge) {
+  MaskPlannerOptions o;
+  o.margin.prediction = false;
+  o.margin.cap_m = 1.0;
+  MaskPlanner planner(o);
+  for (int k = 0; k < 3; ++k)
+    ASSERT_TRUE(planner.set_mesh("a", k, sphere({0.04f * k, 1, 0}, 0.2f, kT0 + k * kDt)));
+  const int64_t last = kT0 + 2 * kDt;
+  auto fresh = planner.plan(last + 20'000'000);  // younger than the initial 40 ms latency
+  auto stale = planner.plan(last + 300'000'000);
+  ASSERT_TRUE(fresh && stale);
+  EXPECT_NEAR(fresh->margin.latency_s, 0.04, 1e-9);
+  EXPECT_NEAR(stale->margin.latency_s, 0.30, 1e-9);
+  // 1 m/s: 0.3 s of motion is covered.
+  EXPECT_NEAR(stale->margin.margin_m, o.margin.floor_m + 0.3, 0.02);
+  EXPECT_GT(stale->margin.margin_m, fresh->margin.margin_m + 0.2);
+
+  // Once frames were shown, the lateness measured on them (shown - planned) is added to the age:
+  // a frame planned for last + 20 ms and shown 30 ms later than planned.
+  ASSERT_TRUE(planner.shown(*fresh, last + 50'000'000));
+  EXPECT_NEAR(planner.overrun_s(), 0.030, 1e-9);
+  auto next = planner.plan(last + 20'000'000);
+  ASSERT_TRUE(next);
+  EXPECT_NEAR(next->margin.latency_s, 0.050, 1e-9);
+  // Early frames count as on time.
+  ASSERT_TRUE(planner.shown(*next, last));
+  ASSERT_TRUE(planner.shown(*next, last));
+  EXPECT_NEAR(planner.overrun_s(), 0.030, 1e-9);  // the 95 % quantile of {0.03, 0, 0}
+}
+
+// After a gap (no motion estimate for the new mesh) the actor is not taken as still: the margin
+// covers its last known speed over the latency.
+TEST(MaskPlanner, MeshAfterAGapKeepsTheLastKnownSpeed) {
+  MaskPlannerOptions o;
+  o.margin.cap_m = 1.0;
+  MaskPlanner planner(o);
+  for (int k = 0; k < 3; ++k)
+    ASSERT_TRUE(planner.set_mesh("a", k, sphere({0.04f * k, 1, 0}, 0.2f, kT0 + k * kDt)));
+  const int64_t after_gap = kT0 + 2 * kDt + 2'000'000'000;  // 2 s later: beyond max_dt_s
+  ASSERT_TRUE(planner.set_mesh("a", 60, sphere({0.1f, 1, 0}, 0.2f, after_gap)));
+  auto plan = planner.plan(after_gap + 100'000'000);
+  ASSERT_TRUE(plan);
+  EXPECT_FALSE(plan->margin.predicted);
+  EXPECT_NEAR(plan->margin.speed_mps, 1.0, 0.1);
+  EXPECT_NEAR(plan->margin.margin_m, o.margin.floor_m + 0.1, 0.015);  // 1 m/s over 0.1 s
+}
+
 TEST(MaskPlanner, RefusedMeshKeepsThePreviousAndLatencyComesFromShownFrames) {
   MaskPlanner planner;
   ASSERT_TRUE(planner.set_mesh("a", 1, sphere({0, 1, 0}, 0.2f, kT0)));

@@ -38,7 +38,12 @@ const char kConfigHelp[] =
     "  cameras:                          one entry per camera:\n"
     "    - id: cam0\n"
     "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true,\n"
-    "               frame_code: false, stamp: false, offset_us: 0, jitter_us: 0, drop_every: 0}\n"
+    "               frame_code: false, stamp: false, offset_us: 0, jitter_us: 0, drop_every: 0,\n"
+    "               motion: sequence, swing_peak_speed: 1.5}\n"
+    "                                    motion: the simulated actor's (idle, walk, turn,\n"
+    "                                    raise_hand, crouch, sequence, arm_swing: the fast arm\n"
+    "                                    swing, fingertips at swing_peak_speed m/s); every camera\n"
+    "                                    of a studio must give the same\n"
     "                                    stamp: frame number as a corner code in the pixels;\n"
     "                                    offset/jitter/drop_every: a real camera's imperfections\n"
     "                                    frame_code: the actor wears the frame number (preview tests)\n"
@@ -83,6 +88,8 @@ struct SimKeys {
   bool stamp = false;
   double offset_us = 0, jitter_us = 0;
   int drop_every = 0;
+  sim::Motion motion = sim::Motion::sequence;  // the simulated actor's motion (sim/actor.h)
+  double swing_peak_speed = 1.5;               // arm_swing: fingertip peak speed, m/s
   Expected<void> validate() const {
     if (index >= ring) return fail("index: must be below ring");
     return {};
@@ -127,6 +134,15 @@ const yaml::Schema<SimKeys> kSim{
     yaml::field("offset_us", &SimKeys::offset_us).range(-5e5, 5e5),
     yaml::field("jitter_us", &SimKeys::jitter_us).range(0, 1e6),
     yaml::field("drop_every", &SimKeys::drop_every).range(0, 1e9),
+    yaml::field("motion", &SimKeys::motion,
+                [](const yaml::Node& n) -> Expected<sim::Motion> {
+                  auto s = n.as_string();
+                  if (!s) return std::unexpected(s.error());
+                  auto m = sim::parse_motion(*s);
+                  if (!m) return n.fail("motion: " + m.error().message);
+                  return m;
+                }),
+    yaml::field("swing_peak_speed", &SimKeys::swing_peak_speed).range(0.05, 10),
 };
 const yaml::Schema<FileSourceOptions> kFiles{
     yaml::field("path", &FileSourceOptions::path).required().relative_path(),
@@ -233,6 +249,8 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
     SimSourceOptions so;
     so.paced = c.sim.paced;
     so.studio.frame_code = c.sim.frame_code;
+    so.studio.actor.motion = c.sim.motion;
+    so.studio.actor.swing_peak_speed = c.sim.swing_peak_speed;
     so.stamp = c.sim.stamp;
     so.offset_ns = int64_t(c.sim.offset_us * 1000);
     so.jitter_ns = int64_t(c.sim.jitter_us * 1000);

@@ -13,6 +13,7 @@
 //   cameras:
 //     - id: cam0
 //       source: {type: sim, ring: 6, index: 0, width: 704, height: 576}   # simulated ring camera
+//                 # motion: arm_swing (sim::Motion by name; default sequence), swing_peak_speed
 //     - id: cam1
 //       source: {type: files, path: DIR, fps: 25, loop: true}            # image folder replay
 //     - id: cam2

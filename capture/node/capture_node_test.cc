@@ -123,6 +123,9 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
        "source: index: must be below ring"},
       {"cameras:\n  - id: a\n    source: {type: tape}\n", "unknown source type 'tape'"},
       {"cameras:\n  - id: a\n    source: {type: sim, colour: red}\n", "colour: unknown key"},
+      {"cameras:\n  - id: a\n    source: {type: sim, motion: cartwheel}\n",
+       "motion: unknown motion 'cartwheel' (expected idle, walk, turn, raise_hand, crouch, "
+       "sequence or arm_swing)"},
       {"image: {rate: fast}\ncameras:\n  - id: a\n    source: {type: sim}\n", "image.rate"},
       {"cameras:\n  - id: a\n    source: {type: files, path: nowhere}\n", "nowhere"},
       {"clock: {fps: 25, period_ns: 40000000}\ncameras: []\n", "not both"},

@@ -15,7 +15,10 @@ Expected<void> ProjectorNodeOptions::validate() const {
   if (!(rate >= 1 && rate <= 240)) return fail("rate: 1..240 frames per second");
   if (eye_texture.size() != 2 || thumbnail.size() != 2 || default_eye.size() != 3)
     return fail("eye_texture and thumbnail: 2 numbers; default_eye: 3");
+  if (output == OutputKind::window && monitor.empty())
+    return fail("monitor: a name (or primary) for output: window");
   if (frame_every < 0) return fail("frame_every: >= 0");
+  if (!(display_lag_s >= 0 && display_lag_s <= 1)) return fail("display_lag: 0..1 seconds");
   if (!(head_timeout_s > 0)) return fail("head_timeout: > 0 seconds");
   return mask_options().validate();
 }
@@ -49,8 +52,18 @@ runtime::ServiceDefinition projector_service_definition() {
       "                            newer one arrives is dropped (meshes_superseded)\n"
       "    form: single_pass       single_pass (homography folded into the projection, the\n"
       "                            paper's) or two_pass (eye texture + 3x3 warp)\n"
+      "    output: headless        headless (EGL surfaceless, no display needed) or window: a\n"
+      "                            full-screen GLFW window on `monitor` showing every frame\n"
+      "                            (same renderer; the frame is blitted to the window, scaled if\n"
+      "                            the monitor's mode is not the projector's size)\n"
+      "    monitor: primary        output: window: the monitor's name as GLFW reports it (X11:\n"
+      "                            the xrandr output, e.g. HDMI-1) or primary; an unknown name\n"
+      "                            fails at start listing the connected monitors\n"
       "    eye_texture: [0, 0]     two_pass eye texture size; 0 0 = one texel per projector pixel\n"
       "    default_eye: [0, 1.7, 2]  eye (studio frame, m) until the actor's head arrives\n"
+      "    display_lag: 0.016      seconds from a rendered frame to its light on the cloth (the\n"
+      "                            projector's input lag): masks are predicted to that instant\n"
+      "                            and the measured latency the margin covers includes it\n"
       "    head_timeout: 2.0       seconds; an older head pose keeps the last good eye\n"
       "    frame_every: 1          publish studio/projector/frame every N frames (0: never)\n"
       "    thumbnail: [160, 90]    RGB8 thumbnail size in studio/projector/frame ([0, 0]: none)\n"
@@ -60,17 +73,22 @@ runtime::ServiceDefinition projector_service_definition() {
       "      prediction: true      move every mesh forward by its predicted motion\n"
       "      velocity_uncertainty: 0.05  m/s, sigma of the velocity estimate\n"
       "      head_disagreement: 0.5      m/s; a head faster than the mesh by more: no prediction\n"
-      "    latency:                motion to photon (mesh capture_ns -> frame rendered)\n"
+      "    latency:                the margin covers each mesh's age when the frame is shown\n"
+      "                            (capture_ns -> render done + display_lag, planned) plus this\n"
+      "                            quantile of how much later than planned frames were shown\n"
       "      window: 100           frames measured\n"
-      "      quantile: 0.95        the latency the margin covers\n"
-      "      initial: 0.04         seconds, before the first measurement\n"
-      "  Output: headless (EGL surfaceless, Mesa llvmpipe without a GPU); the frame is read back\n"
-      "  for studio/projector/frame. A real projector needs a window on its output: run the same\n"
-      "  renderer in a graphical session (not built yet: see deploy/systemd/studio-projector@).\n"
+      "      quantile: 0.95        of the lateness (and of motion to photon, latency_p_ms)\n"
+      "      initial: 0.04         seconds, the latency before the first frame is shown\n"
+      "  The frame is read back for studio/projector/frame (blackout mask, thumbnail) in both\n"
+      "  outputs; a window needs a display (DISPLAY; under systemd a graphical session).\n"
       "  Topics: studio/scene/node, studio/actor/mesh, studio/actor/head in;\n"
       "  studio/projector/calibration, studio/projector/frame, studio/service/status out\n"
-      "  (latency = motion to photon; margin_mm, latency_p_ms, render_ms, motion_ms,\n"
-      "  eye_rejected, meshes_rejected, meshes_superseded, mesh_motion_errors).\n";
+      "  (latency = motion to photon; margin_mm, latency_p_ms, overrun_p_ms (frames shown later\n"
+      "  than planned: the margin covers the mesh's age at display + this), render_ms,\n"
+      "  eye_rejected, meshes_rejected, meshes_superseded, mesh_motion_errors; where a mesh's\n"
+      "  time goes, ms: stage_wait_ms, stage_motion_ms, stage_simplify_ms, stage_mask_ms,\n"
+      "  stage_draw_ms, stage_finish_ms, stage_readback_ms, stage_publish_ms, stage_present_ms,\n"
+      "  mesh_to_frame_ms: see projector/node/frame_stages.h).\n";
   d.create = [](yaml::MapReader& config,
                 runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto section = config.required("projector");
@@ -96,8 +114,12 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::enum_field("form", &ProjectorNodeOptions::form,
                          {{"single_pass", projector_render::Form::single_pass},
                           {"two_pass", projector_render::Form::two_pass}}),
+        yaml::enum_field("output", &ProjectorNodeOptions::output,
+                         {{"headless", OutputKind::headless}, {"window", OutputKind::window}}),
+        yaml::field("monitor", &ProjectorNodeOptions::monitor),
         yaml::field("eye_texture", &ProjectorNodeOptions::eye_texture).size(2),
         yaml::field("default_eye", &ProjectorNodeOptions::default_eye).size(3),
+        yaml::field("display_lag", &ProjectorNodeOptions::display_lag_s).range(0, 1),
         yaml::field("head_timeout", &ProjectorNodeOptions::head_timeout_s).min(0.01),
         yaml::field("frame_every", &ProjectorNodeOptions::frame_every).range(0, 100000),
         yaml::field("thumbnail", &ProjectorNodeOptions::thumbnail).size(2),

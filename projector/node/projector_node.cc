@@ -9,11 +9,12 @@
 
 #include "core/clock.h"
 #include "core/log.h"
+#include "frame_output.h"
+#include "frame_stages.h"
 #include "projector/mesh_inbox.h"
 #include "projector_wire.h"
 #include "runtime/service_loop.h"
 #include "scene_mirror.h"
-#include "scene_render/egl_context.h"
 #include "wire/convert.h"
 #include "wire/sample.h"
 #include "wire/scene_convert.h"
@@ -32,7 +33,8 @@ class ProjectorNode : public runtime::Node {
         view_(std::move(view)),
         projector_(projector),
         planner_(options_.mask_options()),
-        loop_(ctx, kLog) {
+        loop_(ctx, kLog),
+        stages_(loop_.metrics()) {
     calibration_ =
         &loop_.output<studio_ProjectorCalibration>({.counter = "calibrations_out", .rate = false});
     frames_ = &loop_.output<studio_ProjectorFrame>({.counter = "frames_published", .rate = false});
@@ -73,10 +75,10 @@ class ProjectorNode : public runtime::Node {
     assets_failed_ = &loop_.counter("assets_failed");
     superseded_ = &loop_.counter("meshes_superseded");
     mesh_errors_ = &loop_.counter("mesh_motion_errors");
-    motion_ms_ = &loop_.metrics().gauge("motion_ms");
     margin_mm_ = &loop_.metrics().gauge("margin_mm");
     latency_p_ms_ = &loop_.metrics().gauge("latency_p_ms");
     render_ms_ = &loop_.metrics().gauge("render_ms");
+    overrun_p_ms_ = &loop_.metrics().gauge("overrun_p_ms");
   }
   ~ProjectorNode() override { stop(); }
 
@@ -134,6 +136,7 @@ class ProjectorNode : public runtime::Node {
     std::lock_guard lock(mutex_);
     auto replaced = inbox_.offer(id, s.frame, std::move(mesh));
     if (!replaced) return runtime::reject("mesh", replaced.error().message);
+    mesh_arrived_ = SteadyClock::now();
     if (*replaced) superseded_->add();
     wake_.notify_all();
     return {};
@@ -150,27 +153,35 @@ class ProjectorNode : public runtime::Node {
   }
 
   // The render thread's planner takes what the handlers left: removals, new meshes (their
-  // motion estimated here, outside the lock), the followed head's speed.
-  void take_inputs() {
+  // motion estimated and mask mesh simplified here, outside the lock), the followed head's
+  // speed. Returns when the newest mesh taken arrived (nullopt: no mesh).
+  std::optional<SteadyClock::time_point> take_inputs() {
     MeshInbox::Taken taken;
     std::optional<double> head_speed;
+    std::optional<SteadyClock::time_point> arrived;
     {
       std::lock_guard lock(mutex_);
       taken = inbox_.take();
       head_speed = head_speed_;
+      if (!taken.meshes.empty()) arrived = mesh_arrived_;
     }
-    if (!taken.meshes.empty()) {
-      const auto t0 = SteadyClock::now();
+    if (arrived) {
+      stages_.add(FrameStages::wait, seconds(SteadyClock::now() - *arrived));
       std::string error;
       if (const int refused = apply(std::move(taken), planner_, &error); refused > 0) {
         mesh_errors_->add(refused);
         STUDIO_LOG(debug, kLog) << error;
       }
-      motion_ms_->set(std::chrono::duration<double, std::milli>(SteadyClock::now() - t0).count());
+      stages_.add(FrameStages::motion, planner_.last_mesh_cost().motion_s);
+      stages_.add(FrameStages::simplify, planner_.last_mesh_cost().simplify_s);
     } else {
       apply(std::move(taken), planner_);
     }
     if (head_speed) planner_.set_head_speed(options_.mesh_actor, *head_speed);
+    return arrived;
+  }
+  static double seconds(SteadyClock::duration d) {
+    return std::chrono::duration<double>(d).count();
   }
 
   // The eye for this frame: the followed head when fresh, else the last good eye.
@@ -185,10 +196,11 @@ class ProjectorNode : public runtime::Node {
     return last_good_eye_;
   }
 
-  // The render thread: its own GL context (EGL surfaceless), one frame per period.
+  // The render thread: its own GL context (EGL surfaceless, or the full-screen window's), one
+  // frame per period.
   void render_loop() {
-    std::optional<scene_render::HeadlessContext> context;  // outlives the renderer, this thread
-    auto fr = init_renderer(context);
+    FrameOutput out;  // outlives the renderer, this thread
+    auto fr = open_frame_output(options_, view_, projector_.camera.id, out);
     init_.set_value(fr ? Expected<void>{} : std::unexpected(fr.error()));
     if (!fr) return;
     Frame state;
@@ -205,25 +217,8 @@ class ProjectorNode : public runtime::Node {
           return;
       }
       next = SteadyClock::now() + period;
-      render_one(*fr, state);
+      render_one(*fr, state, out.window ? &*out.window : nullptr);
     }
-  }
-
-  Expected<projector_render::FrameRenderer> init_renderer(
-      std::optional<scene_render::HeadlessContext>& out) {
-    auto context = scene_render::HeadlessContext::create();
-    if (!context) return std::unexpected(context.error());
-    projector_render::FrameRendererOptions fo;
-    fo.form = options_.form;
-    fo.eye_texture_size = {options_.eye_texture[0], options_.eye_texture[1]};
-    fo.thumb_width = options_.thumbnail[0];
-    fo.thumb_height = options_.thumbnail[1];
-    auto fr = projector_render::FrameRenderer::create(view_, fo);
-    if (!fr) return fr;
-    STUDIO_LOG(info, kLog) << "rendering " << fr->width() << "x" << fr->height() << " on "
-                           << context->renderer();
-    out.emplace(std::move(*context));
-    return fr;
   }
 
   // What the render thread keeps from frame to frame.
@@ -236,7 +231,7 @@ class ProjectorNode : public runtime::Node {
     uint64_t count = 0;
   };
 
-  void render_one(projector_render::FrameRenderer& fr, Frame& st) {
+  void render_one(projector_render::FrameRenderer& fr, Frame& st, WindowOutput* window) {
     std::optional<std::map<scene::NodeId, scene::Node>> nodes;
     {
       std::lock_guard lock(mutex_);
@@ -250,11 +245,20 @@ class ProjectorNode : public runtime::Node {
       scene_left_out_->add(r.left_out);
       assets_failed_->add(r.assets_failed);
     }
-    take_inputs();
+    const auto arrived = take_inputs();
     Eigen::Vector3d eye = eye_now(SteadyClock::now());
     const int64_t start_ns = realtime_ns();
+    auto t = SteadyClock::now();
+    auto stage = [&](FrameStages::Stage s) {
+      const auto now = SteadyClock::now();
+      stages_.add(s, seconds(now - t));
+      t = now;
+    };
     std::optional<MaskPlan> plan;
-    if (auto p = planner_.plan(start_ns + int64_t(st.render_s * 1e9))) plan = std::move(*p);
+    const int64_t lag_ns = int64_t(options_.display_lag_s * 1e9);
+    if (auto p = planner_.plan(start_ns + int64_t(st.render_s * 1e9) + lag_ns))
+      plan = std::move(*p);
+    stage(FrameStages::mask);
     const std::span<const ActorMesh> masks =
         plan ? std::span<const ActorMesh>(plan->masks) : std::span<const ActorMesh>();
     auto drawn = fr.render(st.scene, eye, masks);
@@ -267,7 +271,14 @@ class ProjectorNode : public runtime::Node {
       }
       drawn = fr.render(st.scene, eye, masks);
     }
+    stage(FrameStages::draw);
     fr.finish();
+    stage(FrameStages::finish);
+    if (arrived) stages_.add(FrameStages::mesh_to_frame, seconds(t - *arrived));
+    if (window) {  // on the projector: after the frame counts as rendered, like a display's lag
+      window->show(fr.framebuffer(), fr.width(), fr.height());
+      stage(FrameStages::present);
+    }
     const int64_t done_ns = realtime_ns();
     const double took = (done_ns - start_ns) * 1e-9;
     st.render_s = st.count++ == 0 ? took : 0.9 * st.render_s + 0.1 * took;
@@ -276,8 +287,9 @@ class ProjectorNode : public runtime::Node {
       std::lock_guard lock(mutex_);
       if (drawn) last_good_eye_ = eye;
     }
-    if (plan) planner_.shown(*plan, done_ns);
+    if (plan) planner_.shown(*plan, done_ns + lag_ns);  // on the cloth
     latency_p_ms_->set(planner_.latency_s() * 1e3);
+    overrun_p_ms_->set(planner_.overrun_s() * 1e3);
     render_ms_->set(st.render_s * 1e3);
     if (plan) margin_mm_->set(plan->margin.margin_m * 1e3);
     if (plan && plan->newest_capture_ns > 0)
@@ -289,12 +301,16 @@ class ProjectorNode : public runtime::Node {
 
   void publish(projector_render::FrameRenderer& fr, projector_render::Readback& rb,
                const MaskPlan* plan, const Eigen::Vector3d& eye, uint64_t count, int64_t done_ns) {
+    const auto t0 = SteadyClock::now();
     fr.read(rb);
+    const auto t1 = SteadyClock::now();
+    stages_.add(FrameStages::readback, seconds(t1 - t0));
     wire::Owned<studio_ProjectorFrame> f;
     fill_frame({projector_.camera.id, plan, eye, options_.form == projector_render::Form::two_pass,
                 count, done_ns},
                rb, *f);
     (void)frames_->write(*f);
+    stages_.add(FrameStages::publish, seconds(SteadyClock::now() - t1));
   }
 
   struct Head {
@@ -312,6 +328,7 @@ class ProjectorNode : public runtime::Node {
   MeshInbox inbox_;  // meshes for the render thread
   std::optional<double> head_speed_;
   std::optional<Head> head_;
+  SteadyClock::time_point mesh_arrived_;  // of the newest mesh offered
   Eigen::Vector3d last_good_eye_ = Eigen::Vector3d::Zero();
   std::promise<Expected<void>> init_;
   std::atomic<bool> degraded_{false};
@@ -322,8 +339,9 @@ class ProjectorNode : public runtime::Node {
                    *scene_left_out_ = nullptr, *assets_failed_ = nullptr, *superseded_ = nullptr,
                    *mesh_errors_ = nullptr;
   runtime::Gauge *margin_mm_ = nullptr, *latency_p_ms_ = nullptr, *render_ms_ = nullptr,
-                 *motion_ms_ = nullptr;
-  runtime::ServiceLoop loop_;  // last: stopped before the state above goes
+                 *overrun_p_ms_ = nullptr;
+  runtime::ServiceLoop loop_;  // stopped before the state above goes
+  FrameStages stages_;         // the render thread's (gauges of loop_'s metrics)
 
  public:
   void set_default_eye(const Eigen::Vector3d& eye) { last_good_eye_ = eye; }

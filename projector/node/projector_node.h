@@ -3,7 +3,8 @@
 // server. Renders the virtual scene from the actor's eye through the projector's screen rectangle
 // (single pass: the homography folded into the projection, or two pass: eye texture + warp) at
 // once per new actor mesh (drawn at once; stale undrawn meshes dropped and counted) and at least
-// at the projector's rate, headless (EGL surfaceless; no window), and blacks out every actor: their
+// at the projector's rate, headless (EGL surfaceless) or in a full-screen window on a named
+// monitor (GLFW, the same renderer; node/window_output.h), and blacks out every actor: their
 // latest meshes, moved forward by the predicted motion and grown by the computed margin, drawn
 // black from the projector with no depth test (projector/mask_planner.h).
 //
@@ -37,6 +38,8 @@ struct LatencyOptions {
   Expected<void> validate() const { return {}; }
 };
 
+enum class OutputKind { headless, window };
+
 struct ProjectorNodeOptions {
   std::string rig;              // rig.yaml holding the projector (relative to the config file)
   std::string projector;        // its id
@@ -44,8 +47,13 @@ struct ProjectorNodeOptions {
   std::string mesh_actor = "actor0";  // that actor's mesh id: the head's speed joins its margin
   double rate = 25;                   // frames per second without meshes (a mesh: a frame at once)
   projector_render::Form form = projector_render::Form::single_pass;
+  OutputKind output = OutputKind::headless;  // window: full screen on `monitor` (window_output.h)
+  std::string monitor = "primary";
   std::vector<int> eye_texture{0, 0};            // two pass: eye texture size, 0 0 = suggested
   std::vector<double> default_eye{0, 1.7, 2.0};  // eye until a head pose arrives, studio frame
+  // Render done -> the frame on the cloth (the projector's input lag and scan-out): the mask is
+  // predicted to, and the margin covers, the display instant, not the render's end.
+  double display_lag_s = 0.016;
   double head_timeout_s = 2.0;  // an older head pose falls back to the last good eye (counted)
   int frame_every = 1;          // publish studio/projector/frame every N rendered frames (0: never)
   std::vector<int> thumbnail{160, 90};

@@ -39,18 +39,35 @@ std::pair<ActorMesh, double> simplified(const ActorMesh& mesh, const GrowOptions
 
 }  // namespace
 
-Expected<ActorMesh> grow_mesh(const ActorMesh& input, double margin_m, const GrowOptions& options) {
-  if (auto v = input.validate(); !v) return std::unexpected(v.error());
-  if (!(margin_m >= 0) || !std::isfinite(margin_m)) return fail("grow mask: margin must be >= 0");
+namespace {
+
+Expected<void> check(const GrowOptions& options) {
   if (!(options.min_cosine > 0 && options.min_cosine <= 1))
     return fail("grow mask: min_cosine must be in (0, 1]");
   if (!(options.max_error >= 0 && options.error_safety >= 1))
     return fail("grow mask: max_error must be >= 0 and error_safety >= 1");
+  return {};
+}
+
+}  // namespace
+
+Expected<MaskBase> simplify_for_mask(const ActorMesh& input, const GrowOptions& options) {
+  if (auto v = input.validate(); !v) return std::unexpected(v.error());
+  if (auto ok = check(options); !ok) return std::unexpected(ok.error());
   // Fewer, larger triangles first: pushed out by the margin, each small triangle of a hull mesh
   // grows to the margin's size, and a renderer rasterises all of them over one another. The
   // simplification's error is added to the push, so the mask still covers the mesh.
   auto [mesh, error_m] = simplified(input, options);
-  margin_m += error_m;
+  return MaskBase{std::move(mesh), error_m};
+}
+
+Expected<ActorMesh> grow_mask(const MaskBase& base, double margin_m, const GrowOptions& options) {
+  const ActorMesh& mesh = base.mesh;
+  if (auto v = mesh.validate(); !v) return std::unexpected(v.error());
+  if (!(margin_m >= 0) || !std::isfinite(margin_m) || !(base.error_m >= 0))
+    return fail("grow mask: margin must be >= 0");
+  if (auto ok = check(options); !ok) return std::unexpected(ok.error());
+  margin_m += base.error_m;
   const std::vector<Eigen::Vector3f> normals = vertex_normals(mesh);
   std::vector<float> min_cos(mesh.vertices.size(), 1.0f);
   for (const auto& t : mesh.triangles) {
@@ -66,6 +83,13 @@ Expected<ActorMesh> grow_mesh(const ActorMesh& input, double margin_m, const Gro
     out.vertices[i] += normals[i] * static_cast<float>(margin_m / c);
   }
   return out;
+}
+
+Expected<ActorMesh> grow_mesh(const ActorMesh& input, double margin_m, const GrowOptions& options) {
+  if (!(margin_m >= 0) || !std::isfinite(margin_m)) return fail("grow mask: margin must be >= 0");
+  auto base = simplify_for_mask(input, options);
+  if (!base) return std::unexpected(base.error());
+  return grow_mask(*base, margin_m, options);
 }
 
 Expected<double> dilation_radius_px(const Camera& projector, const ActorMesh& mesh,

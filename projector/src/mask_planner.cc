@@ -1,6 +1,7 @@
 #include "projector/mask_planner.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace studio::projector {
@@ -17,21 +18,33 @@ Expected<void> MaskPlannerOptions::validate() const {
 
 MaskPlanner::MaskPlanner(MaskPlannerOptions options)
     : options_(std::move(options)),
-      latencies_(options_.latency_window, options_.latency_quantile) {}
+      latencies_(options_.latency_window, options_.latency_quantile),
+      overruns_(options_.latency_window, options_.latency_quantile) {}
 
 Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t frame,
                                      ActorMesh mesh) {
   if (auto ok = mesh.validate(); !ok) return fail("actor " + actor_id + ": " + ok.error().message);
   auto it = actors_.find(actor_id);
   if (it == actors_.end())
-    it = actors_.emplace(actor_id, Actor{{}, 0, MotionTracker(options_.motion), {}, 0}).first;
+    it =
+        actors_.emplace(actor_id, Actor{{}, {}, 0, MotionTracker(options_.motion), {}, 0, 0}).first;
   Actor& a = it->second;
   if (!a.mesh.vertices.empty() && mesh.capture_ns <= a.mesh.capture_ns)
     return fail("actor " + actor_id + ": mesh capture time not after the previous mesh's");
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  auto base = simplify_for_mask(mesh, options_.grow);
+  if (!base) return fail("actor " + actor_id + ": " + base.error().message);
+  const auto t1 = Clock::now();
   auto motion = a.tracker.update(mesh);
+  const auto t2 = Clock::now();
   a.motion = motion ? *motion : std::nullopt;  // no motion: the margin's no-prediction term
+  if (a.motion) a.known_speed_mps = a.motion->max_speed_mps;
   a.mesh = std::move(mesh);
+  a.base = std::move(*base);
   a.frame = frame;
+  last_cost_ = {std::chrono::duration<double>(t2 - t1).count(),
+                std::chrono::duration<double>(t1 - t0).count()};
   return {};
 }
 
@@ -55,12 +68,18 @@ double MaskPlanner::latency_s() const {
 
 Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
   MaskPlan out;
-  const double latency = latency_s();
+  out.display_ns = display_ns;
+  const double latency = latency_s();  // for the record when there is no actor
   std::vector<bool> predicted;
   bool first = true;
   for (const auto& [id, a] : actors_) {
-    auto m = security_margin(options_.margin, latency, a.head_speed_mps,
-                             a.motion ? &*a.motion : nullptr);
+    const double age = std::clamp((display_ns - a.mesh.capture_ns) * 1e-9, 0.0, 10.0);
+    const double L =
+        overruns_.empty() ? std::max(age, options_.initial_latency_s) : age + overrun_s();
+    // No estimate for this mesh: the last known speed stands in (the head's when faster).
+    const double speed =
+        a.motion ? a.head_speed_mps : std::max(a.head_speed_mps, a.known_speed_mps);
+    auto m = security_margin(options_.margin, L, speed, a.motion ? &*a.motion : nullptr);
     if (!m) return std::unexpected(m.error());
     predicted.push_back(m->predicted);
     if (first || m->margin_m > out.margin.margin_m) out.margin = *m;
@@ -76,19 +95,20 @@ Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
   }
   std::size_t k = 0;
   for (const auto& [id, a] : actors_) {
-    const ActorMesh* mesh = &a.mesh;
-    ActorMesh moved;
+    const MaskBase* base = &a.base;
+    MaskBase moved;
     // Each actor moved forward when its own margin relies on the prediction; the margin drawn
-    // is the largest, which covers every actor's own.
+    // is the largest, which covers every actor's own. The simplified mesh keeps the mesh's
+    // vertices, so the motion (per vertex of the mesh) moves it as it would the mesh.
     if (predicted[k++] && a.motion) {
       const double horizon = std::clamp((display_ns - a.mesh.capture_ns) * 1e-9, 0.0, 1.0);
-      auto p = predict(a.mesh, *a.motion, horizon);
+      auto p = predict(a.base.mesh, *a.motion, horizon);
       if (p) {
-        moved = std::move(*p);
-        mesh = &moved;
+        moved = {std::move(*p), a.base.error_m};
+        base = &moved;
       }
     }
-    auto grown = grow_mesh(*mesh, out.margin.margin_m, options_.grow);
+    auto grown = grow_mask(*base, out.margin.margin_m, options_.grow);
     if (!grown) return std::unexpected(grown.error());
     out.masks.push_back(std::move(*grown));
   }
@@ -97,7 +117,10 @@ Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
 
 bool MaskPlanner::shown(const MaskPlan& plan, std::int64_t shown_ns) {
   if (plan.newest_capture_ns == 0) return false;
-  return latencies_.add(plan.newest_capture_ns, shown_ns);
+  if (!latencies_.add(plan.newest_capture_ns, shown_ns)) return false;
+  if (plan.display_ns > 0)
+    (void)overruns_.add(plan.display_ns, std::max(shown_ns, plan.display_ns));
+  return true;
 }
 
 }  // namespace studio::projector

@@ -33,8 +33,25 @@ struct GrowOptions {
   double error_safety = 1.5;
 };
 
-// Errors: invalid mesh, negative or non-finite margin.
+// Errors: invalid mesh, negative or non-finite margin. = grow_mask(simplify_for_mask(mesh)).
 Expected<ActorMesh> grow_mesh(const ActorMesh& mesh, double margin_m,
+                              const GrowOptions& options = {});
+
+// The two halves of grow_mesh(), so a caller that grows one mesh for many frames (the projector:
+// a mesh per 40 ms, frames in between, each predicted to its own display instant) simplifies it
+// once. MaskBase::mesh keeps every vertex of the input (unused ones included: a motion estimated
+// per input vertex still applies, projector/motion.h predict()) and at most max_triangles
+// triangles; error_m is how far its surface may lie from the input's (the simplifier's error x
+// error_safety), which grow_mask() adds to the margin.
+struct MaskBase {
+  ActorMesh mesh;
+  double error_m = 0;
+};
+// Errors: invalid mesh or options.
+Expected<MaskBase> simplify_for_mask(const ActorMesh& mesh, const GrowOptions& options = {});
+// Every vertex pushed out by (margin + base.error_m) / c (see above); no further simplification.
+// Errors: invalid mesh, negative or non-finite margin, invalid options.
+Expected<ActorMesh> grow_mask(const MaskBase& base, double margin_m,
                               const GrowOptions& options = {});
 
 // Errors: invalid mesh, negative margin, no vertex in front of the projector.

@@ -4,11 +4,25 @@
 // black: each moved forward by its predicted motion to the moment the frame is shown and grown
 // by the computed security margin (projector/mask_margin.h, motion.h, mask_geometry.h).
 //
-// Latency L for the margin: the configured quantile of the measured motion-to-photon latencies
-// (mesh capture_ns -> frame rendered, recorded by shown()); before any measurement,
-// `initial_latency_s`. Prediction horizon per mesh: its age when the frame is shown,
+// Latency L for the margin, per actor and frame: the motion-to-photon latency of this frame's
+// mesh, i.e. its age when the frame is shown = (display_ns - capture_ns), known at plan time up
+// to how late the frame really is shown, plus the configured quantile of that lateness measured
+// on the frames shown so far (shown_ns - planned display_ns, 0 when early; recorded by shown()).
+// Before any frame was shown: max(age, initial_latency_s). So a mesh that spent long in the
+// pipeline — or a frame drawn long after its mesh (the hull stalled) — is covered for the time
+// it has really been moving, and a slow earlier mesh does not inflate the margin of a fresh one.
+// latency_s() reports the quantile of the measured motion-to-photon latencies (capture_ns ->
+// shown) for the status. Prediction horizon per mesh: its age when the frame is shown,
 // display_ns - capture_ns. One margin for all actors: the largest of theirs (head speed of an
 // actor from set_head_speed(), 0 when unknown).
+//
+// Cost: set_mesh() does the per-mesh work once — the motion estimate and the mask mesh's
+// simplification (mask_geometry.h simplify_for_mask) — and times both (last_mesh_cost());
+// plan() per frame only moves the simplified mesh forward and grows it.
+//
+// A mesh without a motion estimate (the first after a gap longer than MotionOptions::max_dt_s,
+// e.g. the hull stalled) is not taken as still: its no-prediction margin uses the actor's last
+// known speed (the fastest region of its last estimate) when that exceeds its head's.
 //
 // Bad input is refused by set_mesh() (empty, malformed, capture time going backwards) and the
 // previous mesh of that actor stays in use; the caller counts the refusal.
@@ -41,6 +55,13 @@ struct MaskPlan {
   Margin margin;                       // the margin in use (the largest of the actors')
   std::int64_t newest_capture_ns = 0;  // of the newest mesh in the plan (0: none)
   std::uint64_t newest_frame = 0;
+  std::int64_t display_ns = 0;  // the instant it was planned for
+};
+
+// Wall time of set_mesh()'s two stages, seconds (steady clock).
+struct MeshCost {
+  double motion_s = 0;    // MotionTracker::update
+  double simplify_s = 0;  // simplify_for_mask
 };
 
 class MaskPlanner {
@@ -56,6 +77,8 @@ class MaskPlanner {
   // under test, prediction on or off). Errors: invalid options (the old ones stay).
   Expected<void> set_margin_options(const MarginOptions& margin);
   std::size_t actors() const { return actors_.size(); }
+  // The cost of the last accepted set_mesh().
+  const MeshCost& last_mesh_cost() const { return last_cost_; }
 
   // The masks for a frame to be shown at display_ns (CLOCK_REALTIME).
   Expected<MaskPlan> plan(std::int64_t display_ns) const;
@@ -63,18 +86,24 @@ class MaskPlanner {
   // (no mesh, or a latency that is negative or above 10 s).
   bool shown(const MaskPlan& plan, std::int64_t shown_ns);
   double latency_s() const;
+  // The quantile of (shown - planned display), seconds (0 before any frame was shown).
+  double overrun_s() const { return overruns_.empty() ? 0.0 : overruns_.latency_s(); }
 
  private:
   struct Actor {
     ActorMesh mesh;
+    MaskBase base;  // mesh, simplified for the mask (same vertices)
     std::uint64_t frame = 0;
     MotionTracker tracker;
     std::optional<MeshMotion> motion;
     double head_speed_mps = 0;
+    double known_speed_mps = 0;  // the fastest region of the last motion estimated (kept)
   };
   MaskPlannerOptions options_;
   std::map<std::string, Actor> actors_;
   LatencyWindow latencies_;
+  LatencyWindow overruns_;  // shown_ns - planned display_ns (>= 0), same window and quantile
+  MeshCost last_cost_;
 };
 
 }  // namespace studio::projector

@@ -1,0 +1,131 @@
+// The projector's mask cost per mesh and per frame (projector/mask_planner.h), on meshes of the
+// simulated actor swinging its arm at 1.5 m/s (~11k vertices, 25 Hz, as motion_bench.cc):
+//   BM_FrameMask_SimplifyPerFrame  baseline, what plan() did before: the whole mesh moved forward
+//                                  by its motion, then simplified (meshoptimizer) and grown —
+//                                  for every frame drawn
+//   BM_FrameMask_SimplifiedOnce    plan() now: the mesh simplified once (set_mesh), per frame only
+//                                  the simplified mesh moved forward and grown
+//   BM_SetMesh                     MaskPlanner::set_mesh per mesh: motion estimate + simplification
+//   BM_MeshAndFrame/<old|new>      one mesh and the frame drawn with it, the node's unit of work
+//                                  (set_mesh + plan), before and after
+#include <benchmark/benchmark.h>
+
+#include "projector/mask_geometry.h"
+#include "projector/mask_planner.h"
+#include "projector/motion.h"
+#include "sim/actor.h"
+
+using namespace studio;
+
+namespace {
+
+constexpr int64_t kFrameNs = 40'000'000;
+constexpr double kMargin = 0.03;
+
+const std::vector<projector::ActorMesh>& meshes() {
+  static const std::vector<projector::ActorMesh> m = [] {
+    sim::Actor::Options ao;
+    ao.motion = sim::Motion::arm_swing;
+    const sim::Actor actor(ao);
+    std::vector<projector::ActorMesh> out;
+    for (int f = 0; f < 8; ++f) {
+      const sim::TriangleMesh body = actor.body_at(2.0 + f * 0.04).mesh(f % 2 ? 22 : 24);
+      projector::ActorMesh a;
+      a.vertices = body.vertices;
+      a.triangles = body.triangles;
+      a.capture_ns = 1'000'000'000 + f * kFrameNs;
+      out.push_back(std::move(a));
+    }
+    return out;
+  }();
+  return m;
+}
+
+// The last two meshes' motion (what plan() predicts with).
+const projector::MeshMotion& motion() {
+  static const projector::MeshMotion m = [] {
+    projector::MotionTracker t;
+    (void)t.update(meshes()[0]);
+    (void)t.update(meshes()[1]);
+    return t.update(meshes()[2]).value().value();
+  }();
+  return m;
+}
+
+void BM_FrameMask_SimplifyPerFrame(benchmark::State& state) {
+  const auto& mesh = meshes()[2];
+  for (auto _ : state) {
+    auto moved = projector::predict(mesh, motion(), 0.06);
+    auto grown = projector::grow_mesh(*moved, kMargin);
+    benchmark::DoNotOptimize(grown);
+  }
+  state.counters["triangles_in"] = double(mesh.triangles.size());
+}
+BENCHMARK(BM_FrameMask_SimplifyPerFrame)->Unit(benchmark::kMillisecond)->MinTime(1);
+
+void BM_FrameMask_SimplifiedOnce(benchmark::State& state) {
+  const auto base = projector::simplify_for_mask(meshes()[2]).value();
+  for (auto _ : state) {
+    auto moved = projector::predict(base.mesh, motion(), 0.06);
+    auto grown = projector::grow_mask({std::move(*moved), base.error_m}, kMargin);
+    benchmark::DoNotOptimize(grown);
+  }
+  state.counters["triangles_drawn"] = double(base.mesh.triangles.size());
+}
+BENCHMARK(BM_FrameMask_SimplifiedOnce)->Unit(benchmark::kMillisecond)->MinTime(1);
+
+// Meshes fed to a planner with increasing capture times (wrapping the sequence).
+struct Feed {
+  int64_t shift = 0;
+  size_t k = 0;
+  projector::ActorMesh next() {
+    const auto& m = meshes();
+    projector::ActorMesh mesh = m[k % m.size()];
+    mesh.capture_ns += shift;
+    if (++k % m.size() == 0) shift += int64_t(m.size()) * kFrameNs;
+    return mesh;
+  }
+};
+
+void BM_SetMesh(benchmark::State& state) {
+  projector::MaskPlanner planner;
+  Feed feed;
+  for (auto _ : state) {
+    auto ok = planner.set_mesh("actor0", feed.k, feed.next());
+    if (!ok) state.SkipWithError(ok.error().message.c_str());
+  }
+  state.counters["motion_ms"] = planner.last_mesh_cost().motion_s * 1e3;
+  state.counters["simplify_ms"] = planner.last_mesh_cost().simplify_s * 1e3;
+}
+BENCHMARK(BM_SetMesh)->Unit(benchmark::kMillisecond)->MinTime(2);
+
+// One mesh and its frame. old: the motion estimate, then for the frame the whole mesh predicted,
+// simplified and grown (the planner before); new: MaskPlanner::set_mesh + plan.
+void BM_MeshAndFrame(benchmark::State& state) {
+  const bool old = state.range(0) == 0;
+  projector::MaskPlanner planner;
+  projector::MotionTracker tracker;
+  Feed feed;
+  for (auto _ : state) {
+    projector::ActorMesh mesh = feed.next();
+    const int64_t display_ns = mesh.capture_ns + 60'000'000;
+    if (old) {
+      auto m = tracker.update(mesh);
+      if (m && *m) {
+        auto moved = projector::predict(mesh, **m, 0.06);
+        auto grown = projector::grow_mesh(*moved, kMargin);
+        benchmark::DoNotOptimize(grown);
+      }
+    } else {
+      (void)planner.set_mesh("actor0", feed.k, std::move(mesh));
+      auto plan = planner.plan(display_ns);
+      benchmark::DoNotOptimize(plan);
+    }
+  }
+  state.SetLabel(old ? "old: simplify per frame" : "new: simplify per mesh");
+}
+BENCHMARK(BM_MeshAndFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(2);
+
+}  // namespace
+
+BENCHMARK_MAIN();

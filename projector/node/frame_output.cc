@@ -1,0 +1,36 @@
+#include "frame_output.h"
+
+#include "core/log.h"
+
+namespace studio::projector {
+
+Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeOptions& options,
+                                                            const ProjectorView& view,
+                                                            const std::string& projector_id,
+                                                            FrameOutput& out) {
+  std::string renderer;
+  if (options.output == OutputKind::window) {
+    auto w = WindowOutput::create(options.monitor, "studio-projector " + projector_id);
+    if (!w) return std::unexpected(w.error());
+    renderer = w->renderer() + ", full-screen window on monitor " + w->monitor() + " (" +
+               std::to_string(w->width()) + "x" + std::to_string(w->height()) + ")";
+    out.window.emplace(std::move(*w));
+  } else {
+    auto context = scene_render::HeadlessContext::create();
+    if (!context) return std::unexpected(context.error());
+    renderer = context->renderer() + ", headless";
+    out.headless.emplace(std::move(*context));
+  }
+  projector_render::FrameRendererOptions fo;
+  fo.form = options.form;
+  fo.eye_texture_size = {options.eye_texture[0], options.eye_texture[1]};
+  fo.thumb_width = options.thumbnail[0];
+  fo.thumb_height = options.thumbnail[1];
+  auto fr = projector_render::FrameRenderer::create(view, fo);
+  if (!fr) return fr;
+  STUDIO_LOG(info, "projector") << "rendering " << fr->width() << "x" << fr->height() << " on "
+                                << renderer;
+  return fr;
+}
+
+}  // namespace studio::projector

@@ -1,0 +1,28 @@
+#pragma once
+// Where the projector's frames go (projector_node.h `output:`): headless (EGL surfaceless) or a
+// full-screen window on a named monitor (window_output.h); either way the GL context is made
+// current on the calling thread (the render thread) and the FrameRenderer is created in it, so
+// the same rendering code serves both.
+
+#include <optional>
+
+#include "projector_node.h"
+#include "projector_render/frame_renderer.h"
+#include "scene_render/egl_context.h"
+#include "window_output.h"
+
+namespace studio::projector {
+
+struct FrameOutput {
+  std::optional<scene_render::HeadlessContext> headless;
+  std::optional<WindowOutput> window;  // set for output: window (show each frame there)
+};
+
+// Opens the output (into `out`, which must outlive the renderer) and creates the renderer.
+// Errors: no EGL / no display / unknown monitor / renderer resources (one line each).
+Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeOptions& options,
+                                                            const ProjectorView& view,
+                                                            const std::string& projector_id,
+                                                            FrameOutput& out);
+
+}  // namespace studio::projector

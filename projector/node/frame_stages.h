@@ -1,0 +1,61 @@
+#pragma once
+// Where a projector frame's time goes, from the arrival of an actor mesh (the DDS handler) to the
+// frame rendered with it, published as status gauges (ms, a running mean over about the last 20
+// frames that had the stage; issue 15: "the per-stage breakdown says where the time goes"):
+//   stage_wait_ms      mesh handed over by the handler -> the render thread takes it (the render
+//                      thread was busy with the previous frame, its read-back or publish)
+//   stage_motion_ms    the mesh's motion estimate (once per mesh, MaskPlanner::set_mesh)
+//   stage_simplify_ms  the mask mesh simplified (once per mesh)
+//   stage_mask_ms      per frame: the masks moved forward to the display instant and grown
+//   stage_draw_ms      per frame: GL commands for the scene and the masks (submission)
+//   stage_finish_ms    per frame: glFinish, i.e. llvmpipe rasterising the frame
+//   stage_readback_ms  per published frame: glReadPixels, blackout runs, thumbnail
+//   stage_publish_ms   per published frame: the studio/projector/frame sample written
+//   mesh_to_frame_ms   mesh arrival -> frame rendered (finished), frames with a new mesh
+//   stage_present_ms   per frame with output: window: blit to the window and swap
+// Render thread only (gauges are atomics; the status thread reads them).
+
+#include <array>
+
+#include "runtime/metrics.h"
+
+namespace studio::projector {
+
+class FrameStages {
+ public:
+  enum Stage {
+    wait,
+    motion,
+    simplify,
+    mask,
+    draw,
+    finish,
+    readback,
+    publish,
+    mesh_to_frame,
+    present,
+    kCount
+  };
+
+  explicit FrameStages(runtime::Metrics& metrics) {
+    static constexpr const char* kNames[kCount] = {
+        "stage_wait_ms",    "stage_motion_ms", "stage_simplify_ms", "stage_mask_ms",
+        "stage_draw_ms",    "stage_finish_ms", "stage_readback_ms", "stage_publish_ms",
+        "mesh_to_frame_ms", "stage_present_ms"};
+    for (int i = 0; i < kCount; ++i) gauges_[i] = &metrics.gauge(kNames[i]);
+  }
+  // One measurement of a stage, seconds.
+  void add(Stage s, double seconds) {
+    const double ms = seconds * 1e3;
+    mean_[s] = seen_[s] ? mean_[s] + 0.05 * (ms - mean_[s]) : ms;
+    seen_[s] = true;
+    gauges_[s]->set(mean_[s]);
+  }
+
+ private:
+  std::array<runtime::Gauge*, kCount> gauges_{};
+  std::array<double, kCount> mean_{};
+  std::array<bool, kCount> seen_{};
+};
+
+}  // namespace studio::projector
