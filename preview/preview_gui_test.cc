@@ -60,12 +60,18 @@ TEST_F(PreviewStudioTest, GuiPanelsDriveTheStudioAndTwoViewsRunSideBySide) {
   const std::map<std::string, std::string> views{
       {"director", "eye=0.6,1.9,3.7,at=0,1.1,0,fov=55"},
       {"operator", "eye=-3.5,2.5,1.0,at=0,1.0,0,fov=60"}};
-  for (const auto& [name, view] : views)
-    guis[name] = &spawn_path(name, "/usr/bin/xvfb-run",
-                             {"-a", "-s", "-screen 0 1024x768x24",
-                              studio::testing::built_binary("preview/studio-preview").string(),
-                              "--config", preview_config(name), "--viewpoint", view, "--size",
-                              "960x640", "--test-script", name == "director" ? director : op});
+  // Each on its own Xvfb display (xvfb-exec: `xvfb-run -a` races when two start at once).
+  for (const auto& [name, view] : views) {
+    auto args = studio::testing::xvfb_exec("1024x768x24", dir_ / (name + ".xenv"));
+    const std::string launcher = args.front();
+    args.erase(args.begin());
+    for (const std::string& a :
+         {studio::testing::built_binary("preview/studio-preview").string(), std::string("--config"),
+          preview_config(name), std::string("--viewpoint"), view, std::string("--size"),
+          std::string("960x640"), std::string("--test-script"), name == "director" ? director : op})
+      args.push_back(a);
+    guis[name] = &spawn_path(name, launcher, args);
+  }
   for (auto& [name, g] : guis) {
     const auto code = g->wait_exit(std::chrono::seconds(150));
     ASSERT_TRUE(code.has_value()) << name << " did not finish";

@@ -54,7 +54,7 @@ class PreviewStudioTest : public ::testing::Test {
     return processes_.back();
   }
 
-  // A program outside the build tree (xvfb-run).
+  // A program outside the build tree (tests/harness/xvfb-exec).
   Process& spawn_path(const std::string& name, const std::filesystem::path& binary,
                       std::vector<std::string> args) {
     auto p = Process::start(

@@ -104,6 +104,11 @@ fs::path built_binary(const std::string& relative) {
   return fs::path(STUDIO_BINARY_DIR) / relative;
 }
 
+std::vector<std::string> xvfb_exec(const std::string& screen, const fs::path& env_file) {
+  return {(fs::path(STUDIO_SOURCE_DIR) / "tests/harness/xvfb-exec").string(), screen,
+          env_file.string()};
+}
+
 Expected<Process> Process::start(Options o) {
   if (!fs::exists(o.binary)) return fail("harness: no such binary: " + o.binary.string());
   Process p;

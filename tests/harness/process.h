@@ -103,4 +103,10 @@ class Watchdog {
 // Path of a binary built in this tree (STUDIO_BINARY_DIR/<relative>).
 std::filesystem::path built_binary(const std::string& relative);
 
+// The arguments that run `command` on a private Xvfb display of `screen` (e.g. "960x540x24"):
+// tests/harness/xvfb-exec, which lets Xvfb choose a free display itself (`xvfb-run -a` races
+// when tests start at once) and writes "DISPLAY=:N" to `env_file`. Spawn its first element
+// with the rest as arguments, followed by the command and its arguments.
+std::vector<std::string> xvfb_exec(const std::string& screen, const std::filesystem::path& env_file);
+
 }  // namespace studio::testing
