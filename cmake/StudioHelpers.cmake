@@ -21,15 +21,25 @@ function(studio_test)
     STUDIO_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     STUDIO_SHARED_DATA="${STUDIO_SHARED_DATA}"
     STUDIO_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  # Before LABELS: a multi-valued LABELS ("integration;gl") is flattened into the property
-  # list, so the pairs after it do not reach ctest.
   set(serial "")
   if(T_SERIAL)
     set(serial RUN_SERIAL TRUE)
   endif()
+  # LABELS are not passed in PROPERTIES: gtest_discover_tests flattens every property value into
+  # one argument list (set_tests_properties(... LABELS integration gl TIMEOUT 300)), so a second
+  # label would be read as a property name and the pairs after it (TIMEOUT) lost. They are set
+  # after discovery instead, by an include file ctest reads after the one that adds the tests
+  # (${T_NAME}_TESTS is the list gtest_discover_tests defines). tests/ctest_properties_check.py
+  # checks that every test ends up with a TIMEOUT and its labels.
   gtest_discover_tests(${T_NAME}
-    PROPERTIES ${serial} LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT}
+    PROPERTIES ${serial} TIMEOUT ${T_TIMEOUT}
     DISCOVERY_TIMEOUT 60)
+  set(labels_file "${CMAKE_CURRENT_BINARY_DIR}/${T_NAME}_labels.cmake")
+  file(WRITE "${labels_file}"
+    "if(DEFINED ${T_NAME}_TESTS)\n"
+    "  set_tests_properties(\${${T_NAME}_TESTS} PROPERTIES LABELS [==[${T_LABELS}]==])\n"
+    "endif()\n")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${labels_file}")
   foreach(label ${T_LABELS})
     set_property(GLOBAL APPEND PROPERTY STUDIO_TESTS_${label} ${T_NAME})
   endforeach()

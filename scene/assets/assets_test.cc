@@ -58,7 +58,12 @@ TEST(Museum, GeneratedSceneMeetsTheBrief) {
   }
   EXPECT_GE(a->lights.size(), 3u);
   int light_nodes = 0;
-  for (const AssetNode& n : a->nodes) light_nodes += n.light >= 0;
+  for (const AssetNode& n : a->nodes) {
+    light_nodes += n.light >= 0;
+    // Each light hangs under the hall's root (the generator once attached them through a
+    // reference that add_node had invalidated: ASan, heap-use-after-free).
+    if (n.light >= 0) EXPECT_GE(n.parent, 0) << n.name;
+  }
   EXPECT_GE(light_nodes, 3);
   EXPECT_EQ(a->sha256, *sha256_file(kMuseum));
 

@@ -39,6 +39,7 @@ class GlbWriter {
                    const Eigen::Vector3f& emissive = Eigen::Vector3f::Zero());
   int add_mesh(const std::string& name, const MeshBuild& mesh, int material);
   int add_node(const GltfNode& node);
+  // Valid until the next add_node (which may reallocate the nodes).
   GltfNode& node(int index) { return nodes_[static_cast<std::size_t>(index)]; }
   // type: "point" | "directional" | "spot".
   int add_light(const std::string& name, const std::string& type, const Eigen::Vector3f& colour,

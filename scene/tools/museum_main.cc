@@ -212,7 +212,10 @@ int main(int argc, char** argv) {
     n.translation = at;
     n.rotation = rotation;
     n.light = w.add_light(name, type, colour, intensity);
-    w.node(root).children.push_back(w.add_node(n));
+    // add_node first: it may grow the node vector, which would leave a reference taken by
+    // w.node(root) in the same expression dangling (ASan: heap-use-after-free).
+    const int id = w.add_node(n);
+    w.node(root).children.push_back(id);
   };
   light("light_exhibits_left", "point", {1.0f, 0.97f, 0.92f}, 25, {-5, 4.3, -7},
         Eigen::Quaterniond::Identity());
