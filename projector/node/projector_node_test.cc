@@ -30,20 +30,6 @@ namespace {
 using namespace std::chrono_literals;
 using SteadyClock = std::chrono::steady_clock;
 
-// The back-wall projector at half resolution (960x540), so llvmpipe keeps up on a loaded machine.
-Projector test_projector() {
-  Projector p = testing::studio_projectors()[0];
-  Camera& c = p.camera;
-  c.id = "proj0";
-  c.width = 960;
-  c.height = 540;
-  c.intrinsics.fx /= 2;
-  c.intrinsics.fy /= 2;
-  c.intrinsics.cx = (c.intrinsics.cx + 0.5) / 2 - 0.5;
-  c.intrinsics.cy = (c.intrinsics.cy + 0.5) / 2 - 0.5;
-  return p;
-}
-
 // A closed box (12 triangles, outward faces) centred at c with half size h.
 ActorMesh box(const Eigen::Vector3f& c, float h, int64_t capture_ns) {
   ActorMesh m;
@@ -111,7 +97,7 @@ class ProjectorNodeTest : public studio::testing::ProcessTest {
 };
 
 TEST_F(ProjectorNodeTest, RendersTheSceneMasksTheActorAndReportsOverDds) {
-  const Projector projector = test_projector();
+  const Projector projector = testing::half_back_projector();
   auto& node =
       spawn("projector", "projector/studio-projector", {"--config", write_files(projector)});
   ASSERT_TRUE(node.wait_ready(30s)) << node.log();
@@ -280,7 +266,7 @@ TEST_F(ProjectorNodeTest, RendersTheSceneMasksTheActorAndReportsOverDds) {
 TEST_F(ProjectorNodeTest, DegenerateScreenIsOneLineAtStart) {
   // The rig as a stage could hand it over: the screen's corners on one line (write_rig refuses
   // to write such a rig, so the text is edited after a good one was written).
-  const std::string config = write_files(test_projector());
+  const std::string config = write_files(testing::half_back_projector());
   std::ifstream in(dir_ / "rig.yaml");
   std::stringstream text;
   text << in.rdbuf();
@@ -297,8 +283,9 @@ TEST_F(ProjectorNodeTest, DegenerateScreenIsOneLineAtStart) {
 }
 
 TEST_F(ProjectorNodeTest, EyeBehindTheScreenAsDefaultIsRefusedAtStart) {
-  auto& node = spawn("projector", "projector/studio-projector",
-                     {"--config", write_files(test_projector(), "  form: two_pass\n")});
+  auto& node =
+      spawn("projector", "projector/studio-projector",
+            {"--config", write_files(testing::half_back_projector(), "  form: two_pass\n")});
   (void)node;
   // A good two-pass config starts (the positive control of the refusal below).
   ASSERT_TRUE(node.wait_ready(30s)) << node.log();

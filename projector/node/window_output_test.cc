@@ -1,11 +1,11 @@
 // The projector service with `output: window` (issue 15 item 3: "a GLFW full-screen window on a
 // named monitor, same code"), as a real process on a private Xvfb display (tests/harness/xvfb-exec;
-// Xvfb's screen 960x540, the test projector's size). The test reads the X display itself (XGetImage of the root window: what
-// the monitor shows, independent of the projector's GL code) and compares it with the frame the
-// projector published for the same, static input: the thumbnail (read back from the renderer's
-// target, as headless) and the full-resolution blackout mask. A monitor name that is not
-// connected fails at start with one line listing the connected monitors; the name listed there
-// is then the positive control.
+// Xvfb's screen 960x540, the test projector's size). The test reads the X display itself (XGetImage
+// of the root window: what the monitor shows, independent of the projector's GL code) and compares
+// it with the frame the projector published for the same, static input: the thumbnail (read back
+// from the renderer's target, as headless) and the full-resolution blackout mask. A monitor name
+// that is not connected fails at start with one line listing the connected monitors; the name
+// listed there is then the positive control.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -31,20 +31,6 @@ namespace {
 using namespace std::chrono_literals;
 using SteadyClock = std::chrono::steady_clock;
 
-// The back-wall projector at half resolution (960x540).
-Projector half_projector() {
-  Projector p = testing::studio_projectors()[0];
-  Camera& c = p.camera;
-  c.id = "proj0";
-  c.width = 960;
-  c.height = 540;
-  c.intrinsics.fx /= 2;
-  c.intrinsics.fy /= 2;
-  c.intrinsics.cx = (c.intrinsics.cx + 0.5) / 2 - 0.5;
-  c.intrinsics.cy = (c.intrinsics.cy + 0.5) / 2 - 0.5;
-  return p;
-}
-
 std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p);
   std::stringstream s;
@@ -57,7 +43,7 @@ class WindowOutputTest : public studio::testing::ProcessTest {
   // The projector on a private Xvfb display; "DISPLAY=:N" is written to x.env.
   studio::testing::Process& spawn_in_xvfb(const std::string& monitor) {
     Rig rig;
-    rig.projectors.push_back(half_projector());
+    rig.projectors.push_back(testing::half_back_projector());
     EXPECT_TRUE(yaml::write_rig(rig, (dir_ / "rig.yaml").string()).has_value());
     const auto config = dir_ / ("projector-" + std::to_string(processes_.size()) + ".yaml");
     std::ofstream(config) << "instance: proj-window\nstatus_period: 0.2\nprojector:\n"

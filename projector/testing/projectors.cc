@@ -69,4 +69,17 @@ std::vector<Projector> studio_projectors() {
   return out;
 }
 
+Projector half_back_projector() {
+  Projector p = studio_projectors()[0];
+  Camera& c = p.camera;
+  c.id = "proj0";
+  c.width = 960;
+  c.height = 540;
+  c.intrinsics.fx /= 2;
+  c.intrinsics.fy /= 2;
+  c.intrinsics.cx = (c.intrinsics.cx + 0.5) / 2 - 0.5;
+  c.intrinsics.cy = (c.intrinsics.cy + 0.5) / 2 - 0.5;
+  return p;
+}
+
 }  // namespace studio::projector::testing

@@ -17,5 +17,8 @@ Projector make_projector(const std::string& id, const std::array<Eigen::Vector3d
                          const Eigen::Vector3d& offset, double roll);
 // back, left, tilted.
 std::vector<Projector> studio_projectors();
+// The back-wall projector as "proj0" at half resolution (960x540), so llvmpipe keeps up in the
+// node tests on a loaded machine (the intrinsics halved about the pixel-centre convention).
+Projector half_back_projector();
 
 }  // namespace studio::projector::testing
