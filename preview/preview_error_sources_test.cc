@@ -15,30 +15,19 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "scene_render/egl_context.h"
 #include "testing/held_out.h"
 
 namespace studio::preview::held_out {
 namespace {
 
-class PreviewErrorSourcesTest : public ::testing::Test {
+class PreviewErrorSourcesTest : public HeldOutTest {
  protected:
-  static void SetUpTestSuite() {
-    auto c = scene_render::HeadlessContext::create();
-    ASSERT_TRUE(c.has_value()) << c.error().message;
-    context_ = new scene_render::HeadlessContext(std::move(*c));
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
   static Scoring scoring(bool dump) {
     Scoring s;
     s.texturer.unseen = {1, 0, 1};
     if (const char* d = std::getenv("PREVIEW_DUMP_DIR"); d && dump) s.dump_dir = d;
     return s;
   }
-  static inline scene_render::HeadlessContext* context_ = nullptr;
 };
 
 const std::vector<Variant> kModes{{"nearest", TextureMode::nearest}, {"blend", TextureMode::blend}};

@@ -16,23 +16,13 @@
 
 #include <cstdio>
 
-#include "scene_render/egl_context.h"
 #include "testing/held_out.h"
 
 namespace studio::preview::held_out {
 namespace {
 
-class PreviewQualityTest : public ::testing::Test {
+class PreviewQualityTest : public HeldOutTest {
  protected:
-  static void SetUpTestSuite() {
-    auto c = scene_render::HeadlessContext::create();
-    ASSERT_TRUE(c.has_value()) << c.error().message;
-    context_ = new scene_render::HeadlessContext(std::move(*c));
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
   // Nearest and blend over kFrames, printed with where the blend's error is.
   static std::pair<Breakdown, Breakdown> run(bool hull) {
     Scoring s;
@@ -44,7 +34,6 @@ class PreviewQualityTest : public ::testing::Test {
                 r[0].line().c_str(), hull ? "visual hull" : "true surface", r[1].line().c_str());
     return {r[0], r[1]};
   }
-  static inline scene_render::HeadlessContext* context_ = nullptr;
 };
 
 // Measured 28.2 dB (nearest 18.0). Before the key threshold (actor_texturer.h key_threshold)

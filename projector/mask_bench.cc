@@ -13,47 +13,30 @@
 #include "projector/mask_geometry.h"
 #include "projector/mask_planner.h"
 #include "projector/motion.h"
-#include "sim/actor.h"
+#include "testing/swing_meshes.h"
 
 using namespace studio;
 
 namespace {
 
-constexpr int64_t kFrameNs = 40'000'000;
+constexpr int64_t kFrameNs = projector::testing::kSwingFrameNs;
 constexpr double kMargin = 0.03;
 
-const std::vector<projector::ActorMesh>& meshes() {
-  static const std::vector<projector::ActorMesh> m = [] {
-    sim::Actor::Options ao;
-    ao.motion = sim::Motion::arm_swing;
-    const sim::Actor actor(ao);
-    std::vector<projector::ActorMesh> out;
-    for (int f = 0; f < 8; ++f) {
-      const sim::TriangleMesh body = actor.body_at(2.0 + f * 0.04).mesh(f % 2 ? 22 : 24);
-      projector::ActorMesh a;
-      a.vertices = body.vertices;
-      a.triangles = body.triangles;
-      a.capture_ns = 1'000'000'000 + f * kFrameNs;
-      out.push_back(std::move(a));
-    }
-    return out;
-  }();
-  return m;
-}
+using projector::testing::swing_meshes;
 
 // The last two meshes' motion (what plan() predicts with).
 const projector::MeshMotion& motion() {
   static const projector::MeshMotion m = [] {
     projector::MotionTracker t;
-    (void)t.update(meshes()[0]);
-    (void)t.update(meshes()[1]);
-    return t.update(meshes()[2]).value().value();
+    (void)t.update(swing_meshes()[0]);
+    (void)t.update(swing_meshes()[1]);
+    return t.update(swing_meshes()[2]).value().value();
   }();
   return m;
 }
 
 void BM_FrameMask_SimplifyPerFrame(benchmark::State& state) {
-  const auto& mesh = meshes()[2];
+  const auto& mesh = swing_meshes()[2];
   for (auto _ : state) {
     auto moved = projector::predict(mesh, motion(), 0.06);
     auto grown = projector::grow_mesh(*moved, kMargin);
@@ -64,7 +47,7 @@ void BM_FrameMask_SimplifyPerFrame(benchmark::State& state) {
 BENCHMARK(BM_FrameMask_SimplifyPerFrame)->Unit(benchmark::kMillisecond)->MinTime(1);
 
 void BM_FrameMask_SimplifiedOnce(benchmark::State& state) {
-  const auto base = projector::simplify_for_mask(meshes()[2]).value();
+  const auto base = projector::simplify_for_mask(swing_meshes()[2]).value();
   for (auto _ : state) {
     auto moved = projector::predict(base.mesh, motion(), 0.06);
     auto grown = projector::grow_mask({std::move(*moved), base.error_m}, kMargin);
@@ -79,7 +62,7 @@ struct Feed {
   int64_t shift = 0;
   size_t k = 0;
   projector::ActorMesh next() {
-    const auto& m = meshes();
+    const auto& m = swing_meshes();
     projector::ActorMesh mesh = m[k % m.size()];
     mesh.capture_ns += shift;
     if (++k % m.size() == 0) shift += int64_t(m.size()) * kFrameNs;

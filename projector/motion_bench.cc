@@ -6,36 +6,18 @@
 #include <benchmark/benchmark.h>
 
 #include "projector/motion.h"
-#include "sim/actor.h"
+#include "testing/swing_meshes.h"
 
 using namespace studio;
 
 namespace {
 
-constexpr int64_t kFrameNs = 40'000'000;
+constexpr int64_t kFrameNs = projector::testing::kSwingFrameNs;
 
-const std::vector<projector::ActorMesh>& meshes() {
-  static const std::vector<projector::ActorMesh> m = [] {
-    sim::Actor::Options ao;
-    ao.motion = sim::Motion::arm_swing;
-    const sim::Actor actor(ao);
-    std::vector<projector::ActorMesh> out;
-    for (int f = 0; f < 8; ++f) {
-      // Alternate tessellations: consecutive meshes never share vertices (as the hull's).
-      const sim::TriangleMesh body = actor.body_at(2.0 + f * 0.04).mesh(f % 2 ? 22 : 24);
-      projector::ActorMesh a;
-      a.vertices = body.vertices;
-      a.triangles = body.triangles;
-      a.capture_ns = 1'000'000'000 + f * kFrameNs;
-      out.push_back(std::move(a));
-    }
-    return out;
-  }();
-  return m;
-}
+using projector::testing::swing_meshes;
 
 void run(benchmark::State& state, const projector::MotionOptions& options) {
-  const auto& m = meshes();
+  const auto& m = swing_meshes();
   projector::MotionTracker tracker(options);
   int64_t shift = 0;
   size_t k = 0;

@@ -31,6 +31,7 @@
 #include "hull/silhouette_cut.h"
 #include "preview/camera_select.h"
 #include "scene/view.h"
+#include "scene_render/egl_context.h"
 #include "scene_render/render_target.h"
 #include "sim/cameras.h"
 #include "sim/studio.h"
@@ -271,5 +272,23 @@ inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<V
 
 // Frames over the actor's sequence: walking, turning, the raised hand, crouching.
 inline const std::vector<int64_t> kFrames{20, 60, 100, 140, 190, 240, 290, 330, 370, 420};
+
+// A suite that scores against the held-out camera: one headless EGL context, current for every
+// test of the suite (the scoring renders in this process).
+class HeldOutTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    auto c = scene_render::HeadlessContext::create();
+    ASSERT_TRUE(c.has_value()) << c.error().message;
+    context_ = new scene_render::HeadlessContext(std::move(*c));
+  }
+  static void TearDownTestSuite() {
+    delete context_;
+    context_ = nullptr;
+  }
+
+ private:
+  static inline scene_render::HeadlessContext* context_ = nullptr;
+};
 
 }  // namespace studio::preview::held_out
