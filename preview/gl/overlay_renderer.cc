@@ -228,8 +228,13 @@ void OverlayRenderer::draw(const OverlayGeometry& g, const Eigen::Matrix4d& clip
       glDrawArrays(GL_LINES, 0, line_vertices);
       glLineWidth(1.0f);
     }
-    if (all_vertices > line_vertices)
+    // The head marker sits inside the actor's head mesh: drawn over everything (x-ray), so it
+    // shows where the tracker puts the head.
+    if (all_vertices > line_vertices) {
+      glDisable(GL_DEPTH_TEST);
       glDrawArrays(GL_TRIANGLES, line_vertices, all_vertices - line_vertices);
+      glEnable(GL_DEPTH_TEST);
+    }
   }
   glBindVertexArray(0);
   glUseProgram(0);

@@ -1,10 +1,12 @@
 #pragma once
 // Draws the preview's overlays (preview/overlays.h: head marker, camera and projector frusta,
 // projector screens with what each projector shows) into the bound framebuffer after the scene
-// and the actor, depth-tested against them (OpenGL 3.3 core; GL names are plain unsigned ints).
+// and the actor, lines and screens depth-tested against them (OpenGL 3.3 core; GL names are plain
+// unsigned ints).
 //
 // Lines are drawn 2 px wide where the context allows (else 1 px); spheres as shaded UV spheres
-// (normal-facing light, so the marker reads as a ball); a screen as two triangles whose
+// (normal-facing light, so the marker reads as a ball) over everything, without the depth test
+// (the head marker lies inside the actor's head mesh); a screen as two triangles whose
 // fragments look up the projector's thumbnail at the projector pixel of their world point
 // (projective texturing: u = (x + 0.5) / width, v = (y + 0.5) / height of the pixel K [R | t] x,
 // pixel centres at integers, the thumbnail's top row first), `screen_unlit` outside the
