@@ -5,6 +5,9 @@
 // depth maps. Samples: the simulated studio's actor (its tessellated true surface, ~the hull
 // mesh's size) and the five ring cameras' images of the same frame (352x288 and 704x576), made
 // once before timing. Each timed frame ends with glFinish (llvmpipe renders on the CPU).
+// BM_PreviewOverlays: the nearest-camera frame plus every overlay (the five cameras' frusta, a
+// projector's frustum and its screen showing a 160x90 thumbnail, a head marker); its baseline
+// is BM_PreviewFrame/cameras:1/image_w:352 of the same run.
 #include <benchmark/benchmark.h>
 
 #define GL_GLEXT_PROTOTYPES 1
@@ -13,6 +16,7 @@
 #include <numbers>
 
 #include "actor_texturer.h"
+#include "overlay_renderer.h"
 #include "scene/view.h"
 #include "scene_assets/scene_description.h"
 #include "scene_config/scene_yaml.h"
@@ -157,6 +161,43 @@ BENCHMARK(BM_PreviewNewMesh)
     ->Args({3, 704})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// The nearest-camera frame with every overlay on (preview/overlays.h).
+void BM_PreviewOverlays(benchmark::State& state) {
+  Fixture& f = fixture();
+  const Samples& s = f.samples.at(352);
+  f.target.bind();
+  upload(f, s, 1);
+  auto overlay = preview::OverlayRenderer::create().value();
+  std::vector<uint8_t> thumb(160 * 90 * 3);
+  for (std::size_t i = 0; i < thumb.size(); ++i) thumb[i] = uint8_t(i * 7);
+  (void)overlay.set_thumbnail("proj0", 160, 90, thumb.data());
+  Projector p;
+  p.camera = s.cameras[0];
+  p.camera.id = "proj0";
+  p.camera.width = 1280;
+  p.camera.height = 720;
+  p.camera.intrinsics.cx = 639.5;
+  p.camera.intrinsics.cy = 359.5;
+  p.screen = {Eigen::Vector3d(-2, 0, -2.5), Eigen::Vector3d(2, 0, -2.5),
+              Eigen::Vector3d(2, 2.5, -2.5), Eigen::Vector3d(-2, 2.5, -2.5)};
+  const auto geometry =
+      preview::build_overlays({}, s.cameras, {p}, {{"actor0", {0, 1.65, 0}, {0.3, 0, 0}, 1}});
+  const scene_render::View v = view();
+  const Eigen::Matrix4d clip = v.clip_from_cam * v.cam_from_world;
+  const std::array<float, 3> w{1, 0, 0};
+  for (auto _ : state) {
+    f.target.bind();
+    f.renderer.draw(f.scene, v);
+    f.texturer.draw({clip, kEye, kW, kH}, preview::TextureMode::nearest, w, kThreshold);
+    overlay.draw(geometry, clip, kW, kH);
+    glFinish();
+  }
+  state.counters["fps"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["lines"] = double(geometry.lines.size());
+}
+BENCHMARK(BM_PreviewOverlays)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

@@ -1,6 +1,7 @@
 // studio-preview's window under Xvfb (GLFW + Dear ImGui on Mesa), driven by its test hook
 // (--test-script, gui.h) against the running simulated studio: two instances with different
-// viewpoints side by side; one opens the Cameras panel and moves cam0's Gain slider. Checked:
+// viewpoints side by side; one opens the Cameras panel and moves cam0's Gain slider, the other
+// opens the Projectors panel. Checked:
 // the screenshot (the panel's title bar and the slider with its value at the places the window
 // reports, the scene drawn in the 3D view, the two views differ) and the wire (the simulated
 // camera's read-back on studio/camera/state becomes the new value).
@@ -54,8 +55,8 @@ TEST_F(PreviewStudioTest, GuiPanelsDriveTheStudioAndTwoViewsRunSideBySide) {
   std::ofstream(director) << "wait_meshes 3\nopen cameras\nwait 2\nset cam0 Gain 7.5\nwait 2\n"
                              "screenshot "
                           << (dir_ / "director.png").string() << "\nquit\n";
-  std::ofstream(op) << "wait_meshes 3\nwait 1\nscreenshot " << (dir_ / "operator.png").string()
-                    << "\nquit\n";
+  std::ofstream(op) << "wait_meshes 3\nopen projectors\nwait 1\nscreenshot "
+                    << (dir_ / "operator.png").string() << "\nquit\n";
   std::map<std::string, Process*> guis;
   const std::map<std::string, std::string> views{
       {"director", "eye=0.6,1.9,3.7,at=0,1.1,0,fov=55"},
@@ -117,6 +118,13 @@ TEST_F(PreviewStudioTest, GuiPanelsDriveTheStudioAndTwoViewsRunSideBySide) {
   EXPECT_GT(differ, shot.rows * shot.cols / 4) << "two viewpoints, two pictures";
   const std::string op_layout = slurp(dir_ / "operator.png.json");
   EXPECT_TRUE(rect(op_layout, "Cameras").empty()) << "the operator did not open the panel";
+  // The operator's Projectors panel (no projector runs here: the panel says so), its title
+  // drawn where the window reports it.
+  const auto projectors = rect(op_layout, "Projectors");
+  ASSERT_EQ(projectors.size(), 4u) << op_layout;
+  EXPECT_GT(text_pixels(other, {projectors[0], projectors[1], projectors[2], 19}), 10)
+      << "the title 'Projectors' in the title bar";
+  EXPECT_TRUE(rect(layout, "Projectors").empty()) << "the director did not open it";
   EXPECT_NE(op_layout.find("\"meshes\":"), std::string::npos);
 }
 

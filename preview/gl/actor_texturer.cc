@@ -7,6 +7,8 @@
 
 #include <string>
 
+#include "gl_program.h"
+
 namespace studio::preview {
 namespace {
 
@@ -139,50 +141,6 @@ void main() {
   frag = vec4(wsum > 0.0 ? sum / wsum : shade(unseen), 1);
 })";
 
-Expected<GLuint> compile(GLenum type, const char* source, const std::string& name) {
-  const GLuint s = glCreateShader(type);
-  glShaderSource(s, 1, &source, nullptr);
-  glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[512] = {};
-    glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    glDeleteShader(s);
-    std::string first = log;
-    return fail(name + ": shader: " + first.substr(0, first.find('\n')));
-  }
-  return s;
-}
-
-Expected<GLuint> program(const char* vs, const char* fs, const std::string& name) {
-  auto v = compile(GL_VERTEX_SHADER, vs, name);
-  if (!v) return std::unexpected(v.error());
-  auto f = compile(GL_FRAGMENT_SHADER, fs, name);
-  if (!f) {
-    glDeleteShader(*v);
-    return std::unexpected(f.error());
-  }
-  const GLuint p = glCreateProgram();
-  glAttachShader(p, *v);
-  glAttachShader(p, *f);
-  glLinkProgram(p);
-  glDeleteShader(*v);
-  glDeleteShader(*f);
-  GLint ok = 0;
-  glGetProgramiv(p, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    glDeleteProgram(p);
-    return fail(name + ": link failed");
-  }
-  return p;
-}
-
-void set_matrix(GLuint program, const char* name, const Eigen::Matrix4d& m) {
-  const Eigen::Matrix4f f = m.cast<float>();
-  glUniformMatrix4fv(glGetUniformLocation(program, name), 1, GL_FALSE, f.data());
-}
-
 Eigen::Matrix4d cam_from_world(const Camera& c) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
   m.topLeftCorner<3, 3>() = c.cam_from_world.R();
@@ -267,10 +225,10 @@ ActorTexturer::~ActorTexturer() = default;
 Expected<ActorTexturer> ActorTexturer::create(const TexturerOptions& options) {
   auto impl = std::make_unique<Impl>();
   impl->options = options;
-  auto d = program(kDepthVs, kDepthFs, "actor depth");
+  auto d = gl::program(kDepthVs, kDepthFs, "actor depth");
   if (!d) return std::unexpected(d.error());
   impl->depth_program = *d;
-  auto p = program(kDrawVs, kDrawFs, "textured actor");
+  auto p = gl::program(kDrawVs, kDrawFs, "textured actor");
   if (!p) return std::unexpected(p.error());
   impl->draw_program = *p;
   glGenVertexArrays(1, &impl->vao);
@@ -371,8 +329,8 @@ Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const u
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
   glUseProgram(impl_->depth_program);
-  set_matrix(impl_->depth_program, "clip_from_world", s.clip);
-  set_matrix(impl_->depth_program, "cam_from_world", s.cam);
+  gl::set_matrix(impl_->depth_program, "clip_from_world", s.clip);
+  gl::set_matrix(impl_->depth_program, "cam_from_world", s.cam);
   impl_->draw_mesh();
   glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous_fbo));
   glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
@@ -396,7 +354,7 @@ void ActorTexturer::draw(const DrawView& view, TextureMode mode,
   const GLuint p = r.draw_program;
   glUseProgram(p);
   auto at = [&](const std::string& name) { return glGetUniformLocation(p, name.c_str()); };
-  set_matrix(p, "clip_from_world", view.clip_from_world);
+  gl::set_matrix(p, "clip_from_world", view.clip_from_world);
   const int m = mode == TextureMode::flat ? 0 : mode == TextureMode::nearest ? 1 : 2;
   const TexturerOptions& o = r.options;
   glUniform1i(at("mode"), m);
@@ -415,8 +373,8 @@ void ActorTexturer::draw(const DrawView& view, TextureMode mode,
     float w = s.colour ? weights[i] : 0.0f;
     if (mode == TextureMode::nearest && i > 0) w = 0;
     glUniform1f(at("weight" + k), w);
-    set_matrix(p, ("clip" + k).c_str(), s.clip);
-    set_matrix(p, ("cam" + k).c_str(), s.cam);
+    gl::set_matrix(p, ("clip" + k).c_str(), s.clip);
+    gl::set_matrix(p, ("cam" + k).c_str(), s.cam);
     const Eigen::Vector3f c = s.centre.cast<float>();
     glUniform3f(at("centre" + k), c.x(), c.y(), c.z());
     glActiveTexture(GL_TEXTURE0 + 2 * i);

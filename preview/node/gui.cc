@@ -64,12 +64,13 @@ class Script {
       } else if (verb == "open") {
         std::string p;
         in >> p;
-        bool* flag = p == "cameras"     ? &panels.cameras
-                     : p == "capture"   ? &panels.capture
-                     : p == "animation" ? &panels.animation
-                     : p == "services"  ? &panels.services
-                     : p == "view"      ? &panels.view
-                                        : nullptr;
+        bool* flag = p == "cameras"      ? &panels.cameras
+                     : p == "capture"    ? &panels.capture
+                     : p == "animation"  ? &panels.animation
+                     : p == "services"   ? &panels.services
+                     : p == "view"       ? &panels.view
+                     : p == "projectors" ? &panels.projectors
+                                         : nullptr;
         if (!flag) return failed("open: unknown panel '" + p + "'");
         *flag = true;
       } else if (verb == "set") {
@@ -196,6 +197,7 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
     po.blend_options.cameras = config.blend_cameras;
     po.wait = std::chrono::milliseconds(config.wait_ms);
     po.asset_root = config.asset_root;
+    po.overlays = config.overlays;
     auto pipeline = ViewPipeline::create(node, po);
     if (!pipeline) return error(pipeline.error().message);
     PanelState panels;

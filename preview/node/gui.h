@@ -7,12 +7,13 @@
 // drives the real window and its panels exactly as a user's edit would:
 //   wait_meshes N            until N meshes were drawn (30 s at most)
 //   wait SECONDS
-//   open PANEL               cameras | capture | animation | services | view
+//   open PANEL               cameras | capture | animation | services | view | projectors
 //   set CAMERA FEATURE VALUE the camera panel's slider of FEATURE takes VALUE as if dragged
 //                            there: the panel sends CameraControl
 //   viewpoint V              eye=X,Y,Z,at=X,Y,Z[,fov=DEG]
 //   screenshot PNG           the window as drawn, plus PNG.json: {"windows": {title: [x, y, w,
-//                            h]}, "items": {"CAMERA/FEATURE": [x, y, w, h, value]}, "view":
+//                            h]}, "items": {"CAMERA/FEATURE": [x, y, w, h, value],
+//                            "projector/ID": [x, y, w, h, render frame]}, "view":
 //                            {"meshes": N, "textured": N}} (top-left origin, pixels)
 //   quit
 #include <string>

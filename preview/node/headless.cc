@@ -64,6 +64,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   po.blend_options.cameras = config.blend_cameras;
   po.wait = std::chrono::milliseconds(config.wait_ms);
   po.asset_root = config.asset_root;
+  po.overlays = config.overlays;
   auto pipeline = ViewPipeline::create(node, po);
   if (!pipeline) return error(pipeline.error().message, 1);
   auto target = scene_render::RenderTarget::create(config.width, config.height);
@@ -110,15 +111,18 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   const bool written = write_png(options.screenshot, rgba, config.width, config.height);
   const PipelineCounts& c = (*pipeline)->counts();
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const OverlayCounts o = node.overlays().counts();
   if (options.json)
     std::printf(
         "{\"screenshot\":\"%s\",\"width\":%d,\"height\":%d,\"meshes\":%llu,"
         "\"textured\":%llu,\"untextured\":%llu,\"late\":%llu,\"refused\":%llu,"
-        "\"skipped\":%llu,\"seconds\":%.3f,\"renderer\":\"%s\"}\n",
+        "\"skipped\":%llu,\"seconds\":%.3f,\"renderer\":\"%s\",\"overlays\":{\"heads\":%zu,"
+        "\"cameras\":%zu,\"projectors\":%zu,\"thumbnails\":%zu}}\n",
         options.screenshot.c_str(), config.width, config.height, (unsigned long long)c.meshes,
         (unsigned long long)c.textured, (unsigned long long)c.untextured,
         (unsigned long long)c.late, (unsigned long long)c.refused, (unsigned long long)c.skipped,
-        seconds, context->renderer().c_str());
+        seconds, context->renderer().c_str(), o.heads, node.cameras().size(), o.projectors,
+        o.thumbnails);
   else
     std::printf(
         "%s: %dx%d, %d meshes drawn (%llu textured, %llu untextured: %llu late, %llu refused; "

@@ -17,16 +17,20 @@ namespace {
 
 constexpr const char* kUsage =
     R"(usage: studio-preview [--config preview.yaml] [--viewpoint V] [--texturing blend|nearest]
-                      [--size WxH]
+                      [--size WxH] [--overlays LIST]
        studio-preview --headless --screenshot PNG [--frames N | --duration S] [--record DIR]
-                      [--timeout S]
+                      [--timeout S] [--settle S]
                       [--json] [same options]
 
 The director's preview and control panel: the virtual scene (studio/scene/node) and the live
 actor mesh (studio/actor/mesh) from any viewpoint, the actor textured from the studio cameras
 with the images of exactly the frame that built the mesh (requested from the capture servers'
 rings: studio/camera/image_request -> image_reply); panels for the cameras (CameraControl and
-read-back), capture (takes at a frame), animation (play, pause, seek, speed) and services.
+read-back), capture (takes at a frame), animation (play, pause, seek, speed), services and
+projectors (each projector's latest thumbnail). Over the 3D view: the tracked head
+(studio/actor/head), the studio cameras' frusta (studio/camera/calibration), the projectors'
+frusta and their screens showing what each projector shows (studio/projector/calibration and
+the thumbnails of studio/projector/frame).
 Publishes its own studio/service/status (service "preview", the config's instance).
 
 Options:
@@ -35,15 +39,21 @@ Options:
   --texturing T     blend (up to three cameras: the hull carved per pixel by their keys,
                     visibility by depth maps, per-point ULR weights) or nearest (the paper's)
   --size WxH        window or screenshot size
+  --overlays LIST   which overlays the 3D view draws: any of head, cameras, projectors,
+                    screens (comma separated), all or none (default all; preview.yaml's
+                    head_marker, camera_frusta, projector_frusta, projector_screens)
   --headless        no window: EGL surfaceless rendering (Mesa llvmpipe without a GPU)
   --screenshot PNG  headless: the last frame
   --frames N        headless: draw N new meshes, then stop (default 1; 0 = the scene only)
   --record DIR      headless: every drawn mesh's frame as DIR/<n>.png plus DIR/frames.jsonl
                     ({"image", "source_frame", "textured", "cameras"} per line)
   --timeout S       headless: give up after S seconds (default 30)
+  --settle S        headless with --frames 0: draw for S seconds before the screenshot, so
+                    the scene and the overlays' topics arrive (default 1)
   --duration S      headless: draw every mesh that arrives for S seconds, then stop (instead
                     of --frames)
-  --json            headless: the summary as one JSON line
+  --json            headless: the summary as one JSON line ("overlays": the heads, cameras,
+                    calibrated projectors and thumbnails received)
   --test-script F   GUI: scripted input for tests (gui.h: one action per line)
 
 Exit status: 0 done; 1 runtime failure (no display / EGL, DDS, fewer meshes than asked within
@@ -66,7 +76,7 @@ T number(const std::string& flag, const std::string& text, T lo, T hi) {
 }
 
 int run(int argc, char** argv) {
-  std::string config_path, viewpoint, texturing, size, script;
+  std::string config_path, viewpoint, texturing, size, script, overlays;
   bool headless = false;
   preview::HeadlessOptions h;
   for (int i = 1; i < argc; ++i) {
@@ -87,6 +97,10 @@ int run(int argc, char** argv) {
       texturing = value();
     } else if (a == "--size") {
       size = value();
+    } else if (a == "--overlays") {
+      overlays = value();
+    } else if (a == "--settle") {
+      h.settle_s = number<double>(a, value(), 0, 3600);
     } else if (a == "--headless") {
       headless = true;
     } else if (a == "--screenshot") {
@@ -125,6 +139,9 @@ int run(int argc, char** argv) {
     config->width = number<int>("--size", size.substr(0, x), 16, 8192);
     config->height = number<int>("--size", size.substr(x + 1), 16, 8192);
   }
+  if (!overlays.empty())
+    if (auto ok = preview::parse_overlay_list(overlays, config->overlays); !ok)
+      die("--overlays: " + ok.error().message);
   if (!config->log.empty() && !log::configure(config->log))
     die("log: bad spec '" + config->log + "'");
   if (headless) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 
 #include "studio.h"
@@ -156,6 +157,13 @@ void view_panel(PanelState& s, ViewPipeline& pipeline, Viewpoint& view, double n
   remember_window(s, "View");
   bool blend = pipeline.blend();
   if (ImGui::Checkbox("blend cameras (off: nearest)", &blend)) pipeline.set_blend(blend);
+  OverlayOptions& o = pipeline.overlays();
+  ImGui::Checkbox("head marker", &o.head);
+  ImGui::SameLine();
+  ImGui::Checkbox("camera frusta", &o.camera_frusta);
+  ImGui::Checkbox("projector frusta", &o.projector_frusta);
+  ImGui::SameLine();
+  ImGui::Checkbox("projector screens", &o.projector_screens);
   const PipelineCounts& c = pipeline.counts();
   ImGui::Text("meshes %llu: textured %llu, untextured %llu", (unsigned long long)c.meshes,
               (unsigned long long)c.textured, (unsigned long long)c.untextured);
@@ -191,6 +199,29 @@ void view_panel(PanelState& s, ViewPipeline& pipeline, Viewpoint& view, double n
   ImGui::End();
 }
 
+void projectors_panel(PanelState& s, PreviewNode& node, const ViewPipeline& pipeline) {
+  if (!ImGui::Begin("Projectors", &s.projectors)) return ImGui::End();
+  remember_window(s, "Projectors");
+  const auto projectors = node.overlays().projectors();
+  if (projectors.empty()) ImGui::TextUnformatted("no projector on the wire");
+  for (const auto& [id, p] : projectors) {
+    ImGui::Text("%s%s: frame %llu (mesh %llu), latency %.1f ms, margin %.0f mm", id.c_str(),
+                p.calibrated ? "" : " (no calibration)", (unsigned long long)p.render_frame,
+                (unsigned long long)p.mesh_frame, p.latency_ms, 1000 * p.margin_m);
+    const ViewPipeline::Thumbnail t = pipeline.thumbnail(id);
+    if (t.texture == 0) {
+      ImGui::TextUnformatted("  no thumbnail yet");
+      continue;
+    }
+    const float scale = 240.0f / float(t.width);
+    ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(t.texture)),
+                 ImVec2(240.0f, float(t.height) * scale));
+    const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+    s.items["projector/" + id] = {a.x, a.y, b.x - a.x, b.y - a.y, double(p.render_frame)};
+  }
+  ImGui::End();
+}
+
 }  // namespace
 
 void draw_panels(PanelState& s, PreviewNode& node, ViewPipeline& pipeline, Viewpoint& view,
@@ -208,6 +239,8 @@ void draw_panels(PanelState& s, PreviewNode& node, ViewPipeline& pipeline, Viewp
   if (s.animation) animation_panel(s, node);
   ImGui::SetNextWindowPos(ImVec2(580, 450), ImGuiCond_FirstUseEver);
   if (s.services) services_panel(s, node);
+  ImGui::SetNextWindowPos(ImVec2(10, 520), ImGuiCond_FirstUseEver);
+  if (s.projectors) projectors_panel(s, node, pipeline);
 }
 
 }  // namespace studio::preview

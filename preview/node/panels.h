@@ -9,7 +9,10 @@
 //   Services   every service seen on studio/service/status: state, rates, latency; one that
 //              stopped reporting (lease expired or silent for 3 s) or failed is drawn in red.
 //   View       texturing (blend / nearest), counts of textured and untextured meshes,
-//              bookmarks, a keyframed camera move.
+//              the overlays' switches (head marker, camera frusta, projector frusta, projector
+//              screens), bookmarks, a keyframed camera move.
+//   Projectors every projector seen on studio/projector/calibration or /frame: its latest
+//              thumbnail (what it shows), render frame, mesh frame, latency and margin.
 #include <map>
 #include <optional>
 #include <string>
@@ -27,7 +30,8 @@ struct ItemRect {
 };
 
 struct PanelState {
-  bool cameras = false, capture = false, animation = false, services = false, view = true;
+  bool cameras = false, capture = false, animation = false, services = false, view = true,
+       projectors = false;
   std::map<std::string, double> edits;     // "cam/feature" → the slider's value
   std::map<std::string, double> scripted;  // "cam/feature" → value to apply next frame
   char take[64] = "take";

@@ -11,6 +11,8 @@ struct Keys {
   std::string dds_config, log, viewpoint, texturing = "blend", asset_root, take = "take";
   std::vector<int> size{1280, 720};
   int blend_cameras = 3, wait_ms = 200;
+  bool head_marker = true, camera_frusta = true, projector_frusta = true, projector_screens = true;
+  double camera_frustum_m = 0.5;
 };
 
 const yaml::Schema<Keys> kSchema{
@@ -25,6 +27,11 @@ const yaml::Schema<Keys> kSchema{
     yaml::field("wait_ms", &Keys::wait_ms).range(0, 10000),
     yaml::field("asset_root", &Keys::asset_root).relative_path(),
     yaml::field("take", &Keys::take),
+    yaml::field("head_marker", &Keys::head_marker),
+    yaml::field("camera_frusta", &Keys::camera_frusta),
+    yaml::field("camera_frustum_m", &Keys::camera_frustum_m).range(0.01, 20),
+    yaml::field("projector_frusta", &Keys::projector_frusta),
+    yaml::field("projector_screens", &Keys::projector_screens),
 };
 
 }  // namespace
@@ -32,7 +39,7 @@ const yaml::Schema<Keys> kSchema{
 Expected<void> PreviewConfig::validate() const {
   if (instance.empty() || instance.size() > 40) return fail("instance: 1..40 characters");
   if (auto ok = viewpoint.validate(); !ok) return ok;
-  return {};
+  return overlays.validate();
 }
 
 Expected<PreviewConfig> read_preview_config(const std::string& path) {
@@ -56,6 +63,11 @@ Expected<PreviewConfig> read_preview_config(const std::string& path) {
   c.wait_ms = k->wait_ms;
   c.asset_root = k->asset_root;
   c.take = k->take;
+  c.overlays.head = k->head_marker;
+  c.overlays.camera_frusta = k->camera_frusta;
+  c.overlays.camera_frustum_m = k->camera_frustum_m;
+  c.overlays.projector_frusta = k->projector_frusta;
+  c.overlays.projector_screens = k->projector_screens;
   if (auto ok = c.validate(); !ok) return fail(path + ": " + ok.error().message);
   return c;
 }

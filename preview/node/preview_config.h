@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "preview/overlays.h"
 #include "preview/viewpoint.h"
 
 namespace studio::preview {
@@ -23,6 +24,7 @@ struct PreviewConfig {
   int wait_ms = 200;               // wait for a new mesh's images, then draw it untextured
   std::string asset_root;          // relative asset paths of scene nodes resolve here
   std::string take = "take";       // the capture panel's default take name
+  OverlayOptions overlays;         // head marker, frusta, projector screens in the 3D view
   Expected<void> validate() const;
 };
 
@@ -39,7 +41,17 @@ inline constexpr const char* kConfigHelp =
     "  wait_ms: 200                  wait this long for a new mesh's frame-exact images, then\n"
     "                                draw it untextured (counted)\n"
     "  asset_root: DIR               relative asset paths of scene nodes resolve here\n"
-    "  take: take                    the capture panel's default take name\n";
+    "  take: take                    the capture panel's default take name\n"
+    "  head_marker: true             the tracked head (studio/actor/head): a yellow sphere,\n"
+    "                                its velocity (orange) and sight lines to each screen\n"
+    "  camera_frusta: true           each studio camera's frustum (cyan, from\n"
+    "                                studio/camera/calibration)\n"
+    "  camera_frustum_m: 0.5         depth at which camera frusta are cut (metres)\n"
+    "  projector_frusta: true        each projector's frustum to its screen (magenta, from\n"
+    "                                studio/projector/calibration)\n"
+    "  projector_screens: true       each screen textured with what its projector shows (the\n"
+    "                                latest thumbnail on studio/projector/frame, projected\n"
+    "                                through the projector's K [R | t])\n";
 
 // Defaults when path is empty. Errors: "file:line: field: problem".
 Expected<PreviewConfig> read_preview_config(const std::string& path);

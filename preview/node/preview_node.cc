@@ -6,34 +6,13 @@
 #include "wire/convert.h"
 #include "wire/sample.h"
 #include "wire/scene_convert.h"
+#include "wire_views.h"
 
 namespace studio::preview {
 namespace {
 
 constexpr const char* kLog = "preview";
 constexpr std::size_t kKeptImages = 24;  // (camera, frame) images kept for the renderer
-
-scene::ActorMesh mesh_from_wire(const studio_ActorMesh& s) {
-  scene::ActorMesh m;
-  m.actor_id = wire::str(s.actor_id);
-  m.frame = int64_t(s.source_frame);
-  const auto v = wire::view(s.vertices);
-  const auto n = wire::view(s.normals);
-  const auto t = wire::view(s.triangles);
-  m.vertices.resize(v.size() / 3);
-  for (std::size_t i = 0; i < m.vertices.size(); ++i)
-    m.vertices[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-  if (n.size() == v.size()) {
-    m.normals.resize(m.vertices.size());
-    for (std::size_t i = 0; i < m.normals.size(); ++i)
-      m.normals[i] = {n[3 * i], n[3 * i + 1], n[3 * i + 2]};
-  }
-  m.triangles.resize(t.size() / 3);
-  for (std::size_t i = 0; i < m.triangles.size(); ++i)
-    m.triangles[i] = {t[3 * i], t[3 * i + 1], t[3 * i + 2]};
-  if (m.normals.empty()) m.compute_normals();
-  return m;
-}
 
 }  // namespace
 
@@ -114,17 +93,7 @@ struct PreviewNode::Impl {
   void on_mesh(const studio_ActorMesh& s);
 
   void on_state(const studio_CameraState& s) {
-    CameraStateView v;
-    v.camera_id = wire::str(s.camera_id);
-    v.frame = s.frame;
-    v.fps = s.fps;
-    v.drops = s.drops;
-    v.recording = s.recording;
-    v.take = wire::str(s.take);
-    v.error = wire::str(s.error);
-    v.state = int(s.state);
-    for (const auto& f : wire::view(s.features))
-      v.features.push_back({std::string(wire::str(f.name)), f.value, f.min, f.max});
+    CameraStateView v = state_from_wire(s);
     std::lock_guard lock(mutex);
     states[v.camera_id] = std::move(v);
   }
@@ -154,6 +123,7 @@ struct PreviewNode::Impl {
   runtime::Counter& meshes_in;
   runtime::Counter& images_in;
   runtime::Counter& images_refused;
+  OverlayInputs overlays{loop};  // head, projector calibrations and frames (overlay_inputs.h)
 
   mutable std::mutex mutex;
   std::condition_variable changed;
@@ -202,6 +172,8 @@ PreviewNode::~PreviewNode() { stop(); }
 Expected<void> PreviewNode::start() { return impl_->loop.start(); }
 void PreviewNode::stop() { impl_->loop.stop(); }
 runtime::NodeHealth PreviewNode::health() { return impl_->loop.health(); }
+
+const OverlayInputs& PreviewNode::overlays() const { return impl_->overlays; }
 
 std::map<std::string, Camera> PreviewNode::cameras() const {
   std::lock_guard lock(impl_->mutex);

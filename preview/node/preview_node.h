@@ -7,6 +7,8 @@
 //        studio/camera/calibration → cameras;  studio/camera/state → the camera panel
 //        studio/camera/image_reply → frame-exact camera images (only replies to this requester)
 //        studio/service/status → the services panel
+//        studio/actor/head, studio/projector/calibration, studio/projector/frame → the overlays
+//        (overlay_inputs.h)
 //   out: studio/camera/image_request, studio/camera/control, studio/capture/command,
 //        studio/scene/command
 //
@@ -31,6 +33,7 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "overlay_inputs.h"
 #include "preview/frame_images.h"
 #include "runtime/service_loop.h"
 #include "scene/actor_mesh.h"
@@ -77,6 +80,7 @@ class PreviewNode : public runtime::Node {
 
   // Snapshots (copies) for the render and GUI thread.
   std::map<std::string, Camera> cameras() const;
+  const OverlayInputs& overlays() const;  // heads, projectors and their thumbnails
   std::optional<LiveMesh> mesh_after(uint64_t sequence) const;  // newest, if newer than sequence
   uint64_t mesh_sequence() const;                               // of the newest mesh (0: none yet)
   // The scene mirror, rebuilt when it changed since `version` (nullopt: unchanged).

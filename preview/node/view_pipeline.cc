@@ -7,6 +7,7 @@
 
 #include "actor_texturer.h"
 #include "core/log.h"
+#include "overlay_renderer.h"
 #include "scene/view.h"
 #include "scene_assets/asset.h"
 #include "scene_render/renderer.h"
@@ -57,6 +58,8 @@ struct ViewPipeline::Impl {
   PipelineOptions options;
   scene_render::Renderer renderer;
   ActorTexturer texturer;
+  OverlayRenderer overlay;
+  std::map<std::string, uint64_t> thumbnail_versions;  // uploaded, per projector
   scene::Scene scene;
   uint64_t scene_version = 0;
   std::set<std::string> uploaded, failed;
@@ -74,8 +77,35 @@ struct ViewPipeline::Impl {
   PipelineCounts counts;
   std::shared_ptr<PrefetchState> prefetch = std::make_shared<PrefetchState>();
 
-  Impl(PreviewNode& n, const PipelineOptions& o, scene_render::Renderer r, ActorTexturer t)
-      : node(&n), options(o), renderer(std::move(r)), texturer(std::move(t)) {}
+  Impl(PreviewNode& n, const PipelineOptions& o, scene_render::Renderer r, ActorTexturer t,
+       OverlayRenderer ov)
+      : node(&n),
+        options(o),
+        renderer(std::move(r)),
+        texturer(std::move(t)),
+        overlay(std::move(ov)) {}
+
+  // The overlays from the node's mirror of the wire; new thumbnails uploaded once each.
+  void draw_overlays(const Eigen::Matrix4d& clip_from_world, int width, int height) {
+    const OverlayOptions& o = options.overlays;
+    if (!o.head && !o.camera_frusta && !o.projector_frusta && !o.projector_screens) return;
+    const OverlayInputs& in = node->overlays();
+    if (o.projector_screens)
+      for (const auto& [id, p] : in.projectors()) {
+        uint64_t& uploaded = thumbnail_versions[id];
+        if (p.thumbnail.empty() || uploaded == p.thumbnail_version) continue;
+        uploaded = p.thumbnail_version;
+        if (auto ok = overlay.set_thumbnail(id, p.thumb_width, p.thumb_height, p.thumbnail.data());
+            !ok)
+          STUDIO_LOG(warn, "preview") << ok.error().message;
+      }
+    std::vector<Camera> cams;
+    if (o.camera_frusta)
+      for (auto& [id, c] : node->cameras()) cams.push_back(std::move(c));
+    const auto geometry =
+        build_overlays(o, cams, in.calibrated(), o.head ? in.heads() : std::vector<HeadMarker>{});
+    overlay.draw(geometry, clip_from_world, width, height);
+  }
 
   void refresh_scene() {
     auto s = node->scene_after(scene_version);
@@ -175,9 +205,12 @@ Expected<std::unique_ptr<ViewPipeline>> ViewPipeline::create(PreviewNode& node,
   if (auto ok = options.blend_options.validate(); !ok) return std::unexpected(ok.error());
   auto r = scene_render::Renderer::create();
   if (!r) return std::unexpected(r.error());
+  if (auto ok = options.overlays.validate(); !ok) return std::unexpected(ok.error());
   auto t = ActorTexturer::create();
   if (!t) return std::unexpected(t.error());
-  auto impl = std::make_unique<Impl>(node, options, std::move(*r), std::move(*t));
+  auto ov = OverlayRenderer::create();
+  if (!ov) return std::unexpected(ov.error());
+  auto impl = std::make_unique<Impl>(node, options, std::move(*r), std::move(*t), std::move(*ov));
   impl->prefetch->blend = options.blend;
   impl->prefetch->options = options.blend_options;
   // A new mesh's images are requested on arrival, for the last drawn viewpoint; the render
@@ -225,6 +258,7 @@ FrameReport ViewPipeline::render(const Viewpoint& view, int width, int height, b
     r.texturer.draw({v.clip_from_cam * v.cam_from_world, view.eye, width, height}, mode, w,
                     r.current_threshold);
   }
+  r.draw_overlays(v.clip_from_cam * v.cam_from_world, width, height);
   return report;
 }
 
@@ -240,5 +274,10 @@ void ViewPipeline::set_blend(bool blend) {
   impl_->prefetch->blend = blend;
 }
 bool ViewPipeline::blend() const { return impl_->options.blend; }
+OverlayOptions& ViewPipeline::overlays() { return impl_->options.overlays; }
+ViewPipeline::Thumbnail ViewPipeline::thumbnail(const std::string& projector_id) const {
+  const auto t = impl_->overlay.thumbnail(projector_id);
+  return t ? Thumbnail{t->name, t->width, t->height} : Thumbnail{};
+}
 
 }  // namespace studio::preview

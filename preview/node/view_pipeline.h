@@ -8,6 +8,9 @@
 // the previous (mesh, images) pair until they are all here; if they do not arrive within `wait`
 // (late, evicted from the capture ring) the new mesh is drawn untextured and counted. A mesh is
 // never drawn with another frame's image.
+// Over the scene and the actor: the overlays (preview/overlays.h; head marker, camera and
+// projector frusta, projector screens showing the projectors' latest thumbnails), each switched
+// by PipelineOptions::overlays.
 // Needs a current OpenGL 3.3 context (EGL headless or the GLFW window's).
 
 #include <chrono>
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "preview/camera_select.h"
+#include "preview/overlays.h"
 #include "preview/viewpoint.h"
 #include "preview_node.h"
 
@@ -28,6 +32,7 @@ struct PipelineOptions {
   BlendOptions blend_options;  // cameras: how many the blend uses (at most 3 here)
   std::chrono::milliseconds wait{200};
   std::string asset_root;  // relative asset paths of scene nodes resolve here
+  OverlayOptions overlays;
 };
 
 struct FrameReport {
@@ -63,6 +68,14 @@ class ViewPipeline {
   Eigen::Vector3d actor_centre() const;
   void set_blend(bool blend);
   bool blend() const;
+  OverlayOptions& overlays();
+  // GL texture name and size of a projector's latest thumbnail (0: none yet), for the
+  // Projectors panel.
+  struct Thumbnail {
+    unsigned texture = 0;
+    int width = 0, height = 0;
+  };
+  Thumbnail thumbnail(const std::string& projector_id) const;
 
  private:
   struct Impl;

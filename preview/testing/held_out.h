@@ -120,9 +120,10 @@ struct Studio {
   DrawView view;
 };
 
-inline Studio make_studio() {
+// `count` cameras: count - 1 on the ring, one overhead (default 8 + 1).
+inline Studio make_studio(int count = 9) {
   sim::RingOptions r;
-  r.count = 9;
+  r.count = count;
   r.width = kW;
   r.height = kH;
   r.focal_px *= double(kW) / 704.0;
@@ -188,6 +189,8 @@ struct Scoring {
   bool hull = false;       // geometry: the visual hull of the true masks, else the true surface
   sim::StudioOptions sim;  // the realism knobs, for the feeding cameras and the held-out one
   TexturerOptions texturer;
+  int cameras = 9;       // studio cameras: cameras - 1 on the ring + overhead
+  int hull_cells = 96;   // the hull's grid (cells along x and z), as the node's `grid`
   bool verbose = false;  // per frame PSNR
   std::string dump_dir;  // when set: <frame>_truth.png and <frame>_<variant>.png there
 };
@@ -195,7 +198,7 @@ struct Scoring {
 // Scores every variant over `frames` (a current GL context is needed).
 inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<Variant>& variants,
                                        const std::vector<int64_t>& frames) {
-  const Studio s = make_studio();
+  const Studio s = make_studio(setup.cameras);
   sim::StudioOptions o = setup.sim;
   o.threads = 2;
   auto studio = sim::SimulatedStudio::create(s.cameras, o).value();
@@ -214,7 +217,8 @@ inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<V
   for (const int64_t f : frames) {
     const sim::FrameTruth t = studio.render_all(f, &images, &masks);
     held.render(0, f, &truth, &truth_mask);
-    const scene::ActorMesh mesh = setup.hull ? hull_mesh(s.cameras, masks) : true_mesh(t.body);
+    const scene::ActorMesh mesh =
+        setup.hull ? hull_mesh(s.cameras, masks, setup.hull_cells) : true_mesh(t.body);
     if (mesh.triangles.empty()) continue;
     EXPECT_TRUE(texturer.set_mesh(mesh).has_value());
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
