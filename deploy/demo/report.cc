@@ -199,6 +199,23 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     j.key("capture_to_projector_frame");
     cap_proj.write(j);
     j.end_object();
+    // Inside the services: their own per-stage gauges (running means over ~20 frames, ms) from
+    // the last status: the hull's (hull/node/hull_stages.h: mask delivery, cut, mesh, refine,
+    // publish, mask_to_mesh) and the projector's (projector/node/frame_stages.h).
+    j.key("inside_services").begin_object();
+    for (const ServiceSeen& s : c.services) {
+      bool any = false;
+      for (const auto& [name, v] : s.counters) {
+        if (!name.starts_with("stage_") && !name.ends_with("_to_mesh_ms") &&
+            !name.ends_with("_to_frame_ms"))
+          continue;
+        if (!any) j.key(s.service + ":" + s.instance).begin_object();
+        any = true;
+        j.field(name, v);
+      }
+      if (any) j.end_object();
+    }
+    j.end_object();
     // Where the slowest frame spent its time (a stall shows up in one stage).
     j.key("slowest_frame").begin_object();
     if (worst) {
