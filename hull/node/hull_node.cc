@@ -26,18 +26,18 @@ constexpr const char* kLog = "hull";
 using SteadyClock = std::chrono::steady_clock;
 using Assembler = FrameAssembler<RunMask>;
 
+// Straight from the mesh's arrays (3 packed floats / indices per element) into the sample's.
 void mesh_to_wire(const Mesh& mesh, studio_ActorMesh& s) {
-  std::vector<float> v, n;
-  std::vector<uint32_t> t;
-  v.reserve(mesh.vertices.size() * 3);
-  n.reserve(mesh.normals.size() * 3);
-  t.reserve(mesh.triangles.size() * 3);
-  for (const auto& p : mesh.vertices) v.insert(v.end(), {p.x(), p.y(), p.z()});
-  for (const auto& p : mesh.normals) n.insert(n.end(), {p.x(), p.y(), p.z()});
-  for (const auto& tri : mesh.triangles) t.insert(t.end(), tri.begin(), tri.end());
-  wire::assign(s.vertices, v);
-  wire::assign(s.normals, n);
-  wire::assign(s.triangles, t);
+  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
+  static_assert(sizeof(std::array<uint32_t, 3>) == 3 * sizeof(uint32_t));
+  const auto floats = [](const std::vector<Eigen::Vector3f>& v) {
+    return std::span<const float>(v.empty() ? nullptr : v.front().data(), 3 * v.size());
+  };
+  wire::assign(s.vertices, floats(mesh.vertices));
+  wire::assign(s.normals, floats(mesh.normals));
+  wire::assign(s.triangles, std::span<const uint32_t>(
+                                mesh.triangles.empty() ? nullptr : mesh.triangles.front().data(),
+                                3 * mesh.triangles.size()));
 }
 
 Assembler::Options assembler_options(const HullNodeOptions& o, const std::vector<Camera>& cams) {
