@@ -236,7 +236,7 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
       bool any = false;
       for (const auto& [name, v] : s.counters) {
         if (!name.starts_with("stage_") && !name.ends_with("_to_mesh_ms") &&
-            !name.ends_with("_to_frame_ms"))
+            !name.ends_with("_to_frame_ms") && !name.ends_with("_to_mask_ms"))
           continue;
         if (!any) j.key(s.service + ":" + s.instance).begin_object();
         any = true;

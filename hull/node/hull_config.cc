@@ -55,7 +55,8 @@ runtime::ServiceDefinition hull_service_definition() {
       "                            replace the rig's (projector_calibrations_in)\n"
       "    projector_mask_step: 2  the cut samples every step-th projector pixel (1..64)\n"
       "  Status (studio/service/status): where a frame's time goes, ms, running means:\n"
-      "  stage_mask_delivery_ms (its last mask written -> handled), stage_queue_ms, stage_cut_ms,\n"
+      "  capture_to_mask_ms (capture -> its last mask written), stage_mask_delivery_ms (written\n"
+      "  -> handled), stage_queue_ms, stage_cut_ms,\n"
       "  stage_mesh_ms, stage_refine_ms, stage_publish_ms, mask_to_mesh_ms (last mask handled ->\n"
       "  last mesh written); see hull/node/hull_stages.h.\n";
   d.create = [](yaml::MapReader& config,

@@ -156,6 +156,7 @@ class HullNode : public runtime::Node {
     Arrival& a = arrivals_[s.frame];
     a.handled = now;
     a.delivery_ms = meta.source_timestamp ? double(realtime_ns() - meta.source_timestamp) * 1e-6 : -1;
+    a.written_ms = meta.source_timestamp ? double(meta.source_timestamp - s.capture_ns) * 1e-6 : -1;
     if (arrivals_.size() > 64) arrivals_.erase(arrivals_.begin());  // frames never cut
     return {};
   }
@@ -176,7 +177,10 @@ class HullNode : public runtime::Node {
     std::optional<SteadyClock::time_point> last_mask;
     if (auto it = arrivals_.find(frame.frame); it != arrivals_.end()) {
       last_mask = it->second.handled;
-      if (it->second.delivery_ms >= 0) stages_.add(HullStages::mask_delivery, it->second.delivery_ms);
+      if (it->second.delivery_ms >= 0) {
+        stages_.add(HullStages::mask_delivery, it->second.delivery_ms);
+        stages_.add(HullStages::capture_to_mask, it->second.written_ms);
+      }
       stages_.add(HullStages::queue, t - it->second.handled);
     }
     arrivals_.erase(arrivals_.begin(), arrivals_.upper_bound(frame.frame));
@@ -306,6 +310,7 @@ class HullNode : public runtime::Node {
   struct Arrival {
     SteadyClock::time_point handled;
     double delivery_ms = -1;  // -1: no source timestamp
+    double written_ms = -1;   // capture_ns -> written
   };
   std::map<uint64_t, Arrival> arrivals_;  // frame -> its newest mask (loop thread)
   HullStages stages_;

@@ -2,6 +2,9 @@
 // Where a frame's time goes inside the hull service, from its last mask to its last mesh
 // (issue 20: the live pipeline's latency per stage), published as status gauges (ms, a running
 // mean over about the last 20 frames, like the projector's FrameStages):
+//   capture_to_mask_ms      the frame's capture_ns -> its last mask written by its capture server
+//                           (source_timestamp): the capture stage as the hull sees it, free of
+//                           any subscriber's own wake-up delay
 //   stage_mask_delivery_ms  the frame's last mask: written by its capture server
 //                           (source_timestamp) -> handed to the hull's handler (DDS transport,
 //                           the loop's wake-up; CLOCK_REALTIME, same host)
@@ -24,12 +27,22 @@ namespace studio::hull {
 
 class HullStages {
  public:
-  enum Stage { mask_delivery, queue, cut, mesh, refine, publish, mask_to_mesh, kCount };
+  enum Stage {
+    capture_to_mask,
+    mask_delivery,
+    queue,
+    cut,
+    mesh,
+    refine,
+    publish,
+    mask_to_mesh,
+    kCount
+  };
 
   explicit HullStages(runtime::Metrics& metrics) {
     static constexpr const char* kNames[kCount] = {
-        "stage_mask_delivery_ms", "stage_queue_ms",   "stage_cut_ms",   "stage_mesh_ms",
-        "stage_refine_ms",        "stage_publish_ms", "mask_to_mesh_ms"};
+        "capture_to_mask_ms", "stage_mask_delivery_ms", "stage_queue_ms",   "stage_cut_ms",
+        "stage_mesh_ms",      "stage_refine_ms",        "stage_publish_ms", "mask_to_mesh_ms"};
     for (int i = 0; i < kCount; ++i) gauges_[i] = &metrics.gauge(kNames[i]);
   }
   // One measurement of a stage, milliseconds.
