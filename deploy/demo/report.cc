@@ -439,18 +439,29 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     if (worst >= 0) {
       std::snprintf(buf, sizeof buf, "%s (p99 %.1f ms)", latency_limit.c_str(), worst);
       latency_limit = buf;
-      // The simulated cameras render their image after the frame's instant (capture_ns), all at
-      // once: that CPU is in this stage, where a real camera hands over a finished image.
       // The service that owns the stage: its own gauges say where inside it the time goes.
-      const char* owner = latency_limit.starts_with("mesh_to_projector") ? "projector"
+      const char* owner = latency_limit.starts_with("mesh_to_projector")  ? "projector"
                           : latency_limit.starts_with("segments_to_head") ? "tracker"
                           : latency_limit.starts_with("capture_to_mask")  ? "capture"
                                                                           : "hull";
       latency_limit += inside_line(c, owner);
-      if (latency_limit.starts_with("capture_to_mask"))
+      // The simulated cameras render their image after the frame's instant (capture_ns), all at
+      // once: that CPU is in this stage, where a real camera hands over a finished image.
+      if (latency_limit.starts_with("capture_to_mask")) {
         latency_limit +=
             ": for the simulated cameras this includes rendering each image after "
             "the frame instant (all cameras at once on the shared cores), then keying";
+        // As written by the capture servers, before any subscriber's own wake-up delay.
+        for (const ServiceSeen& s : c.services)
+          if (auto g = s.counters.find("capture_to_mask_ms");
+              s.service == "hull" && g != s.counters.end()) {
+            std::snprintf(buf, sizeof buf,
+                          "; the last mask written %.1f ms after capture (mean, "
+                          "the hull's capture_to_mask_ms)",
+                          g->second);
+            latency_limit += buf;
+          }
+      }
     }
   }
   j.key("held_back_by").begin_object();

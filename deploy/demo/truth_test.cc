@@ -3,6 +3,8 @@
 // pixel-centre rays) instead of rendering every camera's image to get it. Both must be the same
 // pixels as the mask SimulatedStudio::render() produces beside its image, on every camera of the
 // example rig and frames of every motion the demo runs.
+#include "truth.h"
+
 #include <gtest/gtest.h>
 
 #include "capture/sim_source.h"
@@ -12,7 +14,6 @@
 #include "sim/cameras.h"
 #include "sim/projector_light.h"
 #include "sim/studio.h"
-#include "truth.h"
 
 namespace studio::demo {
 namespace {

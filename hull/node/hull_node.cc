@@ -155,7 +155,8 @@ class HullNode : public runtime::Node {
     // The frame's newest mask so far: when it was handled, and its transport (hull_stages.h).
     Arrival& a = arrivals_[s.frame];
     a.handled = now;
-    a.delivery_ms = meta.source_timestamp ? double(realtime_ns() - meta.source_timestamp) * 1e-6 : -1;
+    a.delivery_ms =
+        meta.source_timestamp ? double(realtime_ns() - meta.source_timestamp) * 1e-6 : -1;
     a.written_ms = meta.source_timestamp ? double(meta.source_timestamp - s.capture_ns) * 1e-6 : -1;
     if (arrivals_.size() > 64) arrivals_.erase(arrivals_.begin());  // frames never cut
     return {};
@@ -212,7 +213,8 @@ class HullNode : public runtime::Node {
     stages_.add(HullStages::mesh, d.mesh);
     stages_.add(HullStages::refine, d.refine);
     stages_.add(HullStages::publish, d.publish);
-    if (last_mask && !actors.empty()) stages_.add(HullStages::mask_to_mesh, SteadyClock::now() - *last_mask);
+    if (last_mask && !actors.empty())
+      stages_.add(HullStages::mask_to_mesh, SteadyClock::now() - *last_mask);
     for (std::size_t k = actors.size(); k < published_actors_; ++k)
       dispose(options_.actor_prefix + std::to_string(k));
     published_actors_ = actors.size();

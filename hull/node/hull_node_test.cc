@@ -223,9 +223,9 @@ void HullNodeTest::masks_in_segments_and_mesh_out(bool refine) {
         for (const auto& c : wire::view(s.data->counters)) g[c.name] = c.value;
     std::this_thread::sleep_for(50ms);
   }
-  for (const char* name : {"capture_to_mask_ms", "stage_mask_delivery_ms", "stage_queue_ms",
-                           "stage_cut_ms", "stage_mesh_ms", "stage_refine_ms", "stage_publish_ms",
-                           "mask_to_mesh_ms"})
+  for (const char* name :
+       {"capture_to_mask_ms", "stage_mask_delivery_ms", "stage_queue_ms", "stage_cut_ms",
+        "stage_mesh_ms", "stage_refine_ms", "stage_publish_ms", "mask_to_mesh_ms"})
     EXPECT_TRUE(g.contains(name)) << name;
   EXPECT_GT(g["stage_cut_ms"], 0);
   EXPECT_GT(g["stage_mesh_ms"], 0);

@@ -57,7 +57,8 @@ bool inside_runs(const Eigen::Vector3d& h0, const Eigen::Vector3d& h1, const Run
       sa = std::max(0.0, std::min(a, b)), sb = std::min(1.0, std::max(a, b));
     }
     const double ua = u0 + sa * du, ub = u0 + sb * du;
-    const double lo_u = std::floor(std::min(ua, ub) + 0.5), hi_u = std::floor(std::max(ua, ub) + 0.5);
+    const double lo_u = std::floor(std::min(ua, ub) + 0.5),
+                 hi_u = std::floor(std::max(ua, ub) + 0.5);
     if (lo_u < 0 || hi_u >= mask.width()) return false;
     const int lo = int(lo_u), hi = int(hi_u);
     const auto runs = mask.row(y);
