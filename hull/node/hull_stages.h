@@ -9,7 +9,8 @@
 //                           (source_timestamp) -> handed to the hull's handler (DDS transport,
 //                           the loop's wake-up; CLOCK_REALTIME, same host)
 //   stage_queue_ms          last mask handled -> the frame's cut starts (other frames or work
-//                           ahead of it on the loop thread)
+//                           ahead of it on the loop thread; for a frame cut at its deadline
+//                           without every mask, also the wait for the missing ones)
 //   stage_cut_ms            visual hull + connected components
 //   stage_mesh_ms           segment marching cubes, every actor
 //   stage_refine_ms         exact crossings, every actor
