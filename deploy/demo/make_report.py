@@ -273,6 +273,14 @@ def write_markdown(r, path):
             for name, s in (lat.get(group) or {}).items():
                 L.append(f"| {name.replace('_', ' ')} | {fmt(s.get('p50'))} | {fmt(s.get('p95'))} | "
                          f"{fmt(s.get('p99'))} | {fmt(s.get('max'))} | {s.get('n')} |")
+        inside = lat.get("inside_services") or {}
+        if inside:
+            L.append("\nInside the services (their own stage gauges, ms, running mean of ~20 frames, "
+                     "last status):\n")
+            L.append("| service | stage | ms |\n|---|---|---|")
+            for svc, stages in inside.items():
+                for name, v in stages.items():
+                    L.append(f"| {svc} | {name.replace('_', ' ')} | {fmt(v)} |")
         L.append("\n![latency](latency.png)\n")
     hb = r.get("held_back_by") or {}
     L.append(f"Held back by — rate: {hb.get('rate') or 'n/a'}; latency: {hb.get('latency') or 'n/a'}; "

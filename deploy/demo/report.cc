@@ -89,6 +89,35 @@ void draw_histogram(const Stats& s, const std::string& title, const std::string&
   cv::imwrite(path, img);
 }
 
+// "; inside hull:hull mask_to_mesh 7.4 ms: refine 4.0, mesh 1.4, cut 0.9 ms" from the stage gauges
+// of the first service named `service` (its last status); "" when it publishes none.
+std::string inside_line(const Collected& c, const std::string& service) {
+  for (const ServiceSeen& s : c.services) {
+    if (s.service != service) continue;
+    std::vector<std::pair<double, std::string>> stages;
+    std::string total;
+    char buf[96];
+    for (const auto& [name, v] : s.counters) {
+      if (name.starts_with("stage_") && name.ends_with("_ms") && v > 0) {
+        stages.emplace_back(v, name.substr(6, name.size() - 9));
+      } else if (name.ends_with("_to_mesh_ms") || name.ends_with("_to_frame_ms")) {
+        std::snprintf(buf, sizeof buf, " %s %.1f ms", name.substr(0, name.size() - 3).c_str(), v);
+        total = buf;
+      }
+    }
+    if (stages.empty()) return {};
+    std::sort(stages.rbegin(), stages.rend());
+    std::string out = "; inside " + s.service + ":" + s.instance + total + ":";
+    for (std::size_t k = 0; k < std::min<std::size_t>(4, stages.size()); ++k) {
+      std::snprintf(buf, sizeof buf, "%s %s %.1f", k ? "," : "", stages[k].second.c_str(),
+                    stages[k].first);
+      out += buf;
+    }
+    return out + " ms (running means)";
+  }
+  return {};
+}
+
 }  // namespace
 
 std::string make_report(const ProbeOptions& o, const Collected& c) {
@@ -198,6 +227,23 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     cap_both.write(j);
     j.key("capture_to_projector_frame");
     cap_proj.write(j);
+    j.end_object();
+    // Inside the services: their own per-stage gauges (running means over ~20 frames, ms) from
+    // the last status: the hull's (hull/node/hull_stages.h: mask delivery, cut, mesh, refine,
+    // publish, mask_to_mesh) and the projector's (projector/node/frame_stages.h).
+    j.key("inside_services").begin_object();
+    for (const ServiceSeen& s : c.services) {
+      bool any = false;
+      for (const auto& [name, v] : s.counters) {
+        if (!name.starts_with("stage_") && !name.ends_with("_to_mesh_ms") &&
+            !name.ends_with("_to_frame_ms") && !name.ends_with("_to_mask_ms"))
+          continue;
+        if (!any) j.key(s.service + ":" + s.instance).begin_object();
+        any = true;
+        j.field(name, v);
+      }
+      if (any) j.end_object();
+    }
     j.end_object();
     // Where the slowest frame spent its time (a stall shows up in one stage).
     j.key("slowest_frame").begin_object();
@@ -393,12 +439,29 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     if (worst >= 0) {
       std::snprintf(buf, sizeof buf, "%s (p99 %.1f ms)", latency_limit.c_str(), worst);
       latency_limit = buf;
+      // The service that owns the stage: its own gauges say where inside it the time goes.
+      const char* owner = latency_limit.starts_with("mesh_to_projector")  ? "projector"
+                          : latency_limit.starts_with("segments_to_head") ? "tracker"
+                          : latency_limit.starts_with("capture_to_mask")  ? "capture"
+                                                                          : "hull";
+      latency_limit += inside_line(c, owner);
       // The simulated cameras render their image after the frame's instant (capture_ns), all at
       // once: that CPU is in this stage, where a real camera hands over a finished image.
-      if (latency_limit.starts_with("capture_to_mask"))
+      if (latency_limit.starts_with("capture_to_mask")) {
         latency_limit +=
             ": for the simulated cameras this includes rendering each image after "
             "the frame instant (all cameras at once on the shared cores), then keying";
+        // As written by the capture servers, before any subscriber's own wake-up delay.
+        for (const ServiceSeen& s : c.services)
+          if (auto g = s.counters.find("capture_to_mask_ms");
+              s.service == "hull" && g != s.counters.end()) {
+            std::snprintf(buf, sizeof buf,
+                          "; the last mask written %.1f ms after capture (mean, "
+                          "the hull's capture_to_mask_ms)",
+                          g->second);
+            latency_limit += buf;
+          }
+      }
     }
   }
   j.key("held_back_by").begin_object();

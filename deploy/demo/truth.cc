@@ -36,10 +36,12 @@ MeshScore TruthScorer::score_meshes(uint64_t frame, const std::vector<hull::Mesh
   score.frame = frame;
   score.min_iou = std::numeric_limits<double>::infinity();
   const auto& cams = impl_->studio.cameras();
-  Mask truth;
+  // The geometric silhouette cast from the true body: the same pixels as the true mask that
+  // render() makes beside the camera's image (truth_test.cc), without rendering the image.
+  const sim::ActorBody body = impl_->studio.truth(int64_t(frame)).body;
   double sum = 0;
   for (int i = 0; i < int(cams.size()); ++i) {
-    impl_->studio.render(i, int64_t(frame), nullptr, &truth);
+    const Mask truth = sim::actor_in_projector(cams[i], body);
     Mask drawn(cams[i].width, cams[i].height, 0);
     for (const hull::Mesh& m : meshes) {
       const Mask one = hull::testing::rasterise(m, cams[i]);

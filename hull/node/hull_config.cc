@@ -43,7 +43,7 @@ runtime::ServiceDefinition hull_service_definition() {
       "    min_cameras: 2          drop a frame with fewer masks at its deadline\n"
       "    min_views: 2            actor = inside every silhouette that sees it AND seen by\n"
       "                            >= min_views cameras (0..64; see studio-hull offline --help)\n"
-      "    threads: 2              cut threads\n"
+      "    threads: 2              threads of the cut and of the exact crossings\n"
       "    mesh: true              publish studio/actor/mesh\n"
       "    refine: true            exact crossings on the mesh (else half-cell vertices)\n"
       "    min_actor_volume: 0.01  smaller components (m^3) are noise\n"
@@ -53,7 +53,12 @@ runtime::ServiceDefinition hull_service_definition() {
       "                            eq. 7-8), one sample per frame and projector; the\n"
       "                            projectors' own studio/projector/calibration join or\n"
       "                            replace the rig's (projector_calibrations_in)\n"
-      "    projector_mask_step: 2  the cut samples every step-th projector pixel (1..64)\n";
+      "    projector_mask_step: 2  the cut samples every step-th projector pixel (1..64)\n"
+      "  Status (studio/service/status): where a frame's time goes, ms, running means:\n"
+      "  capture_to_mask_ms (capture -> its last mask written), stage_mask_delivery_ms (written\n"
+      "  -> handled), stage_queue_ms, stage_cut_ms,\n"
+      "  stage_mesh_ms, stage_refine_ms, stage_publish_ms, mask_to_mesh_ms (last mask handled ->\n"
+      "  last mesh written); see hull/node/hull_stages.h.\n";
   d.create = [](yaml::MapReader& config,
                 runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto section = config.required("hull");

@@ -1,6 +1,7 @@
 #include "hull_node.h"
 
 #include <chrono>
+#include <map>
 #include <optional>
 #include <utility>
 
@@ -11,6 +12,8 @@
 #include "hull/projector_mask.h"
 #include "hull/segment_mesh.h"
 #include "hull/visibility.h"
+#include "hull_stages.h"
+#include "core/clock.h"
 #include "runtime/service_loop.h"
 #include "wire/actor_convert.h"
 #include "wire/convert.h"
@@ -23,18 +26,18 @@ constexpr const char* kLog = "hull";
 using SteadyClock = std::chrono::steady_clock;
 using Assembler = FrameAssembler<RunMask>;
 
+// Straight from the mesh's arrays (3 packed floats / indices per element) into the sample's.
 void mesh_to_wire(const Mesh& mesh, studio_ActorMesh& s) {
-  std::vector<float> v, n;
-  std::vector<uint32_t> t;
-  v.reserve(mesh.vertices.size() * 3);
-  n.reserve(mesh.normals.size() * 3);
-  t.reserve(mesh.triangles.size() * 3);
-  for (const auto& p : mesh.vertices) v.insert(v.end(), {p.x(), p.y(), p.z()});
-  for (const auto& p : mesh.normals) n.insert(n.end(), {p.x(), p.y(), p.z()});
-  for (const auto& tri : mesh.triangles) t.insert(t.end(), tri.begin(), tri.end());
-  wire::assign(s.vertices, v);
-  wire::assign(s.normals, n);
-  wire::assign(s.triangles, t);
+  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
+  static_assert(sizeof(std::array<uint32_t, 3>) == 3 * sizeof(uint32_t));
+  const auto floats = [](const std::vector<Eigen::Vector3f>& v) {
+    return std::span<const float>(v.empty() ? nullptr : v.front().data(), 3 * v.size());
+  };
+  wire::assign(s.vertices, floats(mesh.vertices));
+  wire::assign(s.normals, floats(mesh.normals));
+  wire::assign(s.triangles, std::span<const uint32_t>(
+                                mesh.triangles.empty() ? nullptr : mesh.triangles.front().data(),
+                                3 * mesh.triangles.size()));
 }
 
 Assembler::Options assembler_options(const HullNodeOptions& o, const std::vector<Camera>& cams) {
@@ -55,6 +58,7 @@ class HullNode : public runtime::Node {
         assembler_(assembler_options(options_, cameras)),
         poses_(std::move(cameras)),
         projectors_(std::move(projectors)),
+        stages_(ctx.metrics),
         loop_(ctx, kLog) {
     if (options_.projector_masks) {
       projector_masks_ =
@@ -92,7 +96,7 @@ class HullNode : public runtime::Node {
         });
     loop_.input<studio_AlphaMask>(
         {.received = "masks_in", .rejected = "masks_rejected", .reason_prefix = "masks_rejected_"},
-        [this](const studio_AlphaMask& s, const wire::SampleMeta&) { return on_mask(s); });
+        [this](const studio_AlphaMask& s, const wire::SampleMeta& m) { return on_mask(s, m); });
     loop_.after_inputs([this](SteadyClock::time_point now) { emit(now); });
     loop_.deadline([this] { return assembler_.next_deadline(); },
                    [this](SteadyClock::time_point now) { emit(now); });
@@ -134,7 +138,7 @@ class HullNode : public runtime::Node {
     return {};
   }
 
-  runtime::Outcome on_mask(const studio_AlphaMask& s) {
+  runtime::Outcome on_mask(const studio_AlphaMask& s, const wire::SampleMeta& meta) {
     auto mask = wire::to_core(s);
     if (!mask) return runtime::reject("to_core", mask.error().message);
     const int index = assembler_.source_index(s.camera_id);
@@ -146,7 +150,15 @@ class HullNode : public runtime::Node {
                         "x" + std::to_string(mask->height()) + " differs from the camera's " +
                         std::to_string(c.width) + "x" + std::to_string(c.height));
     }
-    assembler_.add(s.camera_id, s.frame, s.capture_ns, std::move(*mask), SteadyClock::now());
+    const auto now = SteadyClock::now();
+    assembler_.add(s.camera_id, s.frame, s.capture_ns, std::move(*mask), now);
+    // The frame's newest mask so far: when it was handled, and its transport (hull_stages.h).
+    Arrival& a = arrivals_[s.frame];
+    a.handled = now;
+    a.delivery_ms =
+        meta.source_timestamp ? double(realtime_ns() - meta.source_timestamp) * 1e-6 : -1;
+    a.written_ms = meta.source_timestamp ? double(meta.source_timestamp - s.capture_ns) * 1e-6 : -1;
+    if (arrivals_.size() > 64) arrivals_.erase(arrivals_.begin());  // frames never cut
     return {};
   }
 
@@ -162,6 +174,17 @@ class HullNode : public runtime::Node {
   }
 
   void process(const Assembler::Frame& frame) {
+    auto t = SteadyClock::now();
+    std::optional<SteadyClock::time_point> last_mask;
+    if (auto it = arrivals_.find(frame.frame); it != arrivals_.end()) {
+      last_mask = it->second.handled;
+      if (it->second.delivery_ms >= 0) {
+        stages_.add(HullStages::mask_delivery, it->second.delivery_ms);
+        stages_.add(HullStages::capture_to_mask, it->second.written_ms);
+      }
+      stages_.add(HullStages::queue, t - it->second.handled);
+    }
+    arrivals_.erase(arrivals_.begin(), arrivals_.upper_bound(frame.frame));
     std::vector<View> views;
     for (std::size_t i = 0; i < frame.items.size(); ++i) {
       if (!frame.items[i]) continue;
@@ -182,8 +205,16 @@ class HullNode : public runtime::Node {
       return;
     }
     const std::vector<SegmentSet> actors = connected_components(*hull, options_.min_actor_volume);
+    const auto cut_done = SteadyClock::now();
+    stages_.add(HullStages::cut, cut_done - t);
+    Durations d;
     for (std::size_t k = 0; k < actors.size(); ++k)
-      publish(actors[k], options_.actor_prefix + std::to_string(k), frame, views, cut);
+      publish(actors[k], options_.actor_prefix + std::to_string(k), frame, views, cut, d);
+    stages_.add(HullStages::mesh, d.mesh);
+    stages_.add(HullStages::refine, d.refine);
+    stages_.add(HullStages::publish, d.publish);
+    if (last_mask && !actors.empty())
+      stages_.add(HullStages::mask_to_mesh, SteadyClock::now() - *last_mask);
     for (std::size_t k = actors.size(); k < published_actors_; ++k)
       dispose(options_.actor_prefix + std::to_string(k));
     published_actors_ = actors.size();
@@ -216,28 +247,44 @@ class HullNode : public runtime::Node {
     }
   }
 
+  struct Durations {
+    SteadyClock::duration mesh{}, refine{}, publish{};
+  };
   void publish(const SegmentSet& set, const std::string& actor_id, const Assembler::Frame& frame,
-               std::span<const View> views, const CutOptions& cut) {
+               std::span<const View> views, const CutOptions& cut, Durations& d) {
+    auto t = SteadyClock::now();
+    const auto lap = [&t](SteadyClock::duration& into) {
+      const auto now = SteadyClock::now();
+      into += now - t;
+      t = now;
+    };
     wire::Owned<studio_SegmentSet> s;
     wire::set(s->actor_id, actor_id);
     s->frame = frame.frame;
     s->capture_ns = frame.capture_ns;
     wire::from_core(set, *s);
     (void)segs_->write(*s);
+    lap(d.publish);
     if (!options_.mesh) return;
     wire::Owned<studio_ActorMesh> m;
     wire::set(m->actor_id, actor_id);
     m->frame = frame.frame;
     m->capture_ns = frame.capture_ns;
     m->source_frame = frame.frame;
-    Mesh mesh = segment_marching_cubes(set);
+    // With exact crossings the normals come after the vertices moved (refine_crossings).
+    Mesh mesh = segment_marching_cubes(set, {.normals = !options_.refine});
+    lap(d.mesh);
     if (options_.refine) {
       // Only fails on a mask of the wrong size, which the frame's cut already rejected.
-      if (auto ok = refine_crossings(mesh, set, views, cut); !ok)
+      if (auto ok = refine_crossings(mesh, set, views, cut); !ok) {
         STUDIO_LOG(warn, kLog) << "frame " << frame.frame << ": " << ok.error().message;
+        compute_normals(mesh);
+      }
+      lap(d.refine);
     }
     mesh_to_wire(mesh, *m);
     (void)meshes_->write(*m);
+    lap(d.publish);
   }
 
   void dispose(const std::string& actor_id) {
@@ -262,6 +309,13 @@ class HullNode : public runtime::Node {
   std::vector<runtime::Counter*> frame_counts_;
   runtime::Counter* stale_ = nullptr;
   runtime::Counter* invalid_ = nullptr;
+  struct Arrival {
+    SteadyClock::time_point handled;
+    double delivery_ms = -1;  // -1: no source timestamp
+    double written_ms = -1;   // capture_ns -> written
+  };
+  std::map<uint64_t, Arrival> arrivals_;  // frame -> its newest mask (loop thread)
+  HullStages stages_;
   runtime::ServiceLoop loop_;  // last: stopped before the state above goes
 };
 

@@ -6,6 +6,8 @@
 // studio/actor/mesh stamped with the frame and the masks' capture_ns. Cameras start from the rig
 // file and follow studio/camera/calibration (tracked cameras send one per frame).
 //
+// Status: besides the loop's counters, where each frame's time goes (hull_stages.h gauges).
+//
 // Config (the `hull:` section of the service config; see hull_service_definition()):
 //   rig: rig.yaml             cameras (required; relative to the config file)
 //   box: [x0,y0,z0,x1,y1,z1]  the reconstruction volume, studio frame, metres (required)
@@ -16,7 +18,8 @@
 //   min_views: 2              visibility policy (hull/silhouette_cut.h): a point is actor iff
 //                             inside every silhouette that sees it and seen by >= min_views
 //                             cameras (0..64; the offline CLI's default, kDefaultMinViews)
-//   threads: 2                cut threads (columns are independent)
+//   threads: 2                threads of the cut and of the exact crossings (columns and
+//                             crossing vertices are independent)
 //   mesh: true                publish studio/actor/mesh (segment marching cubes)
 //   refine: true              exact crossings on the mesh (hull/crossing_refine.h): vertices
 //                             between an inside and an outside column move to where the hull

@@ -210,6 +210,29 @@ void HullNodeTest::masks_in_segments_and_mesh_out(bool refine) {
   const float cell = float(options.grid_spec().du());
   EXPECT_LT(refine ? off_exact : off_plain, 1e-5f);
   EXPECT_GT(refine ? off_plain : off_exact, 0.2f * cell);
+
+  // The status says where the frames' time went (hull_stages.h): every stage gauge is there, the
+  // work stages took time, the crossings only when refining, and the stages fit in the total.
+  auto status_topic = wire::Topic<studio_ServiceStatus>::create(p).value();
+  auto status = wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
+  std::map<std::string, double> g;
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  while (std::chrono::steady_clock::now() < until && !g.contains("mask_to_mesh_ms")) {
+    for (auto& s : status.take())
+      if (s.meta.valid_data && std::string(s.data->service) == "hull")
+        for (const auto& c : wire::view(s.data->counters)) g[c.name] = c.value;
+    std::this_thread::sleep_for(50ms);
+  }
+  for (const char* name :
+       {"capture_to_mask_ms", "stage_mask_delivery_ms", "stage_queue_ms", "stage_cut_ms",
+        "stage_mesh_ms", "stage_refine_ms", "stage_publish_ms", "mask_to_mesh_ms"})
+    EXPECT_TRUE(g.contains(name)) << name;
+  EXPECT_GT(g["stage_cut_ms"], 0);
+  EXPECT_GT(g["stage_mesh_ms"], 0);
+  EXPECT_EQ(g["stage_refine_ms"] > 0, refine);
+  EXPECT_GE(g["stage_mask_delivery_ms"], 0);
+  EXPECT_LT(g["stage_mask_delivery_ms"], 1000);
+  EXPECT_GE(g["mask_to_mesh_ms"], 0.5 * (g["stage_cut_ms"] + g["stage_mesh_ms"]));
   EXPECT_EQ(hull.stop(), 0) << hull.log();
 }
 

@@ -33,23 +33,41 @@ double neighbour_event(std::span<const Interval> a, std::span<const Interval> b,
 }
 
 // Whether the straight image of the segment p0-p1 (a distortion-free camera, P = K [R | t]) lies
-// in one pixel row and within one run of `mask`, i.e. wholly inside the silhouette: cutting it
-// with that view would keep it whole (pixel (x, y) covers [x-0.5, x+0.5) x [y-0.5, y+0.5), the
-// row walker's convention). False means "cut to find out".
-bool inside_one_run(const Eigen::Matrix<double, 3, 4>& P, const RunMask& mask,
-                    const Eigen::Vector3d& p0, const Eigen::Vector3d& p1) {
-  const Eigen::Vector3d h0 = P * p0.homogeneous(), h1 = P * p1.homogeneous();
+// wholly inside the silhouette: in every pixel row it crosses, its part in that row lies within
+// one run of `mask`, so cutting it with that view would keep it whole (pixel (x, y) covers
+// [x-0.5, x+0.5) x [y-0.5, y+0.5), the row walker's convention). Both ends in front of the camera
+// put the whole segment in front, where its image is the straight segment between the ends'.
+// False means "cut to find out". A crossing segment is one cell long (2-3 px in the studio's
+// cameras), so it crosses one to three rows.
+// h0, h1: the ends' homogeneous images.
+bool inside_runs(const Eigen::Vector3d& h0, const Eigen::Vector3d& h1, const RunMask& mask) {
   if (!(h0.z() > 0) || !(h1.z() > 0)) return false;
-  const double y0 = std::floor(h0.y() / h0.z() + 0.5), y1 = std::floor(h1.y() / h1.z() + 0.5);
-  if (y0 != y1 || y0 < 0 || y0 >= mask.height()) return false;
-  const double xa = std::floor(h0.x() / h0.z() + 0.5), xb = std::floor(h1.x() / h1.z() + 0.5);
-  const double lo = std::min(xa, xb), hi = std::max(xa, xb);
-  if (lo < 0 || hi >= mask.width()) return false;
-  const auto runs = mask.row(int(y0));
-  // The first run ending after lo must also start at or before it and reach past hi.
-  const auto it = std::upper_bound(runs.begin(), runs.end(), lo,
-                                   [](double x, const Run& r) { return x < double(r.end); });
-  return it != runs.end() && double(it->begin) <= lo && hi < double(it->end);
+  const double w0 = 1 / h0.z(), w1 = 1 / h1.z();
+  const double u0 = h0.x() * w0, v0 = h0.y() * w0;
+  const double u1 = h1.x() * w1, v1 = h1.y() * w1;
+  const double ylo = std::floor(std::min(v0, v1) + 0.5), yhi = std::floor(std::max(v0, v1) + 0.5);
+  if (ylo < 0 || yhi >= mask.height() || yhi - ylo > 8) return false;
+  const double du = u1 - u0, dv = v1 - v0;
+  const double inv_dv = ylo == yhi ? 0 : 1 / dv;  // one row: the whole segment is in it
+  for (int y = int(ylo); y <= int(yhi); ++y) {
+    // The segment's part in the row's band [y - 0.5, y + 0.5): s in [sa, sb] of [0, 1].
+    double sa = 0, sb = 1;
+    if (inv_dv != 0) {
+      const double a = (y - 0.5 - v0) * inv_dv, b = a + inv_dv;
+      sa = std::max(0.0, std::min(a, b)), sb = std::min(1.0, std::max(a, b));
+    }
+    const double ua = u0 + sa * du, ub = u0 + sb * du;
+    const double lo_u = std::floor(std::min(ua, ub) + 0.5),
+                 hi_u = std::floor(std::max(ua, ub) + 0.5);
+    if (lo_u < 0 || hi_u >= mask.width()) return false;
+    const int lo = int(lo_u), hi = int(hi_u);
+    const auto runs = mask.row(y);
+    // The first run ending after lo must also start at or before it and reach past hi.
+    const auto it = std::upper_bound(runs.begin(), runs.end(), lo,
+                                     [](int x, const Run& r) { return x < r.end; });
+    if (it == runs.end() || it->begin > lo || hi >= it->end) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -60,6 +78,7 @@ Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<con
   const GridSpec& g = set.grid();
   const int ua = g.u(), va = g.v(), aa = g.a();
   const double du = g.du(), dv = g.dv();
+  const double two_du = 2 / du, two_dv = 2 / dv;  // lattice lines are at half cells
   const Eigen::AlignedBox3d domain(g.box_min, g.box_max);
   // Lines along e_u and along e_v: two pencils through points at infinity.
   std::vector<PreparedView> along[2];
@@ -72,11 +91,13 @@ Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<con
       along[k].push_back(std::move(*p));
     }
   }
-  // Distortion-free cameras get a cheap whole-segment test before the cut (inside_one_run).
+  // Distortion-free cameras get a cheap whole-segment test before the cut (inside_runs).
+  // The image of a point on an edge is affine in it: h = P (from, 1) + s P (d, 0).
   std::vector<std::optional<Eigen::Matrix<double, 3, 4>>> straight(views.size());
   for (std::size_t v = 0; v < views.size(); ++v)
     if (views[v].camera->distortion.is_identity())
       straight[v] = views[v].camera->projection_matrix();
+  const int edge_axis[2] = {ua, va};
   const auto column = [&](int i, int j) -> std::span<const Interval> {
     if (i < 0 || j < 0 || i >= g.cells_u || j >= g.cells_v) return {};
     return set.column(i, j);
@@ -88,8 +109,8 @@ Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<con
     for (std::size_t vi = first; vi < last; ++vi) {
       Eigen::Vector3f& p = mesh.vertices[vi];
       // Lattice line in doubled coordinates (see segment_mesh.cc): column (i, j) is (2i+2, 2j+2).
-      const int x2 = int(std::lround((p[ua] - g.box_min[ua]) / du * 2 + 1));
-      const int y2 = int(std::lround((p[va] - g.box_min[va]) / dv * 2 + 1));
+      const int x2 = int(std::lround((p[ua] - g.box_min[ua]) * two_du + 1));
+      const int y2 = int(std::lround((p[va] - g.box_min[va]) * two_dv + 1));
       const bool odd_x = (x2 & 1) != 0, odd_y = (y2 & 1) != 0;
       if (odd_x == odd_y) continue;  // a column or a cell centre
       const int k = odd_x ? 0 : 1;   // edge along u or along v
@@ -119,11 +140,14 @@ Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<con
       Eigen::Vector3d d = Eigen::Vector3d::Zero();
       d[k == 0 ? ua : va] = first_inside ? 1 : -1;
       a.assign(1, Interval{0.f, float(step)});
+      const double sign = first_inside ? 1 : -1;
       for (std::size_t v = 0; v < views.size(); ++v) {
-        if (a.size() == 1 && straight[v] &&
-            inside_one_run(*straight[v], *views[v].mask, from + double(a[0].lo) * d,
-                           from + double(a[0].hi) * d)) {
-          continue;  // this view keeps the piece whole
+        if (a.size() == 1 && straight[v]) {
+          const Eigen::Matrix<double, 3, 4>& P = *straight[v];
+          const Eigen::Vector3d h = P.leftCols<3>() * from + P.col(3);
+          const Eigen::Vector3d e = sign * P.col(edge_axis[k]);
+          if (inside_runs(h + double(a[0].lo) * e, h + double(a[0].hi) * e, *views[v].mask))
+            continue;  // this view keeps the piece whole
         }
         b.clear();
         along[k][v].cut_line(from, d, a, &b, &scratch);

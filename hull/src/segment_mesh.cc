@@ -139,7 +139,7 @@ void compute_normals(Mesh& mesh) {
 #endif
 }
 
-Mesh segment_marching_cubes(const SegmentSet& set) {
+Mesh segment_marching_cubes(const SegmentSet& set, const MeshOptions& options) {
   const GridSpec& g = set.grid();
   // Work on the bounding rectangle of the non-empty columns (local i, j = global - i0, j0): the
   // cost follows the occupied area, not the box.
@@ -369,7 +369,7 @@ Mesh segment_marching_cubes(const SegmentSet& set) {
     }
   }
 
-  compute_normals(mesh);
+  if (options.normals) compute_normals(mesh);
   return mesh;
 }
 

@@ -33,9 +33,15 @@ struct Mesh {
   double volume() const;
 };
 
+struct MeshOptions {
+  // Vertex normals (compute_normals). A caller that moves the vertices afterwards and recomputes
+  // them (refine_crossings) skips this pass: mesh.normals is then empty.
+  bool normals = true;
+};
+
 // Cost follows the occupied part of the grid (the bounding rectangle of the non-empty columns).
 // Keeps its working memory per thread between calls, so a frame loop does not reallocate it.
-Mesh segment_marching_cubes(const SegmentSet& set);
+Mesh segment_marching_cubes(const SegmentSet& set, const MeshOptions& options = {});
 
 // (Re)computes mesh.normals: unit area-weighted vertex normals (zero for isolated vertices).
 void compute_normals(Mesh& mesh);
