@@ -1,0 +1,104 @@
+#include "static_layer.h"
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace studio::projector_render {
+
+Expected<StaticLayer> StaticLayer::create(const projector::ProjectorView& view,
+                                          const projector::OffAxisOptions& off_axis,
+                                          const projector::SceneCacheOptions& options, int width,
+                                          int height) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  auto bound = projector::StaticShiftBound::create(view, off_axis);
+  if (!bound) return std::unexpected(bound.error());
+  auto target = scene_render::RenderTarget::create(width, height);
+  if (!target) return std::unexpected(target.error());
+  return StaticLayer(std::move(*bound), options, std::move(*target), view);
+}
+
+StaticLayer::StaticLayer(projector::StaticShiftBound bound, projector::SceneCacheOptions options,
+                         scene_render::RenderTarget target, const projector::ProjectorView& view)
+    : bound_(std::move(bound)),
+      options_(options),
+      target_(std::move(target)),
+      screen_(view.screen()),
+      screen_from_pixel_(view.screen_from_pixel()),
+      projector_height_(view.camera().height) {}
+
+double StaticLayer::shift_px(std::uint64_t version, const Eigen::Vector3d& eye) const {
+  if (!valid_ || version != version_) return std::numeric_limits<double>::infinity();
+  return bound_.shift_px(heights_, eye_, eye);
+}
+
+namespace {
+void blit(unsigned from, unsigned to, int w, int h) {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, from);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, to);
+  glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+}
+}  // namespace
+
+void StaticLayer::restore(const scene_render::RenderTarget& into) const {
+  const bool scissor = glIsEnabled(GL_SCISSOR_TEST);  // the blit honours the scissor box
+  if (scissor) glDisable(GL_SCISSOR_TEST);
+  blit(target_.framebuffer(), into.framebuffer(), into.width(), into.height());
+  if (scissor) glEnable(GL_SCISSOR_TEST);
+  into.bind();
+}
+
+void StaticLayer::store(const scene_render::RenderTarget& from, std::uint64_t version,
+                        const Eigen::Vector3d& eye, const DepthModel& model) {
+  const bool scissor = glIsEnabled(GL_SCISSOR_TEST);
+  if (scissor) glDisable(GL_SCISSOR_TEST);
+  blit(from.framebuffer(), target_.framebuffer(), from.width(), from.height());
+  if (scissor) glEnable(GL_SCISSOR_TEST);
+  from.bind();
+  const auto [bx, by, bw, bh] = model.box;
+  depth_.resize(std::size_t(std::max(bw, 0)) * std::size_t(std::max(bh, 0)));
+  if (!depth_.empty()) {
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(bx, by, bw, bh, GL_DEPTH_COMPONENT, GL_FLOAT, depth_.data());
+  }
+  // Eye view distance of a depth value: window depth -> NDC z' (-> the eye's NDC z = z' k in the
+  // single pass) -> glFrustum's z = 2 f n / ((f + n) - ndc_z (f - n)); height = h_e - z.
+  const double n = model.near, f = model.far, h_e = screen_.signed_distance(eye);
+  // k = w' / w at the screen point a pixel lights: both clip w are linear in the screen point's
+  // homogeneous coordinates M (s, t, 1) ~ M screen_from_pixel (u, v, 1), so k = (p . q) / (e . q).
+  Eigen::Matrix<double, 4, 3> M;
+  M << screen_.right, screen_.up, screen_.origin, 0, 0, 1;
+  const Eigen::RowVector3d e_row = model.eye_clip_from_world.row(3) * M * screen_from_pixel_;
+  const Eigen::RowVector3d p_row =
+      model.projector_clip_from_world
+          ? Eigen::RowVector3d(model.projector_clip_from_world->row(3) * M * screen_from_pixel_)
+          : Eigen::RowVector3d::Zero();
+  double z_min = std::numeric_limits<double>::infinity(), z_max = 0;
+  for (int y = 0; y < bh; ++y) {
+    const float* row = depth_.data() + std::size_t(y) * bw;
+    const double v = projector_height_ - 1 - (by + y);  // image row of GL row by + y
+    for (int x = 0; x < bw; ++x) {
+      const float d = row[x];
+      if (d <= 0.0f || d >= 1.0f) continue;  // the black around the screen, or nothing drawn
+      double ndc = 2.0 * d - 1.0;
+      if (model.projector_clip_from_world) {
+        const Eigen::Vector3d q(bx + x, v, 1.0);
+        ndc *= p_row.dot(q) / e_row.dot(q);
+      }
+      const double z = 2 * f * n / ((f + n) - ndc * (f - n));
+      z_min = std::min(z_min, z);
+      z_max = std::max(z_max, z);
+    }
+  }
+  heights_ = z_max > 0 ? projector::HeightRange{h_e - z_max, h_e - z_min}
+                       : projector::HeightRange{1, 0};  // nothing static shown: hi < lo
+  version_ = version;
+  eye_ = eye;
+  valid_ = true;
+}
+
+}  // namespace studio::projector_render
