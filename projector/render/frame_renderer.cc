@@ -68,6 +68,7 @@ struct FrameRenderer::Impl {
   scene::ActorMesh scratch;
   std::vector<std::uint8_t> rgba;
   std::optional<StaticLayer> layer;  // scene_cache enabled
+  std::optional<Eigen::Vector3d> last_eye;  // of the previous layered frame
 
   Expected<FrameInfo> render(const scene::Scene& still, std::uint64_t version,
                              const scene::Scene* moving, const Eigen::Vector3d& eye,
@@ -170,7 +171,8 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
                                                       {},
                                                       {},
                                                       {},
-                                                      std::move(layer)}));
+                                                      std::move(layer),
+                                                      std::nullopt}));
 }
 
 scene_render::Renderer& FrameRenderer::renderer() { return impl_->renderer; }
@@ -202,6 +204,15 @@ Expected<FrameInfo> FrameRenderer::Impl::render(const scene::Scene& still, std::
   FrameInfo info;
   info.shift_px = l ? l->shift_px(version, eye) : std::numeric_limits<double>::infinity();
   info.from_cache = l && info.shift_px <= l->options().max_error_px;
+  // A re-rendered static layer is kept (a blit and a depth read, ~a fifth of a frame) only when
+  // it may serve the next frame: a new static version, nothing cached yet, or an eye that moved
+  // less than the bound since the previous frame (a still eye). An eye moving every frame by
+  // more than the bound (a walking actor, tracker noise) costs no more than a full render.
+  const bool keep =
+      l && !info.from_cache &&
+      (!l->valid() || l->version() != version || !r.last_eye ||
+       l->bound().shift_px(l->heights(), *r.last_eye, eye) <= l->options().max_error_px);
+  r.last_eye = eye;
   const double near = r.options.off_axis.near_m, far = r.options.off_axis.far_m;
   if (r.options.form == Form::single_pass) {
     auto pass = r.view.single_pass(eye, r.options.off_axis);
@@ -227,7 +238,7 @@ Expected<FrameInfo> FrameRenderer::Impl::render(const scene::Scene& still, std::
       glScissor(r.screen_box[0], r.screen_box[1], r.screen_box[2], r.screen_box[3]);
       r.renderer.draw(still, v);
       glDisable(GL_SCISSOR_TEST);
-      if (l)
+      if (keep)
         l->store(r.target, version, eye,
                  {pass->eye.clip_from_world, pass->clip_from_world, near, far, r.screen_box});
     }
@@ -248,7 +259,7 @@ Expected<FrameInfo> FrameRenderer::Impl::render(const scene::Scene& still, std::
     } else {
       r.eye_target->bind();
       r.renderer.draw(still, v);
-      if (l)
+      if (keep)
         l->store(*r.eye_target, version, eye,
                  {pass->eye.clip_from_world,
                   std::nullopt,
@@ -276,6 +287,7 @@ Expected<FrameInfo> FrameRenderer::Impl::render(const scene::Scene& still, std::
     }
   }
   info.masks = draw_masks(masks);
+  info.stored = keep;
   return info;
 }
 

@@ -258,6 +258,37 @@ TEST(SceneCache, MovingNodeIsDrawnEveryFrameAndANewStaticVersionReRenders) {
   }
 }
 
+// An eye moving more than the bound every frame re-renders without keeping the layer (it would
+// not serve the next frame); once the eye stops, the layer is kept and the next frame reuses it.
+TEST(SceneCache, MovingEyeDoesNotKeepTheLayerAStillEyeDoes) {
+  (void)context();
+  const Projector p = projector::testing::studio_projectors()[0];
+  auto view = projector::ProjectorView::create(p).value();
+  std::mt19937 rng(4);
+  const Eigen::Vector3d eye(0.2, 1.6, 1.0);
+  const Markers m = make_markers(p, eye, rng);
+  FrameRendererOptions fo;
+  fo.thumb_width = fo.thumb_height = 0;
+  auto fr = FrameRenderer::create(view, fo);
+  ASSERT_TRUE(fr) << fr.error().message;
+  ASSERT_TRUE(fr->renderer().upload(square_asset()));
+  const LayeredScene layered{m.scene, 1, nullptr};
+  std::vector<FrameInfo> infos;
+  for (int k = 0; k < 6; ++k)  // walking: 5 mm per frame
+    infos.push_back(fr->render(layered, eye + Eigen::Vector3d(0.005 * k, 0, 0), {}).value());
+  for (int k = 0; k < 3; ++k)  // stopped
+    infos.push_back(fr->render(layered, eye + Eigen::Vector3d(0.025, 0, 0), {}).value());
+  EXPECT_TRUE(infos[0].stored);  // nothing cached yet
+  for (int k = 1; k < 6; ++k) {
+    EXPECT_FALSE(infos[k].from_cache) << k;
+    EXPECT_FALSE(infos[k].stored) << k;
+  }
+  EXPECT_FALSE(infos[6].from_cache);  // the first frame at rest: re-rendered and kept
+  EXPECT_TRUE(infos[6].stored);
+  EXPECT_TRUE(infos[7].from_cache);
+  EXPECT_TRUE(infos[8].from_cache);
+}
+
 TEST(SceneCache, DefaultMuseumFromTheCacheMatchesAFullRender) {
   (void)context();
   const Projector p = projector::testing::studio_projectors()[0];

@@ -53,6 +53,7 @@ class StaticLayer {
              const Eigen::Vector3d& eye, const DepthModel& model);
   void invalidate() { valid_ = false; }
   bool valid() const { return valid_; }
+  std::uint64_t version() const { return version_; }
 
   const projector::HeightRange& heights() const { return heights_; }
   const projector::StaticShiftBound& bound() const { return bound_; }

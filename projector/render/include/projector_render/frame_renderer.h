@@ -87,6 +87,9 @@ struct FrameInfo {
   // nothing was cached for this static version (a full render follows either way when it
   // exceeds SceneCacheOptions::max_error_px).
   double shift_px = 0;
+  // A re-rendered static layer was kept for later frames (not when the eye moved more than the
+  // bound since the previous frame: it would not serve the next one).
+  bool stored = false;
 };
 
 // The black outside the cloth: the screen's plane around the rectangle, out to 50 m from its
