@@ -26,6 +26,7 @@ Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeO
   fo.eye_texture_size = {options.eye_texture[0], options.eye_texture[1]};
   fo.thumb_width = options.thumbnail[0];
   fo.thumb_height = options.thumbnail[1];
+  fo.scene_cache = options.scene_cache;
   auto fr = projector_render::FrameRenderer::create(view, fo);
   if (!fr) return fr;
   STUDIO_LOG(info, "projector") << "rendering " << fr->width() << "x" << fr->height() << " on "

@@ -32,6 +32,7 @@ class ProjectorNode : public runtime::Node {
       : options_(std::move(options)),
         view_(std::move(view)),
         projector_(projector),
+        mirror_(options_.scene_cache.settle_s),
         planner_(options_.mask_options()),
         loop_(ctx, kLog),
         stages_(loop_.metrics()) {
@@ -75,6 +76,11 @@ class ProjectorNode : public runtime::Node {
     assets_failed_ = &loop_.counter("assets_failed");
     superseded_ = &loop_.counter("meshes_superseded");
     mesh_errors_ = &loop_.counter("mesh_motion_errors");
+    from_cache_ = &loop_.counter("frames_from_cache");
+    rerendered_ = &loop_.counter("scene_rerendered");
+    moving_nodes_ = &loop_.metrics().gauge("scene_moving_nodes");
+    cache_move_mm_ = &loop_.metrics().gauge("scene_cache_move_mm");
+    cpu_per_frame_ = &loop_.metrics().gauge("cpu_per_frame_ms");
     margin_mm_ = &loop_.metrics().gauge("margin_mm");
     latency_p_ms_ = &loop_.metrics().gauge("latency_p_ms");
     render_ms_ = &loop_.metrics().gauge("render_ms");
@@ -117,7 +123,7 @@ class ProjectorNode : public runtime::Node {
     }
     auto node = wire::to_core(s);
     if (!node) return runtime::reject("to_core", node.error().message);
-    mirror_.update(std::move(*node));
+    mirror_.update(std::move(*node), seconds(SteadyClock::now().time_since_epoch()));
     return {};
   }
 
@@ -223,27 +229,30 @@ class ProjectorNode : public runtime::Node {
 
   // What the render thread keeps from frame to frame.
   struct Frame {
-    scene::Scene scene;
-    scene_assets::AssetCache cache;
-    std::set<std::string> failed_assets;
+    RenderScene scene;
     projector_render::Readback readback;
+    CpuPerFrame cpu;
     double render_s = 0;  // smoothed render time: a frame is shown about this much later
     uint64_t count = 0;
   };
 
   void render_one(projector_render::FrameRenderer& fr, Frame& st, WindowOutput* window) {
     std::optional<std::map<scene::NodeId, scene::Node>> nodes;
+    std::set<scene::NodeId> moving;
     {
       std::lock_guard lock(mutex_);
-      if (mirror_.dirty()) {
+      const double now = seconds(SteadyClock::now().time_since_epoch());
+      if (mirror_.dirty(now)) {
         nodes = mirror_.nodes();
+        moving = mirror_.moving(now);
         mirror_.clean();
       }
     }
     if (nodes) {
-      auto r = SceneMirror::rebuild(*nodes, st.scene, st.cache, st.failed_assets, fr.renderer());
+      auto r = st.scene.rebuild(*nodes, moving, fr.renderer());
       scene_left_out_->add(r.left_out);
       assets_failed_->add(r.assets_failed);
+      moving_nodes_->set(double(st.scene.layers.moving_nodes));
     }
     const auto arrived = take_inputs();
     Eigen::Vector3d eye = eye_now(SteadyClock::now());
@@ -261,7 +270,7 @@ class ProjectorNode : public runtime::Node {
     stage(FrameStages::mask);
     const std::span<const ActorMesh> masks =
         plan ? std::span<const ActorMesh>(plan->masks) : std::span<const ActorMesh>();
-    auto drawn = fr.render(st.scene, eye, masks);
+    auto drawn = draw(fr, st.scene, eye, masks);
     if (!drawn) {  // an eye the projection refuses: the last good eye (checked at start)
       eye_rejected_->add();
       STUDIO_LOG(debug, kLog) << drawn.error().message;
@@ -269,8 +278,11 @@ class ProjectorNode : public runtime::Node {
         std::lock_guard lock(mutex_);
         eye = last_good_eye_;
       }
-      drawn = fr.render(st.scene, eye, masks);
+      drawn = draw(fr, st.scene, eye, masks);
     }
+    if (drawn) (drawn->from_cache ? from_cache_ : rerendered_)->add();
+    if (drawn && options_.scene_cache.enabled)
+      cache_move_mm_->set(fr.cache_allowed_move_m(eye) * 1e3);
     stage(FrameStages::draw);
     fr.finish();
     stage(FrameStages::finish);
@@ -283,6 +295,7 @@ class ProjectorNode : public runtime::Node {
     const double took = (done_ns - start_ns) * 1e-9;
     st.render_s = st.count++ == 0 ? took : 0.9 * st.render_s + 0.1 * took;
     rendered_->add();
+    if (auto cpu = st.cpu.frame_done()) cpu_per_frame_->set(*cpu * 1e3);
     {
       std::lock_guard lock(mutex_);
       if (drawn) last_good_eye_ = eye;
@@ -297,6 +310,17 @@ class ProjectorNode : public runtime::Node {
     degraded_ = !drawn;
     if (options_.frame_every > 0 && st.count % uint64_t(options_.frame_every) == 0)
       publish(fr, st.readback, plan ? &*plan : nullptr, eye, st.count, done_ns);
+  }
+
+  // The frame from the layered scene (the scene cache), or the whole scene when it is off.
+  Expected<projector_render::FrameInfo> draw(projector_render::FrameRenderer& fr,
+                                             const RenderScene& s, const Eigen::Vector3d& eye,
+                                             std::span<const ActorMesh> masks) {
+    if (options_.scene_cache.enabled)
+      return fr.render({s.layers.still, s.layers.still_version, &s.layers.moving}, eye, masks);
+    auto n = fr.render(s.scene, eye, masks);
+    if (!n) return std::unexpected(n.error());
+    return projector_render::FrameInfo{.masks = *n};
   }
 
   void publish(projector_render::FrameRenderer& fr, projector_render::Readback& rb,
@@ -337,9 +361,10 @@ class ProjectorNode : public runtime::Node {
   MaskPlanner planner_;  // the render thread's alone
   runtime::Counter *rendered_ = nullptr, *eye_rejected_ = nullptr, *head_stale_ = nullptr,
                    *scene_left_out_ = nullptr, *assets_failed_ = nullptr, *superseded_ = nullptr,
-                   *mesh_errors_ = nullptr;
+                   *mesh_errors_ = nullptr, *from_cache_ = nullptr, *rerendered_ = nullptr;
   runtime::Gauge *margin_mm_ = nullptr, *latency_p_ms_ = nullptr, *render_ms_ = nullptr,
-                 *overrun_p_ms_ = nullptr;
+                 *overrun_p_ms_ = nullptr, *moving_nodes_ = nullptr, *cache_move_mm_ = nullptr,
+                 *cpu_per_frame_ = nullptr;
   runtime::ServiceLoop loop_;  // stopped before the state above goes
   FrameStages stages_;         // the render thread's (gauges of loop_'s metrics)
 
