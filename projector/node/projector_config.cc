@@ -74,6 +74,9 @@ runtime::ServiceDefinition projector_service_definition() {
       "      prediction: true      move every mesh forward by its predicted motion\n"
       "      velocity_uncertainty: 0.05  m/s, sigma of the velocity estimate\n"
       "      head_disagreement: 0.5      m/s; a head faster than the mesh by more: no prediction\n"
+      "      max_acceleration: 8.0       m/s^2, physical bound on the actor's acceleration in the\n"
+      "                                  prediction term (the estimate is the median of the last\n"
+      "                                  5 meshes' largest region acceleration: noise-robust)\n"
       "    latency:                the margin covers each mesh's age when the frame is shown\n"
       "                            (capture_ns -> render done + display_lag, planned) plus this\n"
       "                            quantile of how much later than planned frames were shown\n"
@@ -111,6 +114,7 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("prediction", &MarginOptions::prediction),
         yaml::field("velocity_uncertainty", &MarginOptions::velocity_uncertainty_mps).min(0),
         yaml::field("head_disagreement", &MarginOptions::head_disagreement_mps).min(0),
+        yaml::field("max_acceleration", &MarginOptions::max_acceleration_mps2).range(0.1, 1000),
     };
     static const yaml::Schema<LatencyOptions> latency_schema{
         yaml::field("window", &LatencyOptions::window).range(1, 100000),
