@@ -34,4 +34,18 @@ Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeO
   return fr;
 }
 
+void publish_frame(projector_render::FrameRenderer& fr, projector_render::Readback& rb,
+                   const FrameInfo& facts, runtime::Output<studio_ProjectorFrame>& out,
+                   FrameStages& stages) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  fr.read(rb);
+  const auto t1 = Clock::now();
+  stages.add(FrameStages::readback, std::chrono::duration<double>(t1 - t0).count());
+  wire::Owned<studio_ProjectorFrame> f;
+  fill_frame(facts, rb, *f);
+  (void)out.write(*f);
+  stages.add(FrameStages::publish, std::chrono::duration<double>(Clock::now() - t1).count());
+}
+
 }  // namespace studio::projector

@@ -46,6 +46,16 @@ SceneMirror::Rebuilt RenderScene::rebuild(const std::map<scene::NodeId, scene::N
   return r;
 }
 
+Expected<projector_render::FrameInfo> RenderScene::draw(projector_render::FrameRenderer& fr,
+                                                        const Eigen::Vector3d& eye,
+                                                        std::span<const ActorMesh> masks,
+                                                        bool cache) const {
+  if (cache) return fr.render({layers.still, layers.still_version, &layers.moving}, eye, masks);
+  auto n = fr.render(scene, eye, masks);
+  if (!n) return std::unexpected(n.error());
+  return projector_render::FrameInfo{.masks = *n};
+}
+
 SceneMirror::Rebuilt SceneMirror::rebuild(const std::map<scene::NodeId, scene::Node>& nodes,
                                           scene::Scene& scene, scene_assets::AssetCache& cache,
                                           std::set<std::string>& failed_assets,

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "projector/scene_layers.h"
+#include "projector_render/frame_renderer.h"
 #include "scene/scene.h"
 #include "scene_assets/instantiate.h"
 #include "scene_render/renderer.h"
@@ -65,6 +66,10 @@ struct RenderScene {
   SceneMirror::Rebuilt rebuild(const std::map<scene::NodeId, scene::Node>& nodes,
                                const std::set<scene::NodeId>& moving,
                                scene_render::Renderer& renderer);
+  // The frame from the layers (the scene cache), or from the whole scene when `cache` is off.
+  Expected<projector_render::FrameInfo> draw(projector_render::FrameRenderer& fr,
+                                             const Eigen::Vector3d& eye,
+                                             std::span<const ActorMesh> masks, bool cache) const;
 };
 
 }  // namespace studio::projector
