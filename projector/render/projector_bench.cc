@@ -16,9 +16,9 @@
 // flyer) every frame, as the node does (projector/scene_layers.h), and render it layered from a
 // still eye: the static layer is restored from the cache (one blit of colour + depth), the flyer
 // and the mask drawn over it — the frame the node renders while the eye stays within the bound.
-// `SinglePassCacheMiss`: the same with the eye 5 mm off every other frame (beyond the bound,
-// about 0.6 mm here): every frame re-renders the static layer and stores it (blit + depth read):
-// the cost of a frame when the cache never survives. The `_720p` variants render the same at
+// `SinglePassCacheMiss`: the same with the eye moving 6 mm every frame (on a 2 cm circle; the
+// bound is ~0.6 mm here): every frame re-renders the static layer (and does not keep it: the
+// eye is not still) — the cost of a frame when the cache never survives (a walking actor). The `_720p` variants render the same at
 // 1280x720 (the demo's projector size; the intrinsics scaled by 2/3). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
 // overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame).
 #define GL_GLEXT_PROTOTYPES 1
@@ -171,9 +171,12 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
     } else if (layered) {
       masks[0] = projector::grow_mesh(f.actor, 0.02).value();
       const projector::SceneLayers layers = projector::split_scene(f.scene, f.moving);
-      const Eigen::Vector3d eye = work == Work::single_pass_cache_miss && frame % 2
-                                      ? Eigen::Vector3d(kEye + Eigen::Vector3d(0.005, 0, 0))
-                                      : kEye;
+      // Miss: the eye on a 2 cm circle, 6 mm further each frame (10x the bound).
+      const double turn = 0.3 * double(frame);
+      const Eigen::Vector3d eye =
+          work == Work::single_pass_cache_miss
+              ? Eigen::Vector3d(kEye + 0.02 * Eigen::Vector3d(std::cos(turn), std::sin(turn), 0))
+              : kEye;
       auto info = fr->render(LayeredScene{layers.still, layers.still_version, &layers.moving},
                              eye, masks);
       if (!info) state.SkipWithError("render failed");
