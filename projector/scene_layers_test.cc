@@ -23,7 +23,8 @@ scene::Node node(const std::string& id, const std::string& parent, scene::NodeKi
 scene::Scene museum(double flyer_x, double wall_x = 0) {
   scene::Scene s;
   for (const auto& n :
-       {node("set", "", scene::NodeKind::group, 1), node("set/wall", "set", scene::NodeKind::model, wall_x),
+       {node("set", "", scene::NodeKind::group, 1),
+        node("set/wall", "set", scene::NodeKind::model, wall_x),
         node("set/arm", "set", scene::NodeKind::group, flyer_x),
         node("set/arm/flyer", "set/arm", scene::NodeKind::model, 0.5),
         node("set/sun", "set", scene::NodeKind::light)})
@@ -65,7 +66,8 @@ TEST(SceneLayers, MovingLightIsNotSplit) {
   EXPECT_TRUE(a.moving.nodes().empty());
   // A light under a moving group moves too.
   scene::Scene s = museum(0.0);
-  ASSERT_TRUE(s.apply({0, scene::AddNode{node("set/arm/lamp", "set/arm", scene::NodeKind::light)}}));
+  ASSERT_TRUE(
+      s.apply({0, scene::AddNode{node("set/arm/lamp", "set/arm", scene::NodeKind::light)}}));
   EXPECT_TRUE(split_scene(s, {"set/arm"}).moving_light);
 }
 

@@ -156,7 +156,8 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
   std::optional<StaticLayer> layer;
   if (options.scene_cache.enabled) {
     const scene_render::RenderTarget& t = eye_target ? *eye_target : *target;
-    auto l = StaticLayer::create(view, options.off_axis, options.scene_cache, t.width(), t.height());
+    auto l =
+        StaticLayer::create(view, options.off_axis, options.scene_cache, t.width(), t.height());
     if (!l) return std::unexpected(l.error());
     layer.emplace(std::move(*l));
   }

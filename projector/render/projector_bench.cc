@@ -18,9 +18,11 @@
 // and the mask drawn over it — the frame the node renders while the eye stays within the bound.
 // `SinglePassCacheMiss`: the same with the eye moving 6 mm every frame (on a 2 cm circle; the
 // bound is ~0.6 mm here): every frame re-renders the static layer (and does not keep it: the
-// eye is not still) — the cost of a frame when the cache never survives (a walking actor). The `_720p` variants render the same at
-// 1280x720 (the demo's projector size; the intrinsics scaled by 2/3). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
-// overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame).
+// eye is not still) — the cost of a frame when the cache never survives (a walking actor). The
+// `_720p` variants render the same at 1280x720 (the demo's projector size; the intrinsics scaled
+// by 2/3). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
+// overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame),
+// from_cache (cached cases: the fraction of frames whose static layer came from the cache).
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -135,6 +137,7 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
   const bool layered = work == Work::single_pass_cached || work == Work::single_pass_cache_miss ||
                        work == Work::two_pass_cached;
   std::int64_t hits = 0, misses = 0;
+  const double pixels = double(projector.camera.width) * projector.camera.height;
   fo.form = two_pass ? Form::two_pass : Form::single_pass;
   fo.warp_screen_only = work != Work::two_pass_full_warp;
   if (work == Work::single_pass_bilinear)
@@ -209,18 +212,19 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
   if (work == Work::plain) {
     target->bind();
     state.counters["shaded_per_px"] =
-        shaded_per_pixel(double(projector.camera.width) * projector.camera.height, [&] { fr->renderer().draw(f.scene, plain); });
+        shaded_per_pixel(pixels, [&] { fr->renderer().draw(f.scene, plain); });
   } else if (work != Work::clear && work != Work::grow_mask) {
     state.counters["shaded_per_px"] =
-        shaded_per_pixel(double(projector.camera.width) * projector.camera.height, [&] { (void)fr->render(f.scene, kEye, masks); });
+        shaded_per_pixel(pixels, [&] { (void)fr->render(f.scene, kEye, masks); });
   }
   if (work != Work::clear && work != Work::grow_mask)
     state.counters["triangles"] = double(fr->renderer().triangles_last_frame());
   state.counters["fps"] =
       benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   if (work == Work::single_pass_readback) state.counters["blackout_px"] = double(blackout);
-  if (layered) state.counters["from_cache"] = double(hits) / double(std::max<std::int64_t>(1, hits + misses));
-  state.counters["pixels"] = double(projector.camera.width) * projector.camera.height;
+  if (layered)
+    state.counters["from_cache"] = double(hits) / double(std::max<std::int64_t>(1, hits + misses));
+  state.counters["pixels"] = pixels;
   state.SetLabel(f.context.renderer());
 }
 

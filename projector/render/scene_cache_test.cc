@@ -33,7 +33,8 @@ scene_render::HeadlessContext& context() {
 }
 
 // Where the ray from the eye through x meets the plane of the raw corners.
-Eigen::Vector3d on_screen(const Projector& p, const Eigen::Vector3d& eye, const Eigen::Vector3d& x) {
+Eigen::Vector3d on_screen(const Projector& p, const Eigen::Vector3d& eye,
+                          const Eigen::Vector3d& x) {
   const Eigen::Vector3d n =
       (p.screen[1] - p.screen[0]).cross(p.screen[3] - p.screen[0]).normalized();
   return eye + n.dot(p.screen[0] - eye) / n.dot(x - eye) * (x - eye);
@@ -115,8 +116,8 @@ Markers make_markers(const Projector& p, const Eigen::Vector3d& eye, std::mt1993
     if (!apart) continue;
     m.points.push_back(x);
     const double scale = 0.045 * (x - eye).norm() / (on - eye).norm();
-    EXPECT_TRUE(m.scene.apply({0, scene::AddNode{marker(
-                                      "marker" + std::to_string(m.points.size()), x, eye, scale)}}));
+    const std::string id = "marker" + std::to_string(m.points.size());
+    EXPECT_TRUE(m.scene.apply({0, scene::AddNode{marker(id, x, eye, scale)}}));
   }
   return m;
 }
