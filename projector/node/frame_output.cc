@@ -26,11 +26,26 @@ Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeO
   fo.eye_texture_size = {options.eye_texture[0], options.eye_texture[1]};
   fo.thumb_width = options.thumbnail[0];
   fo.thumb_height = options.thumbnail[1];
+  fo.scene_cache = options.scene_cache;
   auto fr = projector_render::FrameRenderer::create(view, fo);
   if (!fr) return fr;
   STUDIO_LOG(info, "projector") << "rendering " << fr->width() << "x" << fr->height() << " on "
                                 << renderer;
   return fr;
+}
+
+void publish_frame(projector_render::FrameRenderer& fr, projector_render::Readback& rb,
+                   const FrameInfo& facts, runtime::Output<studio_ProjectorFrame>& out,
+                   FrameStages& stages) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  fr.read(rb);
+  const auto t1 = Clock::now();
+  stages.add(FrameStages::readback, std::chrono::duration<double>(t1 - t0).count());
+  wire::Owned<studio_ProjectorFrame> f;
+  fill_frame(facts, rb, *f);
+  (void)out.write(*f);
+  stages.add(FrameStages::publish, std::chrono::duration<double>(Clock::now() - t1).count());
 }
 
 }  // namespace studio::projector

@@ -6,7 +6,10 @@
 
 #include <optional>
 
+#include "frame_stages.h"
 #include "projector_node.h"
+#include "projector_wire.h"
+#include "runtime/service_loop.h"
 #include "projector_render/frame_renderer.h"
 #include "scene_render/egl_context.h"
 #include "window_output.h"
@@ -24,5 +27,11 @@ Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeO
                                                             const ProjectorView& view,
                                                             const std::string& projector_id,
                                                             FrameOutput& out);
+
+// Reads the frame back (blackout runs, thumbnail) and publishes it on studio/projector/frame;
+// stages readback and publish timed.
+void publish_frame(projector_render::FrameRenderer& fr, projector_render::Readback& rb,
+                   const FrameInfo& facts, runtime::Output<studio_ProjectorFrame>& out,
+                   FrameStages& stages);
 
 }  // namespace studio::projector

@@ -16,6 +16,9 @@
 // Render thread only (gauges are atomics; the status thread reads them).
 
 #include <array>
+#include <chrono>
+#include <ctime>
+#include <optional>
 
 #include "runtime/metrics.h"
 
@@ -56,6 +59,40 @@ class FrameStages {
   std::array<runtime::Gauge*, kCount> gauges_{};
   std::array<double, kCount> mean_{};
   std::array<bool, kCount> seen_{};
+};
+
+// The process's CPU time (every thread: llvmpipe's rasteriser threads, DDS, the render thread)
+// per rendered frame, over windows of at least a second (gauge cpu_per_frame_ms).
+class CpuPerFrame {
+ public:
+  // One frame rendered; the seconds of CPU per frame when a window closes.
+  std::optional<double> frame_done() {
+    const auto now = std::chrono::steady_clock::now();
+    const double cpu = process_cpu_s();
+    if (frames_ < 0) {  // the first frame opens the first window
+      start_ = now;
+      cpu_start_ = cpu;
+      frames_ = 0;
+      return std::nullopt;
+    }
+    ++frames_;
+    if (now - start_ < std::chrono::seconds(1)) return std::nullopt;
+    const double per_frame = (cpu - cpu_start_) / frames_;
+    start_ = now;
+    cpu_start_ = cpu;
+    frames_ = 0;
+    return per_frame;
+  }
+
+ private:
+  static double process_cpu_s() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+  }
+  std::chrono::steady_clock::time_point start_;
+  double cpu_start_ = 0;
+  long frames_ = -1;
 };
 
 }  // namespace studio::projector

@@ -20,6 +20,7 @@ Expected<void> ProjectorNodeOptions::validate() const {
   if (frame_every < 0) return fail("frame_every: >= 0");
   if (!(display_lag_s >= 0 && display_lag_s <= 1)) return fail("display_lag: 0..1 seconds");
   if (!(head_timeout_s > 0)) return fail("head_timeout: > 0 seconds");
+  if (auto ok = scene_cache.validate(); !ok) return ok;
   return mask_options().validate();
 }
 
@@ -73,12 +74,23 @@ runtime::ServiceDefinition projector_service_definition() {
       "      prediction: true      move every mesh forward by its predicted motion\n"
       "      velocity_uncertainty: 0.05  m/s, sigma of the velocity estimate\n"
       "      head_disagreement: 0.5      m/s; a head faster than the mesh by more: no prediction\n"
+      "      max_acceleration: 8.0       m/s^2, physical bound on the actor's acceleration in the\n"
+      "                                  prediction term (the estimate is the median of the last\n"
+      "                                  5 meshes' largest region acceleration: noise-robust)\n"
       "    latency:                the margin covers each mesh's age when the frame is shown\n"
       "                            (capture_ns -> render done + display_lag, planned) plus this\n"
       "                            quantile of how much later than planned frames were shown\n"
       "      window: 100           frames measured\n"
       "      quantile: 0.95        of the lateness (and of motion to photon, latency_p_ms)\n"
       "      initial: 0.04         seconds, the latency before the first frame is shown\n"
+      "    scene_cache:            render the static scene once, reuse it (colour + depth) while\n"
+      "                            it is unchanged and the eye moved so little that no static\n"
+      "                            point shifts more than max_error_px (bound from the off-axis\n"
+      "                            geometry: projector/static_shift.h); the nodes changed within\n"
+      "                            `settle` seconds (animated ones) are drawn every frame\n"
+      "      enabled: true         false: every frame draws the whole scene\n"
+      "      max_error_px: 0.5     projector pixels (0..10]\n"
+      "      settle: 1.0           seconds a changed node stays with the moving nodes\n"
       "  The frame is read back for studio/projector/frame (blackout mask, thumbnail) in both\n"
       "  outputs; a window needs a display (DISPLAY; under systemd a graphical session).\n"
       "  Topics: studio/scene/node, studio/actor/mesh, studio/actor/head in;\n"
@@ -88,7 +100,10 @@ runtime::ServiceDefinition projector_service_definition() {
       "  eye_rejected, meshes_rejected, meshes_superseded, mesh_motion_errors; where a mesh's\n"
       "  time goes, ms: stage_wait_ms, stage_motion_ms, stage_simplify_ms, stage_mask_ms,\n"
       "  stage_draw_ms, stage_finish_ms, stage_readback_ms, stage_publish_ms, stage_present_ms,\n"
-      "  mesh_to_frame_ms: see projector/node/frame_stages.h).\n";
+      "  mesh_to_frame_ms: see projector/node/frame_stages.h; the scene cache: frames_from_cache,\n"
+      "  scene_rerendered (frames that drew the static scene), scene_moving_nodes,\n"
+      "  scene_cache_move_mm (eye move the cached layer allows); cpu_per_frame_ms: the process's\n"
+      "  CPU time, every thread (llvmpipe's too), per rendered frame over about a second).\n";
   d.create = [](yaml::MapReader& config,
                 runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto section = config.required("projector");
@@ -99,11 +114,17 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("prediction", &MarginOptions::prediction),
         yaml::field("velocity_uncertainty", &MarginOptions::velocity_uncertainty_mps).min(0),
         yaml::field("head_disagreement", &MarginOptions::head_disagreement_mps).min(0),
+        yaml::field("max_acceleration", &MarginOptions::max_acceleration_mps2).range(0.1, 1000),
     };
     static const yaml::Schema<LatencyOptions> latency_schema{
         yaml::field("window", &LatencyOptions::window).range(1, 100000),
         yaml::field("quantile", &LatencyOptions::quantile).range(0.01, 1),
         yaml::field("initial", &LatencyOptions::initial).range(0, 10),
+    };
+    static const yaml::Schema<SceneCacheOptions> cache_schema{
+        yaml::field("enabled", &SceneCacheOptions::enabled),
+        yaml::field("max_error_px", &SceneCacheOptions::max_error_px).range(1e-3, 10),
+        yaml::field("settle", &SceneCacheOptions::settle_s).range(0, 60),
     };
     static const yaml::Schema<ProjectorNodeOptions> schema{
         yaml::field("rig", &ProjectorNodeOptions::rig).required().relative_path(),
@@ -125,6 +146,7 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("thumbnail", &ProjectorNodeOptions::thumbnail).size(2),
         yaml::field("margin", &ProjectorNodeOptions::margin, margin_schema),
         yaml::field("latency", &ProjectorNodeOptions::latency, latency_schema),
+        yaml::field("scene_cache", &ProjectorNodeOptions::scene_cache, cache_schema),
     };
     auto read = schema.read(*section);
     if (!read) return std::unexpected(read.error());

@@ -9,8 +9,10 @@
 
 #include "core/clock.h"
 #include "core/log.h"
+#include "frame_metrics.h"
 #include "frame_output.h"
 #include "frame_stages.h"
+#include "projector/eye_source.h"
 #include "projector/mesh_inbox.h"
 #include "projector_wire.h"
 #include "runtime/service_loop.h"
@@ -32,9 +34,14 @@ class ProjectorNode : public runtime::Node {
       : options_(std::move(options)),
         view_(std::move(view)),
         projector_(projector),
+        mirror_(options_.scene_cache.settle_s),
         planner_(options_.mask_options()),
+        eye_(Eigen::Vector3d(options_.default_eye[0], options_.default_eye[1],
+                             options_.default_eye[2]),
+             options_.head_timeout_s),
         loop_(ctx, kLog),
-        stages_(loop_.metrics()) {
+        stages_(loop_.metrics()),
+        m_(loop_) {
     calibration_ =
         &loop_.output<studio_ProjectorCalibration>({.counter = "calibrations_out", .rate = false});
     frames_ = &loop_.output<studio_ProjectorFrame>({.counter = "frames_published", .rate = false});
@@ -67,18 +74,6 @@ class ProjectorNode : public runtime::Node {
           stop_ = true;
           wake_.notify_all();
         });
-    rendered_ = &loop_.counter("frames_rendered");
-    loop_.count_as_output(*rendered_);
-    eye_rejected_ = &loop_.counter("eye_rejected");
-    head_stale_ = &loop_.counter("head_stale");
-    scene_left_out_ = &loop_.counter("scene_nodes_left_out");
-    assets_failed_ = &loop_.counter("assets_failed");
-    superseded_ = &loop_.counter("meshes_superseded");
-    mesh_errors_ = &loop_.counter("mesh_motion_errors");
-    margin_mm_ = &loop_.metrics().gauge("margin_mm");
-    latency_p_ms_ = &loop_.metrics().gauge("latency_p_ms");
-    render_ms_ = &loop_.metrics().gauge("render_ms");
-    overrun_p_ms_ = &loop_.metrics().gauge("overrun_p_ms");
   }
   ~ProjectorNode() override { stop(); }
 
@@ -117,7 +112,7 @@ class ProjectorNode : public runtime::Node {
     }
     auto node = wire::to_core(s);
     if (!node) return runtime::reject("to_core", node.error().message);
-    mirror_.update(std::move(*node));
+    mirror_.update(std::move(*node), seconds(SteadyClock::now().time_since_epoch()));
     return {};
   }
 
@@ -137,7 +132,7 @@ class ProjectorNode : public runtime::Node {
     auto replaced = inbox_.offer(id, s.frame, std::move(mesh));
     if (!replaced) return runtime::reject("mesh", replaced.error().message);
     mesh_arrived_ = SteadyClock::now();
-    if (*replaced) superseded_->add();
+    if (*replaced) m_.superseded.add();
     wake_.notify_all();
     return {};
   }
@@ -148,7 +143,7 @@ class ProjectorNode : public runtime::Node {
     std::lock_guard lock(mutex_);
     if (options_.actor != s.actor_id) return {};  // another actor's head
     head_speed_ = v.norm();
-    head_ = Head{p, SteadyClock::now()};
+    eye_.head(p, seconds(SteadyClock::now().time_since_epoch()));
     return {};
   }
 
@@ -169,7 +164,7 @@ class ProjectorNode : public runtime::Node {
       stages_.add(FrameStages::wait, seconds(SteadyClock::now() - *arrived));
       std::string error;
       if (const int refused = apply(std::move(taken), planner_, &error); refused > 0) {
-        mesh_errors_->add(refused);
+        m_.mesh_errors.add(refused);
         STUDIO_LOG(debug, kLog) << error;
       }
       stages_.add(FrameStages::motion, planner_.last_mesh_cost().motion_s);
@@ -185,15 +180,13 @@ class ProjectorNode : public runtime::Node {
   }
 
   // The eye for this frame: the followed head when fresh, else the last good eye.
-  Eigen::Vector3d eye_now(SteadyClock::time_point now) {
+  Eigen::Vector3d eye_now(bool last_good = false) {
     std::lock_guard lock(mutex_);
-    if (head_) {
-      if (now - head_->arrived < std::chrono::duration<double>(options_.head_timeout_s))
-        return head_->position;
-      head_.reset();
-      head_stale_->add();
-    }
-    return last_good_eye_;
+    if (last_good) return eye_.last_good();
+    bool stale = false;
+    const Eigen::Vector3d eye = eye_.eye(seconds(SteadyClock::now().time_since_epoch()), &stale);
+    if (stale) m_.head_stale.add();
+    return eye;
   }
 
   // The render thread: its own GL context (EGL surfaceless, or the full-screen window's), one
@@ -223,30 +216,33 @@ class ProjectorNode : public runtime::Node {
 
   // What the render thread keeps from frame to frame.
   struct Frame {
-    scene::Scene scene;
-    scene_assets::AssetCache cache;
-    std::set<std::string> failed_assets;
+    RenderScene scene;
     projector_render::Readback readback;
+    CpuPerFrame cpu;
     double render_s = 0;  // smoothed render time: a frame is shown about this much later
     uint64_t count = 0;
   };
 
   void render_one(projector_render::FrameRenderer& fr, Frame& st, WindowOutput* window) {
     std::optional<std::map<scene::NodeId, scene::Node>> nodes;
+    std::set<scene::NodeId> moving;
     {
       std::lock_guard lock(mutex_);
-      if (mirror_.dirty()) {
+      const double now = seconds(SteadyClock::now().time_since_epoch());
+      if (mirror_.dirty(now)) {
         nodes = mirror_.nodes();
+        moving = mirror_.moving(now);
         mirror_.clean();
       }
     }
     if (nodes) {
-      auto r = SceneMirror::rebuild(*nodes, st.scene, st.cache, st.failed_assets, fr.renderer());
-      scene_left_out_->add(r.left_out);
-      assets_failed_->add(r.assets_failed);
+      auto r = st.scene.rebuild(*nodes, moving, fr.renderer());
+      m_.scene_left_out.add(r.left_out);
+      m_.assets_failed.add(r.assets_failed);
+      m_.moving_nodes.set(double(st.scene.layers.moving_nodes));
     }
     const auto arrived = take_inputs();
-    Eigen::Vector3d eye = eye_now(SteadyClock::now());
+    Eigen::Vector3d eye = eye_now();
     const int64_t start_ns = realtime_ns();
     auto t = SteadyClock::now();
     auto stage = [&](FrameStages::Stage s) {
@@ -261,16 +257,16 @@ class ProjectorNode : public runtime::Node {
     stage(FrameStages::mask);
     const std::span<const ActorMesh> masks =
         plan ? std::span<const ActorMesh>(plan->masks) : std::span<const ActorMesh>();
-    auto drawn = fr.render(st.scene, eye, masks);
+    const bool cache = options_.scene_cache.enabled;
+    auto drawn = st.scene.draw(fr, eye, masks, cache);
     if (!drawn) {  // an eye the projection refuses: the last good eye (checked at start)
-      eye_rejected_->add();
+      m_.eye_rejected.add();
       STUDIO_LOG(debug, kLog) << drawn.error().message;
-      {
-        std::lock_guard lock(mutex_);
-        eye = last_good_eye_;
-      }
-      drawn = fr.render(st.scene, eye, masks);
+      eye = eye_now(true);
+      drawn = st.scene.draw(fr, eye, masks, cache);
     }
+    if (drawn) (drawn->from_cache ? m_.from_cache : m_.rerendered).add();
+    if (drawn && cache) m_.cache_move_mm.set(fr.cache_allowed_move_m(eye) * 1e3);
     stage(FrameStages::draw);
     fr.finish();
     stage(FrameStages::finish);
@@ -282,41 +278,26 @@ class ProjectorNode : public runtime::Node {
     const int64_t done_ns = realtime_ns();
     const double took = (done_ns - start_ns) * 1e-9;
     st.render_s = st.count++ == 0 ? took : 0.9 * st.render_s + 0.1 * took;
-    rendered_->add();
-    {
+    m_.rendered.add();
+    if (auto cpu = st.cpu.frame_done()) m_.cpu_per_frame_ms.set(*cpu * 1e3);
+    if (drawn) {
       std::lock_guard lock(mutex_);
-      if (drawn) last_good_eye_ = eye;
+      eye_.good(eye);
     }
     if (plan) planner_.shown(*plan, done_ns + lag_ns);  // on the cloth
-    latency_p_ms_->set(planner_.latency_s() * 1e3);
-    overrun_p_ms_->set(planner_.overrun_s() * 1e3);
-    render_ms_->set(st.render_s * 1e3);
-    if (plan) margin_mm_->set(plan->margin.margin_m * 1e3);
+    m_.latency_p_ms.set(planner_.latency_s() * 1e3);
+    m_.overrun_p_ms.set(planner_.overrun_s() * 1e3);
+    m_.render_ms.set(st.render_s * 1e3);
+    if (plan) m_.margin_mm.set(plan->margin.margin_m * 1e3);
     if (plan && plan->newest_capture_ns > 0)
       loop_.completed(plan->newest_frame, plan->newest_capture_ns);
     degraded_ = !drawn;
     if (options_.frame_every > 0 && st.count % uint64_t(options_.frame_every) == 0)
-      publish(fr, st.readback, plan ? &*plan : nullptr, eye, st.count, done_ns);
+      publish_frame(fr, st.readback,
+                    {projector_.camera.id, plan ? &*plan : nullptr, eye,
+                     options_.form == projector_render::Form::two_pass, st.count, done_ns},
+                    *frames_, stages_);
   }
-
-  void publish(projector_render::FrameRenderer& fr, projector_render::Readback& rb,
-               const MaskPlan* plan, const Eigen::Vector3d& eye, uint64_t count, int64_t done_ns) {
-    const auto t0 = SteadyClock::now();
-    fr.read(rb);
-    const auto t1 = SteadyClock::now();
-    stages_.add(FrameStages::readback, seconds(t1 - t0));
-    wire::Owned<studio_ProjectorFrame> f;
-    fill_frame({projector_.camera.id, plan, eye, options_.form == projector_render::Form::two_pass,
-                count, done_ns},
-               rb, *f);
-    (void)frames_->write(*f);
-    stages_.add(FrameStages::publish, seconds(SteadyClock::now() - t1));
-  }
-
-  struct Head {
-    Eigen::Vector3d position;
-    SteadyClock::time_point arrived;
-  };
 
   ProjectorNodeOptions options_;
   ProjectorView view_;
@@ -327,24 +308,16 @@ class ProjectorNode : public runtime::Node {
   SceneMirror mirror_;
   MeshInbox inbox_;  // meshes for the render thread
   std::optional<double> head_speed_;
-  std::optional<Head> head_;
+  EyeSource eye_;
   SteadyClock::time_point mesh_arrived_;  // of the newest mesh offered
-  Eigen::Vector3d last_good_eye_ = Eigen::Vector3d::Zero();
   std::promise<Expected<void>> init_;
   std::atomic<bool> degraded_{false};
   runtime::Output<studio_ProjectorCalibration>* calibration_ = nullptr;
   runtime::Output<studio_ProjectorFrame>* frames_ = nullptr;
   MaskPlanner planner_;  // the render thread's alone
-  runtime::Counter *rendered_ = nullptr, *eye_rejected_ = nullptr, *head_stale_ = nullptr,
-                   *scene_left_out_ = nullptr, *assets_failed_ = nullptr, *superseded_ = nullptr,
-                   *mesh_errors_ = nullptr;
-  runtime::Gauge *margin_mm_ = nullptr, *latency_p_ms_ = nullptr, *render_ms_ = nullptr,
-                 *overrun_p_ms_ = nullptr;
   runtime::ServiceLoop loop_;  // stopped before the state above goes
   FrameStages stages_;         // the render thread's (gauges of loop_'s metrics)
-
- public:
-  void set_default_eye(const Eigen::Vector3d& eye) { last_good_eye_ = eye; }
+  FrameMetrics m_;
 };
 
 }  // namespace
@@ -360,9 +333,8 @@ Expected<std::unique_ptr<runtime::Node>> make_projector_node(const ProjectorNode
   if (auto ok = view->single_pass(eye); !ok && options.form == projector_render::Form::single_pass)
     return fail("default_eye: " + ok.error().message);
   if (auto ok = view->two_pass(eye); !ok) return fail("default_eye: " + ok.error().message);
-  auto node = std::make_unique<ProjectorNode>(options, std::move(*view), projector, context);
-  node->set_default_eye(eye);
-  return std::unique_ptr<runtime::Node>(std::move(node));
+  return std::unique_ptr<runtime::Node>(
+      std::make_unique<ProjectorNode>(options, std::move(*view), projector, context));
 }
 
 }  // namespace studio::projector

@@ -14,7 +14,8 @@
 // Topics out: studio/projector/calibration (from the rig file, once, transient-local),
 // studio/projector/frame (per rendered frame: frame numbers, capture_ns -> render_done_ns,
 // margin, the blackout mask at full resolution as runs, a thumbnail), studio/service/status
-// (latency = motion to photon of the newest mesh; gauges margin_mm, latency_p_ms).
+// (latency = motion to photon of the newest mesh; gauges margin_mm, latency_p_ms; the scene
+// cache's frames_from_cache and scene_rerendered).
 //
 // Bad input never stops the projection: a degenerate or unseen screen fails at start (one line);
 // an eye behind or too close to the screen, a malformed or empty mesh, a scene node that does not
@@ -59,6 +60,10 @@ struct ProjectorNodeOptions {
   std::vector<int> thumbnail{160, 90};
   MarginOptions margin;
   LatencyOptions latency;
+  // The static scene rendered once and reused while it is unchanged and the eye stays within
+  // the displacement bound (projector/static_shift.h); the nodes changed within settle_s drawn
+  // every frame (node/scene_mirror.h).
+  SceneCacheOptions scene_cache;
 
   Expected<void> validate() const;
   MaskPlannerOptions mask_options() const;

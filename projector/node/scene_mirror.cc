@@ -4,6 +4,58 @@
 
 namespace studio::projector {
 
+void SceneMirror::update(scene::Node node, double now) {
+  auto it = nodes_.find(node.id);
+  if (it != nodes_.end()) {
+    scene::Node before = it->second;
+    before.frame = node.frame;  // a new stamp alone is no change
+    if (before == node) {
+      it->second = std::move(node);
+      return;
+    }
+    changed_[node.id] = now;
+  }
+  nodes_[node.id] = std::move(node);
+  dirty_ = true;
+}
+
+bool SceneMirror::dirty(double now) {
+  for (auto it = changed_.begin(); it != changed_.end();) {
+    if (now - it->second >= settle_s_) {  // settled: joins the still layer
+      it = changed_.erase(it);
+      dirty_ = true;
+    } else {
+      ++it;
+    }
+  }
+  return dirty_;
+}
+
+std::set<scene::NodeId> SceneMirror::moving(double now) const {
+  std::set<scene::NodeId> out;
+  for (const auto& [id, t] : changed_)
+    if (now - t < settle_s_) out.insert(id);
+  return out;
+}
+
+SceneMirror::Rebuilt RenderScene::rebuild(const std::map<scene::NodeId, scene::Node>& nodes,
+                                          const std::set<scene::NodeId>& moving,
+                                          scene_render::Renderer& renderer) {
+  auto r = SceneMirror::rebuild(nodes, scene, cache, failed_assets, renderer);
+  layers = split_scene(scene, moving);
+  return r;
+}
+
+Expected<projector_render::FrameInfo> RenderScene::draw(projector_render::FrameRenderer& fr,
+                                                        const Eigen::Vector3d& eye,
+                                                        std::span<const ActorMesh> masks,
+                                                        bool cache) const {
+  if (cache) return fr.render({layers.still, layers.still_version, &layers.moving}, eye, masks);
+  auto n = fr.render(scene, eye, masks);
+  if (!n) return std::unexpected(n.error());
+  return projector_render::FrameInfo{.masks = *n};
+}
+
 SceneMirror::Rebuilt SceneMirror::rebuild(const std::map<scene::NodeId, scene::Node>& nodes,
                                           scene::Scene& scene, scene_assets::AssetCache& cache,
                                           std::set<std::string>& failed_assets,

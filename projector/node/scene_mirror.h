@@ -5,11 +5,19 @@
 // uploaded to the renderer. A node that cannot be placed (its parent never arrived, a failed
 // validation) is left out and counted; an unreadable asset is reported once and its nodes are
 // not drawn (Renderer::check_assets).
+//
+// Scene cache (issue 15): the mirror notes when each node last changed (a sample that differs
+// from the node's previous state, its frame stamp aside); a node changed within `settle_s` is
+// moving (drawn every frame with its subtree, projector/scene_layers.h), the others are still
+// (cached). A moving node that settles makes the mirror dirty, so the layers are split again and
+// the still layer, now holding it, is drawn once more and cached.
 
 #include <map>
 #include <set>
 #include <string>
 
+#include "projector/scene_layers.h"
+#include "projector_render/frame_renderer.h"
 #include "scene/scene.h"
 #include "scene_assets/instantiate.h"
 #include "scene_render/renderer.h"
@@ -18,12 +26,17 @@ namespace studio::projector {
 
 class SceneMirror {
  public:
-  void update(scene::Node node) {
-    nodes_[node.id] = std::move(node);
-    dirty_ = true;
+  explicit SceneMirror(double settle_s = 1.0) : settle_s_(settle_s) {}
+  // `now`: seconds on a monotonic clock.
+  void update(scene::Node node, double now);
+  void remove(const scene::NodeId& id) {
+    changed_.erase(id);
+    dirty_ = nodes_.erase(id) > 0 || dirty_;
   }
-  void remove(const scene::NodeId& id) { dirty_ = nodes_.erase(id) > 0 || dirty_; }
-  bool dirty() const { return dirty_; }
+  // Dirty: a node changed, or a moving node settled by `now`.
+  bool dirty(double now);
+  // The nodes changed within settle_s of `now`.
+  std::set<scene::NodeId> moving(double now) const;
   const std::map<scene::NodeId, scene::Node>& nodes() const { return nodes_; }
 
   struct Rebuilt {
@@ -36,8 +49,27 @@ class SceneMirror {
   void clean() { dirty_ = false; }
 
  private:
+  double settle_s_;
   std::map<scene::NodeId, scene::Node> nodes_;
+  std::map<scene::NodeId, double> changed_;  // when a node last changed (moving ones)
   bool dirty_ = false;
+};
+
+// The render thread's copy of the scene: rebuilt from the mirror's nodes when they changed, with
+// its assets, and split into the still and moving layers.
+struct RenderScene {
+  scene::Scene scene;
+  scene_assets::AssetCache cache;
+  std::set<std::string> failed_assets;
+  SceneLayers layers;
+  // Rebuilds the scene (SceneMirror::rebuild) and its layers (moving: SceneMirror::moving).
+  SceneMirror::Rebuilt rebuild(const std::map<scene::NodeId, scene::Node>& nodes,
+                               const std::set<scene::NodeId>& moving,
+                               scene_render::Renderer& renderer);
+  // The frame from the layers (the scene cache), or from the whole scene when `cache` is off.
+  Expected<projector_render::FrameInfo> draw(projector_render::FrameRenderer& fr,
+                                             const Eigen::Vector3d& eye,
+                                             std::span<const ActorMesh> masks, bool cache) const;
 };
 
 }  // namespace studio::projector

@@ -7,12 +7,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 
 #include "projector/camera_clip.h"
 #include "scene_render/render_target.h"
+#include "static_layer.h"
 
 namespace studio::projector_render {
 namespace {
@@ -22,6 +24,7 @@ const std::string kFrameId = "\x01screen-frame";
 Expected<void> FrameRendererOptions::validate() const {
   if (auto ok = off_axis.validate(); !ok) return ok;
   if (auto ok = renderer.validate(); !ok) return ok;
+  if (auto ok = scene_cache.validate(); !ok) return ok;
   if (eye_texture_size.x() < 0 || eye_texture_size.y() < 0 || eye_texture_size.x() > 8192 ||
       eye_texture_size.y() > 8192 || (eye_texture_size.x() == 0) != (eye_texture_size.y() == 0))
     return fail("eye_texture: both sides 1..8192, or both 0 (suggested size)");
@@ -64,6 +67,13 @@ struct FrameRenderer::Impl {
   std::vector<std::string> mask_ids;
   scene::ActorMesh scratch;
   std::vector<std::uint8_t> rgba;
+  std::optional<StaticLayer> layer;  // scene_cache enabled
+  std::optional<Eigen::Vector3d> last_eye;  // of the previous layered frame
+
+  Expected<FrameInfo> render(const scene::Scene& still, std::uint64_t version,
+                             const scene::Scene* moving, const Eigen::Vector3d& eye,
+                             std::span<const projector::ActorMesh> masks, bool cache);
+  int draw_masks(std::span<const projector::ActorMesh> masks);
 };
 
 FrameRenderer::FrameRenderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -143,6 +153,14 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
       box = {x0, cam.height - y1, x1 - x0, y1 - y0};
     }
   }
+  std::optional<StaticLayer> layer;
+  if (options.scene_cache.enabled) {
+    const scene_render::RenderTarget& t = eye_target ? *eye_target : *target;
+    auto l =
+        StaticLayer::create(view, options.off_axis, options.scene_cache, t.width(), t.height());
+    if (!l) return std::unexpected(l.error());
+    layer.emplace(std::move(*l));
+  }
   return FrameRenderer(std::unique_ptr<Impl>(new Impl{view,
                                                       options,
                                                       std::move(*renderer),
@@ -153,7 +171,9 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
                                                       quad,
                                                       {},
                                                       {},
-                                                      {}}));
+                                                      {},
+                                                      std::move(layer),
+                                                      std::nullopt}));
 }
 
 scene_render::Renderer& FrameRenderer::renderer() { return impl_->renderer; }
@@ -165,7 +185,36 @@ int FrameRenderer::height() const { return impl_->target.height(); }
 
 Expected<int> FrameRenderer::render(const scene::Scene& scene, const Eigen::Vector3d& eye,
                                     std::span<const projector::ActorMesh> masks) {
-  Impl& r = *impl_;
+  auto info = impl_->render(scene, 0, nullptr, eye, masks, false);
+  if (!info) return std::unexpected(info.error());
+  return info->masks;
+}
+
+Expected<FrameInfo> FrameRenderer::render(const LayeredScene& scene, const Eigen::Vector3d& eye,
+                                          std::span<const projector::ActorMesh> masks) {
+  return impl_->render(scene.still, scene.still_version, scene.moving, eye, masks, true);
+}
+
+Expected<FrameInfo> FrameRenderer::Impl::render(const scene::Scene& still, std::uint64_t version,
+                                                const scene::Scene* moving,
+                                                const Eigen::Vector3d& eye,
+                                                std::span<const projector::ActorMesh> masks,
+                                                bool cache) {
+  Impl& r = *this;
+  StaticLayer* const l = cache && r.layer ? &*r.layer : nullptr;
+  FrameInfo info;
+  info.shift_px = l ? l->shift_px(version, eye) : std::numeric_limits<double>::infinity();
+  info.from_cache = l && info.shift_px <= l->options().max_error_px;
+  // A re-rendered static layer is kept (a blit and a depth read, ~a fifth of a frame) only when
+  // it may serve the next frame: a new static version, nothing cached yet, or an eye that moved
+  // less than the bound since the previous frame (a still eye). An eye moving every frame by
+  // more than the bound (a walking actor, tracker noise) costs no more than a full render.
+  const bool keep =
+      l && !info.from_cache &&
+      (!l->valid() || l->version() != version || !r.last_eye ||
+       l->bound().shift_px(l->heights(), *r.last_eye, eye) <= l->options().max_error_px);
+  r.last_eye = eye;
+  const double near = r.options.off_axis.near_m, far = r.options.off_axis.far_m;
   if (r.options.form == Form::single_pass) {
     auto pass = r.view.single_pass(eye, r.options.off_axis);
     if (!pass) return std::unexpected(pass.error());
@@ -176,25 +225,53 @@ Expected<int> FrameRenderer::render(const scene::Scene& scene, const Eigen::Vect
     // Only what the eye sees through the screen rectangle reaches the frame.
     v.cull_clip_from_world = pass->eye.clip_from_world;
     v.clear = false;
-    r.target.bind();
-    const Eigen::Vector4f& cc = r.options.renderer.clear_colour;
-    glClearColor(cc[0], cc[1], cc[2], cc[3]);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    // Black around the screen first, at depth 0: the scene is then shaded only on the screen
-    // (inside the rectangle's bounding box, and there where the depth test lets it through).
-    r.renderer.draw_actor_occluder(kFrameId, r.mask_view, Eigen::Vector4f(0, 0, 0, 1));
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(r.screen_box[0], r.screen_box[1], r.screen_box[2], r.screen_box[3]);
-    r.renderer.draw(scene, v);
-    glDisable(GL_SCISSOR_TEST);
+    if (info.from_cache) {
+      l->restore(r.target);
+    } else {
+      r.target.bind();
+      const Eigen::Vector4f& cc = r.options.renderer.clear_colour;
+      glClearColor(cc[0], cc[1], cc[2], cc[3]);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      // Black around the screen first, at depth 0: the scene is then shaded only on the screen
+      // (inside the rectangle's bounding box, and there where the depth test lets it through).
+      r.renderer.draw_actor_occluder(kFrameId, r.mask_view, Eigen::Vector4f(0, 0, 0, 1));
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(r.screen_box[0], r.screen_box[1], r.screen_box[2], r.screen_box[3]);
+      r.renderer.draw(still, v);
+      glDisable(GL_SCISSOR_TEST);
+      if (keep)
+        l->store(r.target, version, eye,
+                 {pass->eye.clip_from_world, pass->clip_from_world, near, far, r.screen_box});
+    }
+    if (moving) {
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(r.screen_box[0], r.screen_box[1], r.screen_box[2], r.screen_box[3]);
+      r.renderer.draw(*moving, v);
+      glDisable(GL_SCISSOR_TEST);
+    }
   } else {
     auto pass = r.view.two_pass(eye, r.options.off_axis);
     if (!pass) return std::unexpected(pass.error());
     scene_render::View v;
     v.clip_from_cam = pass->eye.clip_from_world;
     v.eye_in_world = eye;
-    r.eye_target->bind();
-    r.renderer.draw(scene, v);
+    if (info.from_cache) {
+      l->restore(*r.eye_target);
+    } else {
+      r.eye_target->bind();
+      r.renderer.draw(still, v);
+      if (keep)
+        l->store(*r.eye_target, version, eye,
+                 {pass->eye.clip_from_world,
+                  std::nullopt,
+                  near,
+                  far,
+                  {0, 0, r.eye_target->width(), r.eye_target->height()}});
+    }
+    if (moving) {
+      v.clear = false;
+      r.renderer.draw(*moving, v);
+    }
     r.target.bind();
     // The quad's coordinates p in [0, 1]^2 are NDC (2p - 1): texture = texture_from_ndc * ndc.
     Eigen::Matrix3d ndc_from_unit;
@@ -210,6 +287,13 @@ Expected<int> FrameRenderer::render(const scene::Scene& scene, const Eigen::Vect
       r.renderer.draw_texture(r.eye_target->colour_texture(), tex_from_unit);
     }
   }
+  info.masks = draw_masks(masks);
+  info.stored = keep;
+  return info;
+}
+
+int FrameRenderer::Impl::draw_masks(std::span<const projector::ActorMesh> masks) {
+  Impl& r = *this;
   int drawn = 0;
   for (std::size_t i = 0; i < masks.size(); ++i) {
     const projector::ActorMesh& m = masks[i];
@@ -224,6 +308,12 @@ Expected<int> FrameRenderer::render(const scene::Scene& scene, const Eigen::Vect
     ++drawn;
   }
   return drawn;
+}
+
+double FrameRenderer::cache_allowed_move_m(const Eigen::Vector3d& eye) const {
+  const StaticLayer* l = impl_->layer ? &*impl_->layer : nullptr;
+  if (!l || !l->valid()) return 0;
+  return l->bound().allowed_move_m(l->heights(), eye, l->options().max_error_px);
 }
 
 void FrameRenderer::finish() { glFinish(); }

@@ -6,7 +6,8 @@
 // - the view the actor sees: the projector frame "projected" onto the cloth and looked at from
 //   the true eye (each eye pixel's ray meets the screen, the projector pixel lighting that point
 //   is sampled) matches a plain perspective render of the scene from that eye, PSNR >= 30 dB
-//   over the cloth.
+//   over the cloth (also with the scene cache on: the frame's static layer restored from a
+//   nearby eye under the displacement bound).
 #include "projector_render/frame_renderer.h"
 
 #include <gtest/gtest.h>
@@ -185,13 +186,25 @@ TEST(FrameRenderer, TheActorSeesWhatAPlainPerspectiveRenderShows) {
   target->read_rgba(plain_rgba);
   const Eigen::Matrix4d world_from_clip = (plain.clip_from_cam * plain.cam_from_world).inverse();
 
-  for (Form form : {Form::single_pass, Form::two_pass}) {
+  // Full render, and with the scene cache on: the static layer cached from an eye 0.36 mm away
+  // (under the bound) and restored.
+  for (auto [form, cached] : {std::pair{Form::single_pass, false}, {Form::two_pass, false},
+                              {Form::single_pass, true}, {Form::two_pass, true}}) {
     FrameRendererOptions fo;
     fo.form = form;
     auto fr = FrameRenderer::create(view, fo);
     ASSERT_TRUE(fr) << fr.error().message;
     for (const auto& [path, a] : cache.all()) ASSERT_TRUE(fr->renderer().upload(*a));
-    ASSERT_TRUE(fr->render(*scene, eye, {}));
+    if (cached) {
+      const Eigen::Vector3d before = eye + Eigen::Vector3d(0.0003, 0.0002, 0);
+      ASSERT_TRUE(fr->render(LayeredScene{*scene, 1, nullptr}, before, {}));
+      ASSERT_LT((eye - before).norm(), fr->cache_allowed_move_m(before));
+      auto info = fr->render(LayeredScene{*scene, 1, nullptr}, eye, {});
+      ASSERT_TRUE(info);
+      ASSERT_TRUE(info->from_cache);
+    } else {
+      ASSERT_TRUE(fr->render(*scene, eye, {}));
+    }
     fr->finish();
     Readback rb;
     fr->read(rb, true);
@@ -229,8 +242,9 @@ TEST(FrameRenderer, TheActorSeesWhatAPlainPerspectiveRenderShows) {
     const double mse =
         cv::mean(diff, cloth)[0] / 3 + cv::mean(diff, cloth)[1] / 3 + cv::mean(diff, cloth)[2] / 3;
     const double psnr = 10 * std::log10(255.0 * 255.0 / std::max(mse, 1e-12));
-    std::printf("%s: PSNR over the cloth %.1f dB (%d px)\n",
-                form == Form::single_pass ? "single pass" : "two pass", psnr,
+    std::printf("%s%s: PSNR over the cloth %.1f dB (%d px)\n",
+                form == Form::single_pass ? "single pass" : "two pass",
+                cached ? ", from the scene cache" : "", psnr,
                 cv::countNonZero(cloth));
     EXPECT_GE(psnr, 30.0);
   }

@@ -11,16 +11,28 @@
 // `SinglePassBilinear` samples textures bilinearly (the baseline of the projector's nearest
 // texels). The plain scene is drawn with the projector's renderer options. `GrowMask`
 // is the CPU part of the mask alone (grow_mesh per frame, on the calling thread, inside the frame
-// cases). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
-// overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame).
+// cases). Scene cache (issue 15: render the scene only when it changes): `SinglePassCached` and
+// `TwoPassCached` split the scene into still (everything but the animated flyer) and moving (the
+// flyer) every frame, as the node does (projector/scene_layers.h), and render it layered from a
+// still eye: the static layer is restored from the cache (one blit of colour + depth), the flyer
+// and the mask drawn over it — the frame the node renders while the eye stays within the bound.
+// `SinglePassCacheMiss`: the same with the eye moving 6 mm every frame (on a 2 cm circle; the
+// bound is ~0.6 mm here): every frame re-renders the static layer (and does not keep it: the
+// eye is not still) — the cost of a frame when the cache never survives (a walking actor). The
+// `_720p` variants render the same at 1280x720 (the demo's projector size; the intrinsics scaled
+// by 2/3). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
+// overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame),
+// from_cache (cached cases: the fraction of frames whose static layer came from the cache).
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
 #include <GL/glext.h>
 #include <benchmark/benchmark.h>
 
 #include <numbers>
+#include <set>
 
 #include "projector/mask_geometry.h"
+#include "projector/scene_layers.h"
 #include "projector_render/frame_renderer.h"
 #include "scene/view.h"
 #include "scene_assets/scene_description.h"
@@ -43,6 +55,7 @@ struct Fixture {
   scene::Scene scene;
   Projector projector;
   projector::ActorMesh actor;
+  std::set<scene::NodeId> moving;  // the animated nodes
 };
 
 Fixture& fixture() {
@@ -61,8 +74,12 @@ Fixture& fixture() {
     projector::ActorMesh actor;
     for (const auto& v : body.vertices) actor.vertices.push_back(v + Eigen::Vector3f(0, 0, -0.8f));
     actor.triangles = body.triangles;
-    return new Fixture{std::move(*ctx), std::move(cache), std::move(*s),
-                       projector::testing::studio_projectors()[0], std::move(actor)};
+    std::set<scene::NodeId> moving;
+    for (const auto& [name, a] : s->animations())
+      for (const auto& t : a.animation.tracks) moving.insert(t.node);
+    return new Fixture{std::move(*ctx),    std::move(cache),  std::move(*s),
+                       projector::testing::studio_projectors()[0], std::move(actor),
+                       std::move(moving)};
   }();
   return *f;
 }
@@ -76,13 +93,29 @@ enum class Work {
   single_pass_pipelined,
   two_pass,
   two_pass_full_warp,
-  single_pass_readback
+  single_pass_readback,
+  single_pass_cached,
+  single_pass_cache_miss,
+  two_pass_cached
 };
+
+// The back-wall projector at 1280x720 (intrinsics scaled about the pixel-centre convention).
+Projector at_720p(Projector p) {
+  Camera& c = p.camera;
+  const double k = 1280.0 / c.width;
+  c.width = 1280;
+  c.height = 720;
+  c.intrinsics.fx *= k;
+  c.intrinsics.fy *= k;
+  c.intrinsics.cx = (c.intrinsics.cx + 0.5) * k - 0.5;
+  c.intrinsics.cy = (c.intrinsics.cy + 0.5) * k - 0.5;
+  return p;
+}
 
 // Fragments that passed the depth test (llvmpipe shades those: early depth test) in one frame,
 // over the frame's pixel count: 1.0 = every pixel shaded once.
 template <class Draw>
-double shaded_per_pixel(Draw&& draw) {
+double shaded_per_pixel(double pixels, Draw&& draw) {
   GLuint query = 0;
   glGenQueries(1, &query);
   glBeginQuery(GL_SAMPLES_PASSED, query);
@@ -91,14 +124,20 @@ double shaded_per_pixel(Draw&& draw) {
   GLuint64 samples = 0;
   glGetQueryObjectui64v(query, GL_QUERY_RESULT, &samples);
   glDeleteQueries(1, &query);
-  return static_cast<double>(samples) / (1920.0 * 1080.0);
+  return static_cast<double>(samples) / pixels;
 }
 
-void run(benchmark::State& state, Work work) {
+void run(benchmark::State& state, Work work, bool hd720 = false) {
   Fixture& f = fixture();
-  auto view = projector::ProjectorView::create(f.projector);
+  const Projector projector = hd720 ? at_720p(f.projector) : f.projector;
+  auto view = projector::ProjectorView::create(projector);
   FrameRendererOptions fo;
-  const bool two_pass = work == Work::two_pass || work == Work::two_pass_full_warp;
+  const bool two_pass = work == Work::two_pass || work == Work::two_pass_full_warp ||
+                        work == Work::two_pass_cached;
+  const bool layered = work == Work::single_pass_cached || work == Work::single_pass_cache_miss ||
+                       work == Work::two_pass_cached;
+  std::int64_t hits = 0, misses = 0;
+  const double pixels = double(projector.camera.width) * projector.camera.height;
   fo.form = two_pass ? Form::two_pass : Form::single_pass;
   fo.warp_screen_only = work != Work::two_pass_full_warp;
   if (work == Work::single_pass_bilinear)
@@ -132,6 +171,19 @@ void run(benchmark::State& state, Work work) {
     } else if (work == Work::plain) {
       target->bind();
       fr->renderer().draw(f.scene, plain);
+    } else if (layered) {
+      masks[0] = projector::grow_mesh(f.actor, 0.02).value();
+      const projector::SceneLayers layers = projector::split_scene(f.scene, f.moving);
+      // Miss: the eye on a 2 cm circle, 6 mm further each frame (10x the bound).
+      const double turn = 0.3 * double(frame);
+      const Eigen::Vector3d eye =
+          work == Work::single_pass_cache_miss
+              ? Eigen::Vector3d(kEye + 0.02 * Eigen::Vector3d(std::cos(turn), std::sin(turn), 0))
+              : kEye;
+      auto info = fr->render(LayeredScene{layers.still, layers.still_version, &layers.moving},
+                             eye, masks);
+      if (!info) state.SkipWithError("render failed");
+      (info && info->from_cache ? hits : misses) += 1;
     } else {
       masks[0] = projector::grow_mesh(f.actor, 0.02).value();  // per frame, as the node
       if (!fr->render(f.scene, kEye, masks)) state.SkipWithError("render failed");
@@ -160,16 +212,19 @@ void run(benchmark::State& state, Work work) {
   if (work == Work::plain) {
     target->bind();
     state.counters["shaded_per_px"] =
-        shaded_per_pixel([&] { fr->renderer().draw(f.scene, plain); });
+        shaded_per_pixel(pixels, [&] { fr->renderer().draw(f.scene, plain); });
   } else if (work != Work::clear && work != Work::grow_mask) {
     state.counters["shaded_per_px"] =
-        shaded_per_pixel([&] { (void)fr->render(f.scene, kEye, masks); });
+        shaded_per_pixel(pixels, [&] { (void)fr->render(f.scene, kEye, masks); });
   }
   if (work != Work::clear && work != Work::grow_mask)
     state.counters["triangles"] = double(fr->renderer().triangles_last_frame());
   state.counters["fps"] =
       benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   if (work == Work::single_pass_readback) state.counters["blackout_px"] = double(blackout);
+  if (layered)
+    state.counters["from_cache"] = double(hits) / double(std::max<std::int64_t>(1, hits + misses));
+  state.counters["pixels"] = pixels;
   state.SetLabel(f.context.renderer());
 }
 
@@ -185,6 +240,14 @@ void BM_SinglePassPipelined(benchmark::State& s) { run(s, Work::single_pass_pipe
 void BM_TwoPass(benchmark::State& s) { run(s, Work::two_pass); }
 void BM_TwoPassFullWarp(benchmark::State& s) { run(s, Work::two_pass_full_warp); }
 void BM_SinglePassReadback(benchmark::State& s) { run(s, Work::single_pass_readback); }
+void BM_SinglePassCached(benchmark::State& s) { run(s, Work::single_pass_cached); }
+void BM_SinglePassCacheMiss(benchmark::State& s) { run(s, Work::single_pass_cache_miss); }
+void BM_TwoPassCached(benchmark::State& s) { run(s, Work::two_pass_cached); }
+void BM_SinglePass_720p(benchmark::State& s) { run(s, Work::single_pass, true); }
+void BM_SinglePassCached_720p(benchmark::State& s) { run(s, Work::single_pass_cached, true); }
+void BM_SinglePassCacheMiss_720p(benchmark::State& s) {
+  run(s, Work::single_pass_cache_miss, true);
+}
 #define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(2.0)
 BENCHMARK(BM_Clear) OPTS;
 BENCHMARK(BM_GrowMask) OPTS;
@@ -195,6 +258,12 @@ BENCHMARK(BM_SinglePassPipelined) OPTS;
 BENCHMARK(BM_TwoPass) OPTS;
 BENCHMARK(BM_TwoPassFullWarp) OPTS;
 BENCHMARK(BM_SinglePassReadback) OPTS;
+BENCHMARK(BM_SinglePassCached) OPTS;
+BENCHMARK(BM_SinglePassCacheMiss) OPTS;
+BENCHMARK(BM_TwoPassCached) OPTS;
+BENCHMARK(BM_SinglePass_720p) OPTS;
+BENCHMARK(BM_SinglePassCached_720p) OPTS;
+BENCHMARK(BM_SinglePassCacheMiss_720p) OPTS;
 }  // namespace
 
 BENCHMARK_MAIN();

@@ -13,6 +13,8 @@ Expected<void> MarginOptions::validate() const {
     return fail("margin: velocity_uncertainty_mps must be >= 0");
   if (!(head_disagreement_mps >= 0) || !std::isfinite(head_disagreement_mps))
     return fail("margin: head_disagreement_mps must be >= 0");
+  if (!(max_acceleration_mps2 > 0) || !std::isfinite(max_acceleration_mps2))
+    return fail("margin: max_acceleration_mps2 must be > 0");
   return {};
 }
 
@@ -31,7 +33,10 @@ Expected<Margin> security_margin(const MarginOptions& options, double latency_s,
                            head_speed_mps <= motion->max_speed_mps + options.head_disagreement_mps;
   if (can_predict) {
     m.predicted = true;
-    m.acceleration_mps2 = *motion->max_acceleration_mps2;
+    const double a =
+        motion->robust_acceleration_mps2.value_or(*motion->max_acceleration_mps2);
+    m.acceleration_bounded = a > options.max_acceleration_mps2;
+    m.acceleration_mps2 = std::min(a, options.max_acceleration_mps2);
     m.motion_m = 0.5 * m.acceleration_mps2 * latency_s * (latency_s + motion->dt_s) +
                  options.velocity_uncertainty_mps * latency_s;
   } else {

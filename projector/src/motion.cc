@@ -433,6 +433,8 @@ Expected<void> MotionOptions::validate() const {
   if (!(region_size_m > 0) || !std::isfinite(region_size_m))
     return fail("motion: region_size_m must be > 0");
   if (iterations < 1) return fail("motion: iterations must be >= 1");
+  if (acceleration_window < 1 || acceleration_window > 100)
+    return fail("motion: acceleration_window must be 1..100");
   if (!(converged_m > 0) || !std::isfinite(converged_m))
     return fail("motion: converged_m must be > 0");
   if (fit_vertices < 0 || (fit_vertices > 0 && fit_vertices < min_region_vertices))
@@ -486,6 +488,14 @@ Expected<std::optional<MeshMotion>> MotionTracker::update(const ActorMesh& mesh)
       return std::unexpected(m.error());
     }
     motion = std::move(*m);
+    if (motion->max_acceleration_mps2) {
+      accelerations_.push_back(*motion->max_acceleration_mps2);
+      while (accelerations_.size() > std::size_t(options_.acceleration_window))
+        accelerations_.erase(accelerations_.begin());
+      std::vector<double> sorted = accelerations_;
+      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+      motion->robust_acceleration_mps2 = sorted[sorted.size() / 2];
+    }
   }
   // This mesh is the next one's target: its structure is built once, here.
   last_ = std::make_unique<MotionTarget>(mesh, grid_cell(options_));
@@ -496,6 +506,7 @@ Expected<std::optional<MeshMotion>> MotionTracker::update(const ActorMesh& mesh)
 void MotionTracker::reset() {
   last_.reset();
   last_motion_.reset();
+  accelerations_.clear();
 }
 
 Expected<ActorMesh> predict(const ActorMesh& mesh, const MeshMotion& motion, double horizon_s) {

@@ -4,6 +4,7 @@
 // Header-only: the benches that include it link studio_sim.
 
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "projector/actor_mesh.h"
@@ -30,6 +31,27 @@ inline const std::vector<ActorMesh>& swing_meshes() {
     return out;
   }();
   return m;
+}
+
+// `frames` meshes of the arm swing from t = 2 s, 40 ms apart, alternating tessellations, every
+// vertex moved by isotropic Gaussian noise of `noise_m` per axis (a hull's surface error).
+inline std::vector<ActorMesh> noisy_swing_meshes(int frames, double noise_m, unsigned seed) {
+  sim::Actor::Options ao;
+  ao.motion = sim::Motion::arm_swing;
+  const sim::Actor actor(ao);
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g(0.0f, float(noise_m));
+  std::vector<ActorMesh> out;
+  for (int f = 0; f < frames; ++f) {
+    const sim::TriangleMesh body = actor.body_at(2.0 + f * 0.04).mesh(f % 2 ? 22 : 24);
+    ActorMesh a;
+    a.vertices = body.vertices;
+    for (auto& v : a.vertices) v += Eigen::Vector3f(g(rng), g(rng), g(rng));
+    a.triangles = body.triangles;
+    a.capture_ns = 1'000'000'000 + f * kSwingFrameNs;
+    out.push_back(std::move(a));
+  }
+  return out;
 }
 
 }  // namespace studio::projector::testing

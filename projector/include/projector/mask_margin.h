@@ -13,8 +13,14 @@
 //       The mesh is moved forward by its regions' mean velocity over the last two captures
 //       (dt apart, the velocity at t - dt/2). For a region with constant acceleration a, the true
 //       position at t + L differs from x(t) + v_mean L by (v(t) - v_mean) L + a L^2 / 2 =
-//       a L (L + dt) / 2. a = the largest region acceleration of the estimate, sigma_v the
-//       velocity estimate's uncertainty (configured).
+//       a L (L + dt) / 2. a = the largest region acceleration of the estimate (robust: the
+//       median over the tracker's last frames, MeshMotion::robust_acceleration_mps2, when set),
+//       at most max_acceleration_mps2; sigma_v the velocity estimate's uncertainty (configured).
+//       max_acceleration_mps2 is a physical bound on the actor, not a fit: a human limb in fast
+//       stage motion (the simulated arm swing at 1.5 m/s fingertip speed peaks at ~5 m/s^2);
+//       8 m/s^2 keeps 60 % headroom over it, and bounds what noise can add to the margin
+//       (a L (L + dt) / 2 at L = 0.12 s: 77 mm at most, where unbounded estimates of 15-35
+//       m/s^2 from noisy hull meshes put the margin at its cap).
 //   Prediction is used only when the motion has an acceleration estimate (the third mesh on) and
 //   agrees with the head tracker (the head is not faster than the fastest region by more than
 //   head_disagreement_mps); otherwise the no-prediction term applies.
@@ -35,6 +41,7 @@ struct MarginOptions {
   bool prediction = true;
   double velocity_uncertainty_mps = 0.05;  // sigma_v
   double head_disagreement_mps = 0.5;
+  double max_acceleration_mps2 = 8.0;  // physical bound on the actor's acceleration (above)
   Expected<void> validate() const;
 };
 
@@ -44,7 +51,8 @@ struct Margin {
   double motion_m = 0;  // the motion term before clamping
   double latency_s = 0;
   double speed_mps = 0;          // v (no-prediction term)
-  double acceleration_mps2 = 0;  // a (prediction term)
+  double acceleration_mps2 = 0;  // a (prediction term), after the bound
+  bool acceleration_bounded = false;  // the estimate was above max_acceleration_mps2
   bool predicted = false;        // the mesh is to be moved forward by latency_s
   bool capped = false;
 };

@@ -69,6 +69,14 @@ struct MotionOptions {
   double consistency_m = 0.005;
   int min_region_vertices = 12;  // smaller regions take the whole-mesh translation
   double max_dt_s = 0.5;         // meshes further apart are not compared (motion unknown)
+  // MotionTracker: the acceleration the margin uses is the median of the last this many
+  // estimates' max_acceleration_mps2 (1: the latest alone). The largest region acceleration is a
+  // second difference of noisy fits, maximised over ~50 regions: on hull meshes with a few mm
+  // of surface noise it jumps to 15-35 m/s^2 from frame to frame where the simulated arm swing's
+  // true peak is ~5 m/s^2 (projector/margin_noise_test.cc). A true acceleration lasts: an arm
+  // swing's acceleration phase spans 5-10 frames at 25 Hz, so the median of 5 keeps it while
+  // a spike in one or two frames is dropped.
+  int acceleration_window = 5;
   Expected<void> validate() const;
 };
 
@@ -91,6 +99,9 @@ struct MeshMotion {
   // Over regions with an acceleration, the component along the region's mean normal (the full
   // vector where the region has no dominant normal, |mean normal| < 0.5).
   std::optional<double> max_acceleration_mps2;
+  // MotionTracker only: the median of the last acceleration_window max_acceleration_mps2 (the
+  // margin's acceleration, projector/mask_margin.h); unset from estimate_motion.
+  std::optional<double> robust_acceleration_mps2;
   Eigen::Vector3f velocity(size_t vertex) const {
     return regions[vertex_region[vertex]].velocity.cast<float>();
   }
@@ -121,6 +132,7 @@ class MotionTracker {
   MotionOptions options_;
   std::unique_ptr<MotionTarget> last_;  // the last mesh and its target structure
   std::optional<MeshMotion> last_motion_;
+  std::vector<double> accelerations_;  // the last acceleration_window estimates, oldest first
 };
 
 // The mesh moved forward by its velocity field over horizon_s (constant velocity; the

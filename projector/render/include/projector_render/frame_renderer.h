@@ -31,6 +31,7 @@
 #include "core/run_mask.h"
 #include "projector/actor_mesh.h"
 #include "projector/projector_view.h"
+#include "projector/static_shift.h"
 #include "scene/scene.h"
 #include "scene_render/renderer.h"
 
@@ -54,6 +55,9 @@ struct FrameRendererOptions {
   // projector, 2 px out), the rest cleared black; false: over the whole frame (the baseline,
   // black outside the screen by the warp's own test). The same frame either way.
   bool warp_screen_only = true;
+  // The static scene layer cached between frames (render(const LayeredScene&, ...);
+  // render/static_layer.h); enabled = false: every frame draws the whole scene.
+  projector::SceneCacheOptions scene_cache;
   int thumb_width = 160;  // 0: no thumbnail
   int thumb_height = 90;
   Expected<void> validate() const;
@@ -64,6 +68,28 @@ struct Readback {
   RunMask blackout;                     // projector pixels the mask covered, top row first
   std::vector<std::uint8_t> thumbnail;  // RGB8, thumb_width x thumb_height, top row first
   int thumb_width = 0, thumb_height = 0;
+};
+
+// The scene split in two (the projector node's SceneMirror): `still` is drawn into the cached
+// static layer, which is reused while `still_version` stays the same and the eye has moved less
+// than the displacement bound allows (projector/static_shift.h); `moving` (may be null) is drawn
+// over it, with the depth test, every frame. Both hold the same lights.
+struct LayeredScene {
+  const scene::Scene& still;
+  std::uint64_t still_version = 0;
+  const scene::Scene* moving = nullptr;
+};
+
+struct FrameInfo {
+  int masks = 0;            // mask meshes drawn
+  bool from_cache = false;  // the static layer was restored, not drawn
+  // The displacement bound (projector px) of the cached layer at this frame's eye; +inf when
+  // nothing was cached for this static version (a full render follows either way when it
+  // exceeds SceneCacheOptions::max_error_px).
+  double shift_px = 0;
+  // A re-rendered static layer was kept for later frames (not when the eye moved more than the
+  // bound since the previous frame: it would not serve the next one).
+  bool stored = false;
 };
 
 // The black outside the cloth: the screen's plane around the rectangle, out to 50 m from its
@@ -90,6 +116,15 @@ class FrameRenderer {
   // and counted in the result. Returns the number of masks drawn.
   Expected<int> render(const scene::Scene& scene, const Eigen::Vector3d& eye,
                        std::span<const projector::ActorMesh> masks);
+  // The same frame from a layered scene: the static layer restored from the cache when it is
+  // usable at `eye` (else drawn, and cached when the cache is enabled), then the moving nodes,
+  // then the masks. Errors: those of render().
+  Expected<FrameInfo> render(const LayeredScene& scene, const Eigen::Vector3d& eye,
+                             std::span<const projector::ActorMesh> masks);
+  // The largest eye move (metres, any direction, first order) from `eye` under which the cached
+  // static layer stays usable (StaticShiftBound::allowed_move_m over the heights it shows); 0
+  // when nothing is cached or the cache is disabled.
+  double cache_allowed_move_m(const Eigen::Vector3d& eye) const;
   // Finishes the frame (glFinish): after this the frame is rendered.
   void finish();
   // Reads the frame back: blackout mask and thumbnail (and the full RGBA when keep_rgba).

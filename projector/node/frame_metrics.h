@@ -1,0 +1,35 @@
+#pragma once
+// The projector node's counters and gauges (studio/service/status; the list is in
+// projector_config.cc's --help), and what one rendered frame sets in them.
+
+#include "runtime/service_loop.h"
+
+namespace studio::projector {
+
+struct FrameMetrics {
+  explicit FrameMetrics(runtime::ServiceLoop& loop)
+      : rendered(loop.counter("frames_rendered")),
+        eye_rejected(loop.counter("eye_rejected")),
+        head_stale(loop.counter("head_stale")),
+        scene_left_out(loop.counter("scene_nodes_left_out")),
+        assets_failed(loop.counter("assets_failed")),
+        superseded(loop.counter("meshes_superseded")),
+        mesh_errors(loop.counter("mesh_motion_errors")),
+        from_cache(loop.counter("frames_from_cache")),
+        rerendered(loop.counter("scene_rerendered")),
+        moving_nodes(loop.metrics().gauge("scene_moving_nodes")),
+        cache_move_mm(loop.metrics().gauge("scene_cache_move_mm")),
+        cpu_per_frame_ms(loop.metrics().gauge("cpu_per_frame_ms")),
+        margin_mm(loop.metrics().gauge("margin_mm")),
+        latency_p_ms(loop.metrics().gauge("latency_p_ms")),
+        render_ms(loop.metrics().gauge("render_ms")),
+        overrun_p_ms(loop.metrics().gauge("overrun_p_ms")) {
+    loop.count_as_output(rendered);
+  }
+  runtime::Counter &rendered, &eye_rejected, &head_stale, &scene_left_out, &assets_failed,
+      &superseded, &mesh_errors, &from_cache, &rerendered;
+  runtime::Gauge &moving_nodes, &cache_move_mm, &cpu_per_frame_ms, &margin_mm, &latency_p_ms,
+      &render_ms, &overrun_p_ms;
+};
+
+}  // namespace studio::projector
