@@ -63,6 +63,23 @@ TEST(SimFrameSource, PacedFramesFollowTheStudioClock) {
   EXPECT_FALSE(*after);  // stopped: returns promptly with nothing
 }
 
+TEST(SimFrameSource, PacedPictureRenderedAheadIsTheFramesOwn) {
+  // Paced, the next frame is rendered before its instant: what arrives (at or after the instant)
+  // is exactly that frame's picture, also after a wait that ran out.
+  auto src = SimFrameSource::create(small_options(true));
+  ASSERT_TRUE(src) << src.error().message;
+  ASSERT_TRUE((*src)->start());
+  (void)(*src)->next(0ms);  // usually runs out before the instant: the frame is kept
+  for (int i = 0; i < 4; ++i) {
+    auto f = (*src)->next(1s);
+    ASSERT_TRUE(f && *f) << "no frame";
+    Image<Rgb8> expected;
+    (*src)->studio().render(0, int64_t((*f)->frame), &expected, nullptr);
+    EXPECT_EQ((*f)->image.pixels(), expected.pixels()) << "frame " << (*f)->frame;
+    EXPECT_NE(mean_level(expected), 0.0);
+  }
+}
+
 TEST(SimFrameSource, SameFrameSamePictureAcrossInstances) {
   auto a = SimFrameSource::create(small_options(false));
   auto b = SimFrameSource::create(small_options(false));

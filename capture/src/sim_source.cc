@@ -119,6 +119,7 @@ Expected<void> SimFrameSource::start() {
   stopping_ = false;
   started_ = true;
   last_frame_.reset();
+  ahead_.reset();
   return {};
 }
 
@@ -164,6 +165,13 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
     ++f;
   }
   const int64_t capture_ns = clock.time_of(f) + half + options_.offset_ns;
+  // An untracked camera's picture depends on f alone: render it while waiting for its instant,
+  // so that it is ready at capture_ns instead of one render later (kept if the wait runs out).
+  if (options_.paced && !pose_ && !(ahead_ && ahead_->frame == f)) {
+    ahead_.emplace();
+    ahead_->frame = f;
+    studio_.render(0, int64_t(f), &ahead_->image, nullptr);
+  }
   if (options_.paced && !wait_until(capture_ns, deadline)) {
     std::lock_guard lock(mutex_);
     stats_.drops += skipped;  // consumed even when the wait ran out
@@ -183,7 +191,12 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
   Frame frame;
   frame.frame = f;
   frame.capture_ns = capture_ns;
-  studio_.render(0, int64_t(f), &frame.image, nullptr);
+  if (ahead_ && ahead_->frame == f && !pose_) {
+    frame.image = std::move(ahead_->image);
+  } else {
+    studio_.render(0, int64_t(f), &frame.image, nullptr);
+  }
+  ahead_.reset();
   apply_features(frame.image);
   if (options_.stamp) sim::stamp_frame(frame.image.view(), f);
   if (options_.jitter_ns > 0) {  // late delivery: a driver/transport delay of its own
