@@ -332,7 +332,7 @@ uint8_t matte_value(int k, int n) { return static_cast<uint8_t>((255 * k + n / 2
 }  // namespace
 
 Rect touched_rect(const StudioOptions& options, const CameraCache& cam,
-                 const PreparedFrame& frame) {
+                  const PreparedFrame& frame) {
   Rect U = union_rect(to_camera(cam, frame.truth.body, 1));
   for (const ActorBody& b : frame.blur_bodies) U = U.united(union_rect(to_camera(cam, b, 1)));
   if (!U.empty()) {

@@ -250,19 +250,22 @@ void add_noise(uint8_t* out, const uint8_t* in, const int8_t* noise, std::size_t
 #if defined(__SSE2__)
   const __m128i bias = _mm_set1_epi8(static_cast<char>(0x80));
   for (; i + 16 <= n; i += 16) {
-    const __m128i v = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i)), bias);
+    const __m128i v =
+        _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i)), bias);
     const __m128i z = _mm_loadu_si128(reinterpret_cast<const __m128i*>(noise + i));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i), _mm_xor_si128(_mm_adds_epi8(v, z), bias));
   }
 #endif
   for (; i < n; ++i) out[i] = static_cast<uint8_t>(std::clamp(in[i] + noise[i], 0, 255));
 }
-void add_noise(uint8_t* data, const int8_t* noise, std::size_t n) { add_noise(data, data, noise, n); }
+void add_noise(uint8_t* data, const int8_t* noise, std::size_t n) {
+  add_noise(data, data, noise, n);
+}
 
 // The image's first write of a frame: background + noise (noise may be null: none) over the
 // byte range [b0, b1) of a row, or a plain background copy when `plain`.
-void fill_span(uint8_t* out, const uint8_t* bg, const int8_t* noise, std::size_t b0,
-               std::size_t b1, bool plain) {
+void fill_span(uint8_t* out, const uint8_t* bg, const int8_t* noise, std::size_t b0, std::size_t b1,
+               bool plain) {
   if (b1 <= b0) return;
   if (plain || noise == nullptr) {
     if (out != bg) std::memcpy(out + b0, bg + b0, b1 - b0);
@@ -357,7 +360,8 @@ struct SimulatedStudio::Impl {
     const detail::Rect D = detail::touched_rect(options, cam, f);
     const int8_t* noise_base = noise_of(f.truth.frame, index);
     auto* out = reinterpret_cast<uint8_t*>(image->data());
-    const auto* bg = reinterpret_cast<const uint8_t*>(fresh ? image->data() : cam.background.data());
+    const auto* bg =
+        reinterpret_cast<const uint8_t*>(fresh ? image->data() : cam.background.data());
     const std::size_t row = sizeof(Rgb8) * W;
     const std::size_t d0 = sizeof(Rgb8) * std::max(0, D.x0), d1 = sizeof(Rgb8) * std::min(W, D.x1);
     for (int y = 0; y < H; ++y) {

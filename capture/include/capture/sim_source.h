@@ -25,9 +25,10 @@
 // `drop_every` loses frames like a camera dropping packets (they count in stats().drops), and
 // `stamp` writes the frame number into the corner (sim/frame_stamp.h) after the features.
 // Brightness is applied through a 256-entry table (saturating), blur as two separable box passes.
-// Paced and untracked, the picture of the next frame is rendered before its exposure instant
-// (it depends on the frame number alone) and delivered at that instant: the image is ready at
-// capture_ns, not one render (2-5 ms of CPU at 704x576) after it. Never delivered early.
+// Paced and untracked, the picture of the next frame is rendered in the half period before its
+// exposure instant (it depends on the frame number alone) and delivered at that instant: the
+// image is ready at capture_ns, not one render (2-5 ms of CPU at 704x576) after it, and the
+// render does not compete with the previous frame's keying. Never delivered early.
 
 #include <atomic>
 #include <chrono>
