@@ -63,6 +63,24 @@ TEST(SimFrameSource, PacedFramesFollowTheStudioClock) {
   EXPECT_FALSE(*after);  // stopped: returns promptly with nothing
 }
 
+TEST(SimFrameSource, PacedPictureRenderedAheadIsTheFramesOwn) {
+  // Paced, the next frame is rendered in the half period before its instant: what arrives (at
+  // or after the instant) is exactly that frame's picture, also after waits that ran out before
+  // and after the render ahead (short timeouts, tried until a frame comes).
+  auto src = SimFrameSource::create(small_options(true));
+  ASSERT_TRUE(src) << src.error().message;
+  ASSERT_TRUE((*src)->start());
+  for (int i = 0; i < 4; ++i) {
+    Expected<std::optional<Frame>> f = std::optional<Frame>();
+    for (int attempt = 0; attempt < 400 && f && !*f; ++attempt) f = (*src)->next(3ms);
+    ASSERT_TRUE(f && *f) << "no frame";
+    Image<Rgb8> expected;
+    (*src)->studio().render(0, int64_t((*f)->frame), &expected, nullptr);
+    EXPECT_EQ((*f)->image.pixels(), expected.pixels()) << "frame " << (*f)->frame;
+    EXPECT_NE(mean_level(expected), 0.0);
+  }
+}
+
 TEST(SimFrameSource, SameFrameSamePictureAcrossInstances) {
   auto a = SimFrameSource::create(small_options(false));
   auto b = SimFrameSource::create(small_options(false));

@@ -6,6 +6,12 @@
 // reports `speedup` = naive time / studio time.
 // `process_cpu_ms_per_frame` is the CPU time of all render threads per studio frame: on this
 // shared machine wall-clock fps depends on what else runs, CPU cost per frame does not.
+// BM_Studio6Cameras/T/1 is the same with the pre-issue-20 renderer (StudioOptions::
+// reference_renderer, bit-identical images): the baseline in the same run.
+// BM_CaptureCameraFastVsReference renders one camera per call into a fresh image without a mask,
+// as a capture server does (capture/sim_source.h), alternating the default and the reference
+// renderer on the same frames (so load hits both alike), and reports each one's thread CPU ms
+// per camera frame and `speedup` = reference / default.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -17,14 +23,21 @@
 namespace studio::sim {
 namespace {
 
-SimulatedStudio make_studio(int threads) {
+SimulatedStudio make_studio(int threads, bool reference = false) {
   StudioOptions o;
   o.threads = threads;
+  o.reference_renderer = reference;
   return SimulatedStudio::create(ring_cameras(), o).value();
 }
 
+double thread_cpu() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
 void BM_Studio6Cameras(benchmark::State& state) {
-  const SimulatedStudio studio = make_studio(static_cast<int>(state.range(0)));
+  const SimulatedStudio studio = make_studio(static_cast<int>(state.range(0)), state.range(1) != 0);
   std::vector<Image<Rgb8>> images;
   std::vector<Mask> masks;
   int64_t frame = 0;
@@ -46,7 +59,39 @@ void BM_Studio6Cameras(benchmark::State& state) {
   state.counters["camera_frames_per_s"] = benchmark::Counter(
       static_cast<double>(state.iterations() * studio.camera_count()), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_Studio6Cameras)->Arg(2)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Studio6Cameras)
+    ->ArgNames({"threads", "reference"})
+    ->Args({2, 0})
+    ->Args({2, 1})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+
+void BM_CaptureCameraFastVsReference(benchmark::State& state) {
+  const SimulatedStudio fast = make_studio(1), reference = make_studio(1, true);
+  double cpu_fast = 0, cpu_reference = 0;
+  int64_t frame = 0, camera_frames = 0;
+  for (auto _ : state) {
+    for (int c = 0; c < fast.camera_count(); ++c, ++camera_frames) {
+      Image<Rgb8> a, b;  // fresh, as each Frame in the capture server
+      double t0 = thread_cpu();
+      fast.render(c, frame, &a, nullptr);
+      const double t1 = thread_cpu();
+      reference.render(c, frame, &b, nullptr);
+      cpu_fast += t1 - t0;
+      cpu_reference += thread_cpu() - t1;
+      benchmark::DoNotOptimize(a.data());
+      benchmark::DoNotOptimize(b.data());
+    }
+    ++frame;
+  }
+  state.counters["fast_cpu_ms_per_camera_frame"] = 1e3 * cpu_fast / double(camera_frames);
+  state.counters["reference_cpu_ms_per_camera_frame"] = 1e3 * cpu_reference / double(camera_frames);
+  state.counters["fast_cpu_ms_per_6camera_frame"] = 6e3 * cpu_fast / double(camera_frames);
+  state.counters["speedup"] = cpu_reference / cpu_fast;
+}
+BENCHMARK(BM_CaptureCameraFastVsReference)->Unit(benchmark::kMillisecond)->MinTime(3);
 
 // The naive renderer: per pixel, the world ray against every part; single thread.
 void naive_frame(const SimulatedStudio& studio, int64_t frame, std::vector<Image<Rgb8>>* images,

@@ -84,7 +84,6 @@ void CameraWorker::on_source_error(const Error& error) {
 void CameraWorker::on_frame(Frame& frame, Clock::time_point now) {
   source_failed_ = false;
   io_.frames_captured.add();
-  ring_.push(frame.frame, frame.capture_ns, frame.image);  // before its mask goes out
   bool send = false, raw = false;
   {
     std::lock_guard lock(mutex_);
@@ -99,8 +98,16 @@ void CameraWorker::on_frame(Frame& frame, Clock::time_point now) {
     send = image_due(now, raw);
   }
   if (frame.calibration) publish_tracked_calibration(frame);
-  // Key → mask codec → AlphaMask (unless keying runs elsewhere: masks: false).
-  if (io_.options.publish_masks) key(frame);
+  // Key (unless keying runs elsewhere: masks: false) → the image into the ring, before its mask
+  // goes out (moved, not copied, unless this frame's image is also published) → mask codec →
+  // AlphaMask.
+  const bool keyed = io_.options.publish_masks && key(frame);
+  if (send) {
+    ring_.push(frame.frame, frame.capture_ns, frame.image);
+  } else {
+    ring_.push(frame.frame, frame.capture_ns, std::move(frame.image));
+  }
+  if (keyed) publish_mask(frame);
   if (send) send_image(frame, raw);
 }
 
@@ -114,31 +121,35 @@ bool CameraWorker::image_due(Clock::time_point now, bool& raw) {
   return true;
 }
 
-void CameraWorker::key(const Frame& frame) {
+bool CameraWorker::key(const Frame& frame) {
   const keyer::PlateKeyer::Result r = keyer_->frame(frame.image.view(), mask_);
   if (r.cleared) io_.kept_plates.remove(id_);
   using Step = keyer::PlateKeyer::Step;
   switch (r.step) {
     case Step::kPlateFrame:  // clean plate on command: no mask meanwhile
-      return;
+      return false;
     case Step::kPlateCaptured:
       io_.plates_captured.add();
       STUDIO_LOG(info, kLog) << id_ << ": clean plate captured (" << keyer_->keyer().plate_frames()
                              << " frames)";
       if (!io_.kept_plates.keep(id_, keyer_->keyer(), kLog)) io_.plate_saves_failed.add();
-      return;
+      return false;
     case Step::kNoPlate:
       io_.frames_unkeyed.add();
       if (r.first)
         STUDIO_LOG(warn, kLog) << id_ << ": no clean plate yet (send CameraControl "
                                << keyer::kPlateControl << " N); frames are not keyed";
-      return;
+      return false;
     case Step::kRefused:
       STUDIO_LOG(warn, kLog) << id_ << ": keyer: " << r.error.message;
-      return;
+      return false;
     case Step::kKeyed:
       break;
   }
+  return true;
+}
+
+void CameraWorker::publish_mask(const Frame& frame) {
   encode_mask(mask_, io_.options.coding, mask_bytes_);
   from_core(id_, frame.frame, frame.capture_ns, mask_bytes_, mask_.width(), mask_.height(),
             mask_sample_);

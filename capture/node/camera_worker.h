@@ -100,7 +100,9 @@ class CameraWorker {
   void reap_finished_takes();
   // Whether an image is due (mutex_ held); sets `raw`.
   bool image_due(std::chrono::steady_clock::time_point now, bool& raw);
-  void key(const Frame& frame);
+  // Keys the frame into mask_; true when the mask should go out (publish_mask).
+  bool key(const Frame& frame);
+  void publish_mask(const Frame& frame);
   void send_image(const Frame& frame, bool raw);
   // Every state_period: the fps over the window; true when a state should go out.
   bool state_due(std::chrono::steady_clock::time_point now);

@@ -9,29 +9,41 @@ namespace studio::capture::node {
 
 ImageRing::ImageRing(std::size_t capacity) : slots_(std::max<std::size_t>(capacity, 1)) {}
 
-void ImageRing::push(uint64_t frame, int64_t capture_ns, const Image<Rgb8>& image) {
-  std::lock_guard lock(mutex_);
+ImageRing::Slot& ImageRing::next_slot(uint64_t frame, int64_t capture_ns) {
   Slot& s = slots_[next_];
   next_ = (next_ + 1) % slots_.size();
   s.used = true;
   s.frame = frame;
-  s.image.width = image.width();
-  s.image.height = image.height();
-  s.image.capture_ns = capture_ns;
-  const auto* p = reinterpret_cast<const uint8_t*>(image.data());
-  s.image.rgb.assign(p, p + std::size_t(image.width()) * image.height() * 3);
+  s.capture_ns = capture_ns;
   newest_ = any_ ? std::max(newest_, frame) : frame;
   any_ = true;
+  return s;
+}
+
+void ImageRing::push(uint64_t frame, int64_t capture_ns, const Image<Rgb8>& image) {
+  std::lock_guard lock(mutex_);
+  Slot& s = next_slot(frame, capture_ns);
+  if (s.image.width() == image.width() && s.image.height() == image.height()) {
+    std::copy(image.pixels().begin(), image.pixels().end(), s.image.pixels().begin());
+  } else {
+    s.image = image;
+  }
+}
+
+void ImageRing::push(uint64_t frame, int64_t capture_ns, Image<Rgb8>&& image) {
+  std::lock_guard lock(mutex_);
+  std::swap(next_slot(frame, capture_ns).image, image);
 }
 
 ImageRing::Found ImageRing::find(uint64_t frame, Image3& out) const {
   std::lock_guard lock(mutex_);
   for (const Slot& s : slots_)
     if (s.used && s.frame == frame) {
-      out.width = s.image.width;
-      out.height = s.image.height;
-      out.capture_ns = s.image.capture_ns;
-      out.rgb.assign(s.image.rgb.begin(), s.image.rgb.end());
+      out.width = s.image.width();
+      out.height = s.image.height();
+      out.capture_ns = s.capture_ns;
+      const auto* p = reinterpret_cast<const uint8_t*>(s.image.data());
+      out.rgb.assign(p, p + std::size_t(out.width) * out.height * 3);
       return Found::ok;
     }
   return !any_ || frame > newest_ ? Found::not_yet : Found::evicted;

@@ -6,7 +6,8 @@
 // yet). A reply never carries another frame's image.
 //
 // Threads: push() runs on the camera's grab thread, find() on the loop thread; the ring's mutex
-// guards the slots (a copy of one frame under the lock, ~1 ms for 704x576).
+// guards the slots (find copies one frame under the lock, ~1 ms for 704x576; push by move only
+// swaps buffers).
 
 #include <cstdint>
 #include <memory>
@@ -25,6 +26,8 @@ class ImageRing {
 
   // Keeps a copy of the frame, replacing the oldest slot.
   void push(uint64_t frame, int64_t capture_ns, const Image<Rgb8>& image);
+  // Keeps the frame's image itself (no copy); `image` gets the oldest slot's buffer (stale).
+  void push(uint64_t frame, int64_t capture_ns, Image<Rgb8>&& image);
 
   enum class Found { ok, evicted, not_yet };
   struct Image3 {
@@ -40,8 +43,10 @@ class ImageRing {
   struct Slot {
     bool used = false;
     uint64_t frame = 0;
-    Image3 image;
+    int64_t capture_ns = 0;
+    Image<Rgb8> image;
   };
+  Slot& next_slot(uint64_t frame, int64_t capture_ns);  // mutex_ held
   mutable std::mutex mutex_;
   std::vector<Slot> slots_;
   std::size_t next_ = 0;

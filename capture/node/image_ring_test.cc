@@ -24,6 +24,29 @@ Image<Rgb8> filled(int w, int h, uint8_t v) {
   return img;
 }
 
+TEST(ImageRing, PushByMoveKeepsTheImageAndGivesBackTheOldestBuffer) {
+  ImageRing ring(2);
+  ImageRing::Image3 out;
+  for (uint64_t f = 1; f <= 4; ++f) {
+    Image<Rgb8> img = filled(3, 2, uint8_t(10 * f));
+    ring.push(f, int64_t(f) * 40, std::move(img));
+    // From the third push on, the caller's image holds the evicted frame's buffer.
+    if (f >= 3) {
+      EXPECT_EQ(img.pixels(), filled(3, 2, uint8_t(10 * (f - 2))).pixels());
+    }
+  }
+  ASSERT_EQ(ring.find(4, out), ImageRing::Found::ok);
+  EXPECT_EQ(out.capture_ns, 160);
+  EXPECT_EQ(out.rgb.size(), 18u);
+  EXPECT_EQ(out.rgb[0], 40);
+  EXPECT_EQ(ring.find(3, out), ImageRing::Found::ok);
+  EXPECT_EQ(out.rgb[1], 31);
+  EXPECT_EQ(ring.find(2, out), ImageRing::Found::evicted);
+  ring.push(5, 200, filled(3, 2, 50));  // a copy into the reused slot
+  ASSERT_EQ(ring.find(5, out), ImageRing::Found::ok);
+  EXPECT_EQ(out.rgb[2], 52);
+}
+
 TEST(ImageRing, KeepsTheLastFramesAndSaysWhyOthersAreMissing) {
   ImageRing ring(4);
   ImageRing::Image3 out;

@@ -119,6 +119,7 @@ Expected<void> SimFrameSource::start() {
   stopping_ = false;
   started_ = true;
   last_frame_.reset();
+  ahead_.reset();
   return {};
 }
 
@@ -164,12 +165,24 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
     ++f;
   }
   const int64_t capture_ns = clock.time_of(f) + half + options_.offset_ns;
-  if (options_.paced && !wait_until(capture_ns, deadline)) {
+  auto ran_out = [&] {
     std::lock_guard lock(mutex_);
     stats_.drops += skipped;  // consumed even when the wait ran out
     if (skipped) last_frame_ = f - 1;
     return std::optional<Frame>();
+  };
+  // An untracked camera's picture depends on f alone: render it while waiting for its instant,
+  // so that it is ready at capture_ns instead of one render later (kept if the wait runs out).
+  // It starts half a period before the instant, not at once: after the previous frame's keying
+  // in every capture server on the machine (all run at one real-time priority, where a render
+  // started early would hold up another server's keying, hence its mask).
+  if (options_.paced && !pose_ && !(ahead_ && ahead_->frame == f)) {
+    if (!wait_until(capture_ns - half, deadline)) return ran_out();
+    ahead_.emplace();
+    ahead_->frame = f;
+    studio_.render(0, int64_t(f), &ahead_->image, nullptr);
   }
+  if (options_.paced && !wait_until(capture_ns, deadline)) return ran_out();
   if (pose_) {
     if (auto camera = pose_(f); camera && !same_camera(*camera, studio_.cameras()[0])) {
       Camera c = *camera;
@@ -183,7 +196,12 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
   Frame frame;
   frame.frame = f;
   frame.capture_ns = capture_ns;
-  studio_.render(0, int64_t(f), &frame.image, nullptr);
+  if (ahead_ && ahead_->frame == f && !pose_) {
+    frame.image = std::move(ahead_->image);
+  } else {
+    studio_.render(0, int64_t(f), &frame.image, nullptr);
+  }
+  ahead_.reset();
   apply_features(frame.image);
   if (options_.stamp) sim::stamp_frame(frame.image.view(), f);
   if (options_.jitter_ns > 0) {  // late delivery: a driver/transport delay of its own

@@ -244,19 +244,38 @@ uint64_t mix(uint64_t a, uint64_t b) {
   return h ^ (h >> 33);
 }
 
-// Adds table noise to n bytes with saturation: out = clamp(in + noise, 0, 255).
-void add_noise(uint8_t* data, const int8_t* noise, std::size_t n) {
+// Table noise on n bytes with saturation: out = clamp(in + noise, 0, 255); out may be in.
+void add_noise(uint8_t* out, const uint8_t* in, const int8_t* noise, std::size_t n) {
   std::size_t i = 0;
 #if defined(__SSE2__)
   const __m128i bias = _mm_set1_epi8(static_cast<char>(0x80));
   for (; i + 16 <= n; i += 16) {
-    const __m128i v = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(data + i)), bias);
+    const __m128i v =
+        _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i)), bias);
     const __m128i z = _mm_loadu_si128(reinterpret_cast<const __m128i*>(noise + i));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(data + i), _mm_xor_si128(_mm_adds_epi8(v, z), bias));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i), _mm_xor_si128(_mm_adds_epi8(v, z), bias));
   }
 #endif
-  for (; i < n; ++i) data[i] = static_cast<uint8_t>(std::clamp(data[i] + noise[i], 0, 255));
+  for (; i < n; ++i) out[i] = static_cast<uint8_t>(std::clamp(in[i] + noise[i], 0, 255));
 }
+void add_noise(uint8_t* data, const int8_t* noise, std::size_t n) {
+  add_noise(data, data, noise, n);
+}
+
+// The image's first write of a frame: background + noise (noise may be null: none) over the
+// byte range [b0, b1) of a row, or a plain background copy when `plain`.
+void fill_span(uint8_t* out, const uint8_t* bg, const int8_t* noise, std::size_t b0, std::size_t b1,
+               bool plain) {
+  if (b1 <= b0) return;
+  if (plain || noise == nullptr) {
+    if (out != bg) std::memcpy(out + b0, bg + b0, b1 - b0);
+  } else {
+    add_noise(out + b0, bg + b0, noise + b0, b1 - b0);
+  }
+}
+
+// Thread's mask when the caller wants none (the renderer needs one for its edges).
+thread_local Mask scratch_mask;
 
 constexpr std::size_t kNoiseWindow = 1 << 20;
 
@@ -313,8 +332,61 @@ struct SimulatedStudio::Impl {
     return f;
   }
 
+  const int8_t* noise_of(int64_t frame, int index) const {
+    if (!(options.noise_sigma > 0)) return nullptr;
+    const uint64_t key =
+        mix(mix(options.seed, static_cast<uint64_t>(frame)), static_cast<uint64_t>(index));
+    return noise.data() + key % kNoiseWindow;
+  }
+
+  // The same pixels as render_reference, with the background copy and the noise fused into one
+  // pass outside the rectangle the actor and its shadow may touch (detail::touched_rect), only
+  // that rectangle noised after the actor is drawn, and no fresh mask when none is wanted.
   void render(int index, const detail::PreparedFrame& f, Image<Rgb8>* image, Mask* mask,
               Image<uint8_t>* matte) const {
+    if (options.reference_renderer) return render_reference(index, f, image, mask, matte);
+    const CameraCache& cam = caches.at(index);
+    const int W = cam.camera.width, H = cam.camera.height;
+    Image<Rgb8> local_image;
+    if (image == nullptr) image = &local_image;
+    if (mask == nullptr) mask = &scratch_mask;
+    // A new image starts as a copy of the background (no zero fill first); a reused one is
+    // written row by row below.
+    const bool fresh = image->width() != W || image->height() != H;
+    if (fresh) *image = cam.background;
+    if (mask->width() != W || mask->height() != H) *mask = Mask(W, H);
+    std::memset(mask->data(), 0, static_cast<std::size_t>(W) * H);
+    if (matte) *matte = Image<uint8_t>(W, H, 0);
+    const detail::Rect D = detail::touched_rect(options, cam, f);
+    const int8_t* noise_base = noise_of(f.truth.frame, index);
+    auto* out = reinterpret_cast<uint8_t*>(image->data());
+    const auto* bg =
+        reinterpret_cast<const uint8_t*>(fresh ? image->data() : cam.background.data());
+    const std::size_t row = sizeof(Rgb8) * W;
+    const std::size_t d0 = sizeof(Rgb8) * std::max(0, D.x0), d1 = sizeof(Rgb8) * std::min(W, D.x1);
+    for (int y = 0; y < H; ++y) {
+      const std::size_t o = row * y;
+      const int8_t* nz = noise_base ? noise_base + o : nullptr;
+      if (D.empty() || y < D.y0 || y >= D.y1) {
+        fill_span(out + o, bg + o, nz, 0, row, false);
+      } else {
+        fill_span(out + o, bg + o, nz, 0, d0, false);
+        fill_span(out + o, bg + o, nz, d0, d1, true);  // noised after the actor is drawn
+        fill_span(out + o, bg + o, nz, d1, row, false);
+      }
+    }
+    detail::render_actor(options, cam, f, image, mask, matte);
+    if (noise_base && !D.empty()) {
+      for (int y = std::max(0, D.y0); y < std::min(H, D.y1); ++y) {
+        const std::size_t o = row * y;
+        add_noise(out + o + d0, noise_base + o + d0, d1 - d0);
+      }
+    }
+  }
+
+  // The renderer before issue 20 (StudioOptions::reference_renderer).
+  void render_reference(int index, const detail::PreparedFrame& f, Image<Rgb8>* image, Mask* mask,
+                        Image<uint8_t>* matte) const {
     const CameraCache& cam = caches.at(index);
     const int W = cam.camera.width, H = cam.camera.height;
     Image<Rgb8> local_image;
@@ -327,11 +399,8 @@ struct SimulatedStudio::Impl {
     std::memset(mask->data(), 0, static_cast<std::size_t>(W) * H);
     if (matte) *matte = Image<uint8_t>(W, H, 0);
     detail::render_actor(options, cam, f, image, mask, matte);
-    if (options.noise_sigma > 0) {
-      const uint64_t key = mix(mix(options.seed, static_cast<uint64_t>(f.truth.frame)),
-                               static_cast<uint64_t>(index));
-      add_noise(reinterpret_cast<uint8_t*>(image->data()), noise.data() + key % kNoiseWindow,
-                sizeof(Rgb8) * W * H);
+    if (const int8_t* noise_base = noise_of(f.truth.frame, index)) {
+      add_noise(reinterpret_cast<uint8_t*>(image->data()), noise_base, sizeof(Rgb8) * W * H);
     }
   }
 };

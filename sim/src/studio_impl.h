@@ -71,6 +71,14 @@ inline const Eigen::Vector3d kKeyLight = Eigen::Vector3d(0.4, 1.0, 0.5).normaliz
 inline const Eigen::Vector3d kFillLight = Eigen::Vector3d(-0.5, 0.4, -0.3).normalized();
 
 ShadowMap make_shadow(const ActorBody& body, double strength);
+// The pixels apply_shadow may darken (empty without a shadow).
+Rect shadow_rect(const CameraCache& cam, const ShadowMap& shadow);
+// Darkens the camera's floor pixels in the shadow. `cull` (pinhole cameras only): visit only
+// the pixels of each row whose floor point may lie on the map (same pixels changed).
+void apply_shadow(const CameraCache& cam, const ShadowMap& shadow, Image<Rgb8>* image, bool cull);
+// The pixels render_actor may change for this frame and camera (actor rectangles grown by one
+// pixel, and the shadow's): outside it the image stays the camera's background.
+Rect touched_rect(const StudioOptions& options, const CameraCache& cam, const PreparedFrame& frame);
 // Draws shadow, actor (true mask, and the true matte when not null), spill, anti-aliasing or
 // motion blur into image / mask / matte, which already hold the camera's background and zeros.
 void render_actor(const StudioOptions& options, const CameraCache& cam, const PreparedFrame& frame,

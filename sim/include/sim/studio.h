@@ -28,7 +28,9 @@
 // Speed: the background (cloth, fall-off, seams, projected image) is cached per camera; per
 // frame only the actor's projected bounding rectangles are ray cast, the shadow is a small
 // floor map, noise comes from a table at a per-frame offset, and cameras run on `threads`
-// threads. See BENCHMARKS.md ("Simulated studio") for the measured rate.
+// threads. Anti-aliasing sub-samples are cast only against the parts a conservative cone test
+// cannot rule out for the pixel, and the background copy and the noise are one pass outside
+// the rectangle the actor and its shadow touch. See BENCHMARKS.md ("Simulated studio").
 
 #include <cstdint>
 #include <memory>
@@ -77,6 +79,11 @@ struct StudioOptions {
   bool frame_code = false;  // the actor wears the frame number (sim/frame_code.h)
 
   int threads = 2;  // render_all() threads over cameras
+  // The renderer as it was before issue 20's cuts (every candidate part ray cast for every
+  // anti-aliasing sub-sample; background copy and noise as two whole-image passes; a fresh mask
+  // per call). Same images bit for bit, noise included (studio_test: FastRendererMatchesReference);
+  // kept as the tests' reference and sim_bench's baseline. Not for production use.
+  bool reference_renderer = false;
 
   Expected<void> validate() const;
 };
