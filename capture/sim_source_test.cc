@@ -4,8 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
 
+#include "core/clock.h"
 #include "sim/cameras.h"
 
 namespace studio::capture {
@@ -79,6 +82,35 @@ TEST(SimFrameSource, PacedPictureRenderedAheadIsTheFramesOwn) {
     EXPECT_EQ((*f)->image.pixels(), expected.pixels()) << "frame " << (*f)->frame;
     EXPECT_NE(mean_level(expected), 0.0);
   }
+}
+
+TEST(SimFrameSource, FrameArrivesAfterTheCamerasReadout) {
+  // readout_ns models exposure end + read-out + transfer: no frame reaches the consumer before
+  // capture_ns + readout_ns; an ideal camera (0) delivers from the instant on (control: the
+  // same source without readout delivers before capture_ns + readout at least once).
+  auto arrival_after_capture = [](int64_t readout_ns) {
+    SimSourceOptions o = small_options(true);
+    o.readout_ns = readout_ns;
+    auto src = SimFrameSource::create(o);
+    EXPECT_TRUE(src) << src.error().message;
+    EXPECT_TRUE((*src)->start());
+    int64_t least = INT64_MAX;
+    for (int i = 0; i < 6; ++i) {
+      auto f = (*src)->next(1s);
+      EXPECT_TRUE(f && *f) << "no frame";
+      if (!f || !*f) break;
+      least = std::min(least, realtime_ns() - (*f)->capture_ns);
+    }
+    return least;
+  };
+  constexpr int64_t kReadout = 8'000'000;
+  EXPECT_GE(arrival_after_capture(kReadout), kReadout);
+  EXPECT_LT(arrival_after_capture(0), kReadout);
+  SimSourceOptions bad = small_options(true);
+  bad.readout_ns = 2 * bad.clock.period_ns;
+  auto refused = SimFrameSource::create(bad);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("readout"), std::string::npos);
 }
 
 TEST(SimFrameSource, SameFrameSamePictureAcrossInstances) {

@@ -39,7 +39,11 @@ const char kConfigHelp[] =
     "    - id: cam0\n"
     "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true,\n"
     "               frame_code: false, stamp: false, offset_us: 0, jitter_us: 0, drop_every: 0,\n"
-    "               motion: sequence, swing_peak_speed: 1.5}\n"
+    "               readout_us: -1, motion: sequence, swing_peak_speed: 1.5}\n"
+    "                                    readout_us: exposure instant -> frame on the host (the\n"
+    "                                    rest of the exposure, read-out, transfer); -1 (default):\n"
+    "                                    a GigE camera's, half the exposure + 8 bits a pixel at\n"
+    "                                    1 Gbit/s (8.2 ms at 704x576); 0: an ideal camera"
     "                                    motion: the simulated actor's (idle, walk, turn,\n"
     "                                    raise_hand, crouch, sequence, arm_swing: the fast arm\n"
     "                                    swing, fingertips at swing_peak_speed m/s); every camera\n"
@@ -87,11 +91,13 @@ struct SimKeys {
   bool frame_code = false;  // sim/frame_code.h
   bool stamp = false;
   double offset_us = 0, jitter_us = 0;
+  double readout_us = -1;  // -1: a GigE camera's (see kUsage)
   int drop_every = 0;
   sim::Motion motion = sim::Motion::sequence;  // the simulated actor's motion (sim/actor.h)
   double swing_peak_speed = 1.5;               // arm_swing: fingertip peak speed, m/s
   Expected<void> validate() const {
     if (index >= ring) return fail("index: must be below ring");
+    if (readout_us < 0 && readout_us != -1) return fail("readout_us: -1 (auto) or >= 0");
     return {};
   }
 };
@@ -133,6 +139,7 @@ const yaml::Schema<SimKeys> kSim{
     yaml::field("stamp", &SimKeys::stamp),
     yaml::field("offset_us", &SimKeys::offset_us).range(-5e5, 5e5),
     yaml::field("jitter_us", &SimKeys::jitter_us).range(0, 1e6),
+    yaml::field("readout_us", &SimKeys::readout_us).range(-1, 1e6),
     yaml::field("drop_every", &SimKeys::drop_every).range(0, 1e9),
     yaml::field("motion", &SimKeys::motion,
                 [](const yaml::Node& n) -> Expected<sim::Motion> {
@@ -259,6 +266,13 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
     so.camera.id = c.id;
     so.clock = clock;
     so.exposure_us = std::min(so.exposure_us, double(clock.period_ns) / 1000.0);
+    // A GigE camera unless told: the second half of the exposure, then 8-bit pixels (Bayer) at
+    // 1 Gbit/s = 1000 bits per microsecond.
+    const double readout_us =
+        c.sim.readout_us >= 0 ? c.sim.readout_us
+                              : so.exposure_us / 2 + double(c.sim.width) * c.sim.height * 8 / 1000;
+    so.readout_ns = c.sim.readout_us >= 0 ? int64_t(readout_us * 1000)
+                                          : std::min(int64_t(readout_us * 1000), clock.period_ns);
     setup.calibration = so.camera;
     src = SimFrameSource::create(so);
   } else if (c.type == "files") {

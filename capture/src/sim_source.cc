@@ -92,6 +92,8 @@ Expected<void> SimSourceOptions::validate() const {
     return fail("sim source " + camera.id + ": offset must be within half a frame period (" + std::to_string(offset_ns) + " ns, period " + std::to_string(clock.period_ns) + " ns)");
   if (jitter_ns < 0 || jitter_ns > 10 * clock.period_ns)
     return fail("sim source " + camera.id + ": jitter must be in 0..10 frame periods");
+  if (readout_ns < 0 || readout_ns > clock.period_ns)
+    return fail("sim source " + camera.id + ": readout must be in 0..1 frame period");
   if (max_blur_px < 0 || max_blur_px > 64)
     return fail("sim source " + camera.id + ": max_blur_px must be in 0..64");
   return {};
@@ -204,6 +206,11 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
   ahead_.reset();
   apply_features(frame.image);
   if (options_.stamp) sim::stamp_frame(frame.image.view(), f);
+  // The camera's read-out and transfer: the frame reaches the host no earlier than this.
+  if (options_.paced && options_.readout_ns > 0 &&
+      !wait_until(capture_ns + options_.readout_ns, deadline + std::chrono::nanoseconds(
+                                                                  options_.readout_ns)))
+    return ran_out();
   if (options_.jitter_ns > 0) {  // late delivery: a driver/transport delay of its own
     jitter_state_ = jitter_state_ * 6364136223846793005ull + 1442695040888963407ull;
     std::this_thread::sleep_for(

@@ -29,6 +29,10 @@
 // exposure instant (it depends on the frame number alone) and delivered at that instant: the
 // image is ready at capture_ns, not one render (2-5 ms of CPU at 704x576) after it, and the
 // render does not compete with the previous frame's keying. Never delivered early.
+// `readout_ns` models what a real camera adds between the exposure instant and the frame reaching
+// the host (the rest of the exposure, sensor read-out, link transfer): the frame is delivered no
+// earlier than capture_ns + readout_ns. 0 (the library default) is an ideal camera; the capture
+// service's config default is a GigE camera's (capture_config: readout_us: auto).
 
 #include <atomic>
 #include <chrono>
@@ -59,6 +63,7 @@ struct SimSourceOptions {
   bool stamp = false;         // the frame number as a corner code in the pixels (sim/frame_stamp.h)
   int64_t offset_ns = 0;      // genlock offset of this camera's exposure, |offset| < period/2
   int64_t jitter_ns = 0;      // delivery delayed by a uniform 0..jitter (driver/transport)
+  int64_t readout_ns = 0;     // delivered no earlier than capture_ns + readout_ns (0..1 period)
   uint64_t drop_every = 0;    // frames f with f % drop_every == drop_every-1 are lost (counted)
   Expected<void> validate() const;
 };
