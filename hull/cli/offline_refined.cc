@@ -66,7 +66,7 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
   --max-depth C     carving stops C cells below the hull (default 12)
   --surface S|off   surface stage on the mesh (after carving with --refine): S Laplacian steps
                     with the silhouette rims anchored, moving the hull's bulges between the
-                    silhouette cones inwards (10 recommended: -18 % mean / -24 % p95 surface
+                    silhouette cones inwards (10 recommended: -18 % mean / -23 % p95 surface
                     distance vs the hull with --refine on the concave test poses, union PSNR
                     +1 dB); default off
   --surface-photo N photo-consistency iterations of the surface stage before the steps (patch

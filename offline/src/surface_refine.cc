@@ -128,7 +128,6 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
     // 1-2. Data term per vertex.
     parallel_for(nv, o.threads, [&](std::size_t a, std::size_t b) {
       std::vector<std::size_t> seen;
-      std::vector<std::vector<float>> patches;
       std::vector<double> score, sums, pair_values;
       std::vector<int> depths;
       std::vector<std::vector<std::vector<float>>> per_cam;
