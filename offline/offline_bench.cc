@@ -2,10 +2,11 @@
 // overhead) at 704x576, the actor crouching (frame 45), one core per frame (the CLI runs frames in
 // parallel, one per core). Stages after keying: hull = cut + segment marching cubes + exact
 // crossings (the baseline: `studio-hull offline` without --refine); carve = photo_carve;
-// refined_mesh; texture = vertex_colours; encode = the glb bytes. BM_Frame runs a whole frame per
-// mode at 256^2 and 512^2 columns (frames_per_min_1core: one core, wall time of the stages).
-// BM_Quality: the refinement's quality (surface distance to the true actor, counters in mm) against
-// its cost, per threshold, with the hull as the baseline in the same run.
+// refined_mesh; surface = refine_surface (default options: the shape prior); texture =
+// vertex_colours; encode = the glb bytes. BM_Frame runs a whole frame per mode at 256^2 and 512^2
+// columns (frames_per_min_1core: one core, wall time of the stages). BM_Quality: the refinement's
+// quality (surface distance to the true actor, counters in mm) against its cost, per threshold
+// and surface setting, with the hull as the baseline in the same run.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -15,6 +16,7 @@
 #include "hull/silhouette_cut.h"
 #include "offline/frame_files.h"
 #include "offline/photo_carve.h"
+#include "offline/surface_refine.h"
 #include "offline/texture.h"
 #include "sim/cameras.h"
 #include "testing/truth.h"
@@ -48,11 +50,13 @@ hull::Mesh hull_mesh(const Scene& s, const hull::SegmentSet& set) {
   return m;
 }
 
-// range(0): grid; range(1): 0 hull only, 1 refined, 2 refined + textured.
+// range(0): grid; range(1): 0 hull only, 1 refined, 2 refined + textured, 3 refined + surface,
+// 4 refined + surface + textured.
 void BM_Frame(benchmark::State& state) {
   const Scene& s = Scene::get();
   const int mode = int(state.range(1));
-  double t_hull = 0, t_carve = 0, t_mesh = 0, t_texture = 0, t_encode = 0;
+  double t_hull = 0, t_carve = 0, t_mesh = 0, t_surface = 0, t_texture = 0, t_encode = 0;
+  const bool textured = mode == 2 || mode == 4;
   const auto ms = [](auto t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   };
@@ -73,40 +77,53 @@ void BM_Frame(benchmark::State& state) {
       mesh = refined_mesh(carved.set, set, s.views).value();
       t_mesh += ms(t0);
     }
+    if (mode >= 3) {
+      t0 = std::chrono::steady_clock::now();
+      SurfaceRefineOptions so;
+      so.cell = 3.0 / double(state.range(0));
+      mesh = refine_surface(mesh, s.views, so).value().mesh;
+      t_surface += ms(t0);
+    }
     std::vector<Eigen::Vector3f> colours;
-    if (mode == 2) {
+    if (textured) {
       t0 = std::chrono::steady_clock::now();
       colours = vertex_colours(mesh, s.views).value();
       t_texture += ms(t0);
     }
     t0 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(encode_frame_glb(mesh, mode == 2 ? &colours : nullptr, "actor", 45));
+    benchmark::DoNotOptimize(encode_frame_glb(mesh, textured ? &colours : nullptr, "actor", 45));
     t_encode += ms(t0);
   }
   const double n = double(state.iterations());
   state.counters["cut_ms"] = t_hull / n;
   state.counters["carve_ms"] = t_carve / n;
   state.counters["mesh_ms"] = t_mesh / n;
+  state.counters["surface_ms"] = t_surface / n;
   state.counters["texture_ms"] = t_texture / n;
   state.counters["encode_ms"] = t_encode / n;
-  const double frame_ms = (t_hull + t_carve + t_mesh + t_texture + t_encode) / n;
+  const double frame_ms = (t_hull + t_carve + t_mesh + t_surface + t_texture + t_encode) / n;
   state.counters["frames_per_min_1core"] = 60000 / frame_ms;
 }
 BENCHMARK(BM_Frame)
-    ->ArgsProduct({{256, 512}, {0, 1, 2}})
+    ->ArgsProduct({{256, 512}, {0, 1, 2, 3, 4}})
     ->ArgNames({"grid", "mode"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(2);
 
 // range(0): threshold (grey levels; 0 = the hull itself, the baseline); range(1): patch_half
-// (0: the colour spread alone; 3: with the shading-patch NCC test).
+// (0: the colour spread alone; 3: with the shading-patch NCC test); range(2): the surface stage's
+// shape steps (-1: no surface stage); range(3): its photo-term iterations.
 void BM_Quality(benchmark::State& state) {
   const Scene& s = Scene::get();
   const hull::SegmentSet set = hull::visual_hull(testing::studio_grid(256), s.cut_views).value();
   CarveOptions o;
   o.threshold = double(state.range(0));
   o.patch_half = int(state.range(1));
+  SurfaceRefineOptions so;
+  so.cell = 3.0 / 256;
+  so.shape_steps = int(std::max<int64_t>(0, state.range(2)));
+  so.iterations = int(state.range(3));
   hull::Mesh mesh;
   for (auto _ : state) {
     if (state.range(0) == 0) {
@@ -115,6 +132,7 @@ void BM_Quality(benchmark::State& state) {
       const CarveResult carved = photo_carve(set, s.views, o).value();
       mesh = refined_mesh(carved.set, set, s.views).value();
     }
+    if (state.range(2) >= 0) mesh = refine_surface(mesh, s.views, so).value().mesh;
   }
   const auto score = testing::surface_distance(mesh, s.frame.truth.body, 100000);
   state.counters["mean_mm"] = 1e3 * score.both.mean;
@@ -123,13 +141,18 @@ void BM_Quality(benchmark::State& state) {
   state.counters["completeness_mean_mm"] = 1e3 * score.completeness.mean;
 }
 BENCHMARK(BM_Quality)
-    ->Args({0, 0})
-    ->Args({4, 0})
-    ->Args({6, 0})
-    ->Args({6, 3})
-    ->Args({9, 3})
-    ->Args({12, 0})
-    ->ArgNames({"threshold", "patch"})
+    ->Args({0, 0, -1, 0})
+    ->Args({0, 0, 10, 0})
+    ->Args({4, 0, -1, 0})
+    ->Args({6, 0, -1, 0})
+    ->Args({6, 3, -1, 0})
+    ->Args({6, 3, 5, 0})
+    ->Args({6, 3, 10, 0})
+    ->Args({6, 3, 20, 0})
+    ->Args({6, 3, 10, 1})
+    ->Args({9, 3, -1, 0})
+    ->Args({12, 0, -1, 0})
+    ->ArgNames({"threshold", "patch", "surface", "photo"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);

@@ -9,17 +9,21 @@
 //   reaches the PSNR below over the actor's interior (its true mask without the 2-pixel border)
 //   and, rendered anti-aliased over that camera's clean plate, over the union of the true and
 //   the rendered silhouettes (border and contour included: the measure);
+// - the surface stage after carving (surface_refine.h: shape prior with rim anchors) is closer
+//   still, and widens the union PSNR (the hull's bulges outside the true silhouette shrink);
 // - the result does not depend on the thread count; bad input is refused by reason.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
 #include "offline/photo_carve.h"
+#include "offline/surface_refine.h"
 #include "offline/texture.h"
 #include "sim/cameras.h"
 #include "testing/truth.h"
@@ -45,9 +49,11 @@ std::vector<Camera> rig() {
 }
 
 struct Case {
-  testing::SurfaceScore hull, refined;
-  double psnr_hull = 0, psnr_refined = 0;            // interior (2-px border excluded)
-  double psnr_full_hull = 0, psnr_full_refined = 0;  // union of the silhouettes
+  testing::SurfaceScore hull, carved_score, refined;  // refined = carved + surface refinement
+  double psnr_hull = 0, psnr_refined = 0;             // interior (2-px border excluded)
+  double psnr_full_hull = 0, psnr_full_refined = 0;   // union of the silhouettes
+  double psnr_carved = 0, psnr_full_carved = 0;
+  double photo_target_error = 0, photo_stay_error = 0;  // metres (mean |target - truth|, |truth|)
   std::size_t carved = 0;
 };
 
@@ -69,20 +75,60 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
   CarveOptions o;
   o.threads = 2;
   const CarveResult carved = photo_carve(set, views, o).value();
-  const hull::Mesh mesh = refined_mesh(carved.set, set, views, 2).value();
+  const hull::Mesh carved_mesh = refined_mesh(carved.set, set, views, 2).value();
+  SurfaceRefineOptions so_;
+  so_.cell = 3.0 / kGrid;
+  so_.threads = 2;
+  const auto sr = refine_surface(carved_mesh, views, so_).value();
+  std::printf(
+      "  surface refine: %d iterations, anchored %zu, evidence %zu, unseen %zu of %zu vertices, "
+      "mean shift %.2f mm\n",
+      sr.iterations, sr.anchored, sr.evidence, sr.unseen, sr.mesh.vertices.size(),
+      1e3 * sr.mean_shift);
+  const hull::Mesh& mesh = sr.mesh;
   Case c;
+  {
+    // The photo term's data (one iteration, no shape prior) against the true offset along each
+    // vertex's search direction: how far its targets are from the truth, against not moving.
+    SurfaceRefineOptions po = so_;
+    po.iterations = 1, po.shape_steps = 0;
+    const auto pr = refine_surface(carved_mesh, views, po).value();
+    double e_t = 0, e_0 = 0, bias = 0, tb = 0;
+    int cnt = 0, hist[5] = {0, 0, 0, 0, 0};
+    for (std::size_t n = 0; n < carved_mesh.vertices.size(); ++n) {
+      if (pr.first_weight.empty() || pr.first_weight[n] <= 0) continue;
+      const Eigen::Vector3d dir = pr.directions[n].cast<double>();
+      const Eigen::Vector3d o = carved_mesh.vertices[n].cast<double>() + 0.06 * dir;
+      const auto hit = f.truth.body.ray_hit(o, -dir);
+      if (!hit) continue;
+      const double truth = 0.06 - hit->t;
+      if (std::abs(truth) > 0.05) continue;
+      const double t = pr.first_target[n];
+      e_t += std::abs(t - truth), e_0 += std::abs(truth), bias += t - truth, tb += truth, ++cnt;
+      hist[std::min(4, int(std::abs(t - truth) / (0.5 * 3.0 / kGrid)))]++;
+    }
+    c.photo_target_error = cnt ? e_t / cnt : 0, c.photo_stay_error = cnt ? e_0 / cnt : 0;
+    std::printf(
+        "  photo term (1 iteration) on %d vertices: |target - truth| %.2f mm, |truth| %.2f mm, "
+        "bias %.2f mm, truth mean %.2f; err hist (half cells) %d %d %d %d %d\n",
+        cnt, 1e3 * e_t / cnt, 1e3 * e_0 / cnt, 1e3 * bias / cnt, 1e3 * tb / cnt, hist[0], hist[1],
+        hist[2], hist[3], hist[4]);
+  }
   c.carved = carved.carved;
   c.hull = testing::surface_distance(hull_mesh, f.truth.body);
+  c.carved_score = testing::surface_distance(carved_mesh, f.truth.body);
   c.refined = testing::surface_distance(mesh, f.truth.body);
   Mask truth_mask;
   studio.render(int(f.cameras.size()) - 1, frame, nullptr, &truth_mask);
   const Mask actor = testing::erode(truth_mask, 2);
   TextureOptions to;
   to.threads = 2;
-  for (const hull::Mesh* m : std::vector<const hull::Mesh*>{&hull_mesh, &mesh}) {
+  for (const hull::Mesh* m : std::vector<const hull::Mesh*>{&hull_mesh, &carved_mesh, &mesh}) {
     const auto colours = vertex_colours(*m, views, to).value();
     const Image<Rgb8> rendered = testing::render_coloured(*m, colours, f.cameras.back());
-    (m == &mesh ? c.psnr_refined : c.psnr_hull) = testing::psnr(rendered, f.images.back(), actor);
+    (m == &mesh          ? c.psnr_refined
+     : m == &carved_mesh ? c.psnr_carved
+                         : c.psnr_hull) = testing::psnr(rendered, f.images.back(), actor);
     Mask covered;
     const Image<Rgb8> over = testing::render_over(
         *m, colours, f.cameras.back(), studio.background(int(f.cameras.size()) - 1), 4, &covered);
@@ -90,8 +136,9 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
     for (int y = 0; y < both.height(); ++y)
       for (int x = 0; x < both.width(); ++x)
         both.view().row(y)[x] = std::max(both.view().row(y)[x], covered.view().row(y)[x]);
-    (m == &mesh ? c.psnr_full_refined : c.psnr_full_hull) =
-        testing::psnr(over, f.images.back(), both);
+    (m == &mesh          ? c.psnr_full_refined
+     : m == &carved_mesh ? c.psnr_full_carved
+                         : c.psnr_full_hull) = testing::psnr(over, f.images.back(), both);
     {
       // Where the union's squared error is: the actor's interior (true mask without its 2-px
       // border), the border band, and pixels the render covers but the truth does not.
@@ -110,8 +157,10 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
       std::printf(
           "  %s union: %zu px interior (%.0f %% of the squared error), %zu border (%.0f %%), "
           "%zu outside the true mask (%.0f %%)\n",
-          m == &mesh ? "refined" : "hull", px[0], 100 * se[0] / total, px[1], 100 * se[1] / total,
-          px[2], 100 * se[2] / total);
+          m == &mesh          ? "refined"
+          : m == &carved_mesh ? "carved"
+                              : "hull",
+          px[0], 100 * se[0] / total, px[1], 100 * se[1] / total, px[2], 100 * se[2] / total);
     }
   }
   std::printf("%s frame %lld, %d^2 columns: carved %zu of %zu voxels in %d iterations\n",
@@ -125,11 +174,12 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
         1e3 * s.completeness.mean, 1e3 * s.completeness.p95, psnr, full);
   };
   row("hull", c.hull, c.psnr_hull, c.psnr_full_hull);
+  row("carved", c.carved_score, c.psnr_carved, c.psnr_full_carved);
   row("refined", c.refined, c.psnr_refined, c.psnr_full_refined);
   // Where the error is: share of the pooled mean and of the samples beyond the p95, per body
   // region, within one cell of the truth (placement) or beyond (excess or missed volume).
   for (const auto& [what, m] : std::vector<std::pair<const char*, const hull::Mesh*>>{
-           {"hull", &hull_mesh}, {"refined", &mesh}}) {
+           {"hull", &hull_mesh}, {"carved", &carved_mesh}, {"refined", &mesh}}) {
     std::printf("  %-8s error by region (share of mean / of p95 tail):", what);
     for (const auto& b : testing::error_breakdown(*m, f.truth.body, 3.0 / kGrid))
       std::printf(" %s%s %.0f/%.0f %%", b.region.c_str(), b.far ? ">cell" : "", 100 * b.share,
@@ -151,33 +201,66 @@ TEST(PhotoCarve, RefinedSurfaceIsCloserToTheTruthThanTheHull) {
     const Case& c = evaluate(motion, frame);
     EXPECT_GT(c.carved, 0u);
     // Never worse than the hull by more than one cell.
+    EXPECT_LE(c.carved_score.both.mean, c.hull.both.mean + cell);
+    EXPECT_LE(c.carved_score.both.p95, c.hull.both.p95 + cell);
+    EXPECT_LE(c.carved_score.accuracy.mean, c.hull.accuracy.mean + cell);
+    // Better than the hull in this frame.
+    EXPECT_LT(c.carved_score.both.mean, c.hull.both.mean);
+    EXPECT_LT(c.carved_score.both.p95, c.hull.both.p95);
+    hull_mean += c.hull.both.mean, hull_p95 += c.hull.both.p95;
+    mean += c.carved_score.both.mean, p95 += c.carved_score.both.p95;
+  }
+  const double mean_gain = 1 - mean / hull_mean, p95_gain = 1 - p95 / hull_p95;
+  std::printf("carving over the poses: mean %.1f %% lower, p95 %.1f %% lower than the hull\n",
+              100 * mean_gain, 100 * p95_gain);
+  // Measured 12 % / 19 % (docs/offline.md).
+  EXPECT_GE(mean_gain, 0.10);
+  EXPECT_GE(p95_gain, 0.15);
+}
+
+// The surface stage after carving (default options: the shape prior with rim anchors, no photo
+// term): closer to the truth than the carved mesh and the hull, never worse than the hull in any
+// frame by more than one cell.
+TEST(SurfaceRefine, CloserToTheTruthThanCarvingAndTheHull) {
+  const double cell = 3.0 / kGrid;
+  double hull_mean = 0, hull_p95 = 0, carved_mean = 0, carved_p95 = 0, mean = 0, p95 = 0;
+  for (const auto& [motion, frame] : kPoses) {
+    const Case& c = evaluate(motion, frame);
     EXPECT_LE(c.refined.both.mean, c.hull.both.mean + cell);
     EXPECT_LE(c.refined.both.p95, c.hull.both.p95 + cell);
     EXPECT_LE(c.refined.accuracy.mean, c.hull.accuracy.mean + cell);
-    // Better than the hull in this frame.
-    EXPECT_LT(c.refined.both.mean, c.hull.both.mean);
-    EXPECT_LT(c.refined.both.p95, c.hull.both.p95);
+    EXPECT_LE(c.refined.completeness.mean, c.hull.completeness.mean + cell);
+    EXPECT_LT(c.refined.both.mean, c.carved_score.both.mean) << sim::motion_name(motion);
+    EXPECT_LT(c.refined.both.p95, c.carved_score.both.p95) << sim::motion_name(motion);
     hull_mean += c.hull.both.mean, hull_p95 += c.hull.both.p95;
+    carved_mean += c.carved_score.both.mean, carved_p95 += c.carved_score.both.p95;
     mean += c.refined.both.mean, p95 += c.refined.both.p95;
   }
   const double mean_gain = 1 - mean / hull_mean, p95_gain = 1 - p95 / hull_p95;
-  std::printf("over the poses: mean %.1f %% lower, p95 %.1f %% lower than the hull\n",
-              100 * mean_gain, 100 * p95_gain);
-  // Measured 12 % / 19 % (docs/offline.md); the 30 % is not reached.
-  EXPECT_GE(mean_gain, 0.10);
-  EXPECT_GE(p95_gain, 0.15);
+  std::printf(
+      "carved + surface over the poses: mean %.1f %% lower, p95 %.1f %% lower than the "
+      "hull (carving alone %.1f %% / %.1f %%)\n",
+      100 * mean_gain, 100 * p95_gain, 100 * (1 - carved_mean / hull_mean),
+      100 * (1 - carved_p95 / hull_p95));
+  // Measured 18 % / 23 % (docs/offline.md); the 30 % is not reached.
+  EXPECT_GE(mean_gain, 0.16);
+  EXPECT_GE(p95_gain, 0.21);
 }
 
 TEST(Texture, HeldOutViewPsnr) {
   for (const auto& [motion, frame] : kPoses) {
     const Case& c = evaluate(motion, frame);
-    EXPECT_GE(c.psnr_refined, 28.0) << sim::motion_name(motion);
-    EXPECT_GE(c.psnr_refined, c.psnr_hull - 0.25) << sim::motion_name(motion);
+    // The carved mesh: >= 28 dB over the interior (28.3 / 28.7 measured).
+    EXPECT_GE(c.psnr_carved, 28.0) << sim::motion_name(motion);
+    EXPECT_GE(c.psnr_carved, c.psnr_hull - 0.25) << sim::motion_name(motion);
     // Over the union of the true and the rendered silhouettes (anti-aliased render over the
-    // held-out camera's clean plate): measured 24.2 (idle) and 22.9 dB (crouch); the issue's
-    // 28 dB is not reached there (docs/offline.md: the contour's position, not the colour).
-    EXPECT_GE(c.psnr_full_refined, 22.0) << sim::motion_name(motion);
-    EXPECT_GE(c.psnr_full_refined, c.psnr_full_hull - 0.25) << sim::motion_name(motion);
+    // held-out camera's clean plate): carved 24.2 (idle) and 22.9 dB (crouch); the surface stage
+    // shrinks the hull's bulges outside the true silhouette: 25.4 / 23.8 dB. The 28 dB is
+    // not reached there (docs/offline.md).
+    EXPECT_GE(c.psnr_full_carved, 22.0) << sim::motion_name(motion);
+    EXPECT_GE(c.psnr_full_carved, c.psnr_full_hull - 0.25) << sim::motion_name(motion);
+    EXPECT_GE(c.psnr_full_refined, c.psnr_full_carved + 0.5) << sim::motion_name(motion);
+    EXPECT_GE(c.psnr_refined, 27.5) << sim::motion_name(motion);
   }
 }
 
@@ -211,6 +294,24 @@ TEST(PhotoCarve, IndependentOfThreadsAndRefusesBadInput) {
   ASSERT_FALSE(photo_carve(set, wrong, one));
   EXPECT_NE(photo_carve(set, wrong, one).error().message.find("cam2"), std::string::npos);
   ASSERT_FALSE(vertex_colours(hull::segment_marching_cubes(set), wrong));
+  // The surface stage: both terms on, the same result on 1 and 2 threads; bad input refused.
+  hull::Mesh m = hull::segment_marching_cubes(set);
+  SurfaceRefineOptions s1;
+  s1.cell = 3.0 / 96, s1.iterations = 2;
+  SurfaceRefineOptions s2 = s1;
+  s2.threads = 2;
+  const auto r1 = refine_surface(m, views, s1).value();
+  const auto r2 = refine_surface(m, views, s2).value();
+  EXPECT_GT(r1.mean_shift, 0);
+  EXPECT_GT(r1.anchored, 0u);
+  EXPECT_EQ(r1.mesh.vertices, r2.mesh.vertices);
+  EXPECT_EQ(r1.mesh.triangles, m.triangles);
+  SurfaceRefineOptions s_bad = s1;
+  s_bad.cell = 0;
+  ASSERT_FALSE(refine_surface(m, views, s_bad));
+  EXPECT_NE(refine_surface(m, views, s_bad).error().message.find("cell"), std::string::npos);
+  ASSERT_FALSE(refine_surface(m, wrong, s1));
+  EXPECT_FALSE(refine_surface(m, {}, s1));
   EXPECT_FALSE(photo_carve(set, {}, one));
 }
 

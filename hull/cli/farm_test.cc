@@ -199,6 +199,51 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
   EXPECT_NE(r.out.find("\"computed\":2,\"skipped\":0"), std::string::npos) << r.out;
 }
 
+// --surface: the surface stage after carving (offline/surface_refine.h) runs in the process: the
+// same topology as the carved frames, vertices moved (the hull's bulges inwards, so no frame's
+// bounds grow), its setting in the fingerprint (a rerun skips, another setting recomputes).
+TEST_F(HullFarm, SurfaceStage) {
+  const fs::path carved = dir_ / "surface_carved", surface = dir_ / "surface_on";
+  auto r = run(hull() + " offline " + args(carved) + " --frames 0:3 --threads 2 --json", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run(hull() + " offline " + args(surface) + " --surface 10 --frames 0:3 --threads 2 --json",
+          dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"computed\":4,\"skipped\":0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"surface\":"), std::string::npos) << r.out;
+  for (int f = 0; f <= 3; ++f) {
+    const std::string name = offline::frame_file_name("actor", f);
+    const auto a = offline::verify_frame_file((carved / name).string());
+    const auto b = offline::verify_frame_file((surface / name).string());
+    ASSERT_TRUE(a && b) << name;
+    EXPECT_EQ(a->vertices, b->vertices);
+    EXPECT_EQ(a->triangles, b->triangles);
+    EXPECT_TRUE(b->coloured);
+    EXPECT_NE(a->options, b->options);
+    EXPECT_NE(slurp(carved / name), slurp(surface / name)) << name;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(b->min[k], a->min[k] - 1e-5f) << name;
+      EXPECT_LE(b->max[k], a->max[k] + 1e-5f) << name;
+    }
+  }
+  r = run(hull() + " offline " + args(surface) + " --surface 10 --frames 0:3 --threads 2 --json",
+          dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"computed\":0,\"skipped\":4"), std::string::npos) << r.out;
+  r = run(hull() + " offline " + args(surface) + " --surface 4 --frames 0:0 --threads 2 --json",
+          dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"computed\":1,\"skipped\":0"), std::string::npos) << r.out;
+  // Refused by reason, one line: a negative step count, the photo term without the stage.
+  for (const std::string& bad : {std::string(" --surface -1"), std::string(" --surface-photo 2"),
+                                 std::string(" --surface x")}) {
+    r = run(hull() + " offline " + args(surface) + bad, dir_);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("--surface"), std::string::npos) << r.err;
+  }
+}
+
 TEST_F(HullFarm, BadInputIsOneLine) {
   const fs::path out = dir_ / "bad";
   for (const std::string& a :
@@ -223,6 +268,7 @@ TEST_F(HullFarm, BadInputIsOneLine) {
   r = run(hull() + " offline --help", dir_);
   EXPECT_NE(r.out.find("--refine"), std::string::npos);
   EXPECT_NE(r.out.find("--texture"), std::string::npos);
+  EXPECT_NE(r.out.find("--surface"), std::string::npos);
 }
 
 // The Slurm submission itself (no Slurm needed): one job array over the plan's shards, each task
