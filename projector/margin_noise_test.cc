@@ -30,7 +30,9 @@ struct Tracked {
 };
 
 Tracked track(double noise_m, bool robust) {
-  MarginOptions mo;
+  MarginOptions mo;  // the estimate mode with the bound this test was written for
+  mo.worst_case_acceleration = false;
+  mo.max_acceleration_mps2 = 8.0;
   if (!robust) mo.max_acceleration_mps2 = std::numeric_limits<double>::max();
   MotionTracker tracker;
   Tracked out;

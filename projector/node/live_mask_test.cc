@@ -326,15 +326,18 @@ TEST_F(LiveMaskTest, ArmSwingLeavesNoProjectorLightOnTheTrueActor) {
   // period later must be seen lit. On the shared 2-core machine under load 10-17 the p50 was
   // 68-234 ms, the p95 257-551 ms and the margin at the cap in 65-89 % of the frames (mean
   // 0.17-0.19 m): reported, not asserted.
+  // The default margin assumes the worst-case acceleration (15 m/s^2, projector/mask_margin.h):
+  // 0.5 a L (L + dt) stays under half the cap only for L up to ~80 ms, so the margin bound is
+  // checked where the p95 is within that.
   const double p50 = quantile(latency_ms, 0.5), p95 = quantile(latency_ms, 0.95);
-  if (p50 <= 100 && p95 <= 150) {
+  if (p50 <= 60 && p95 <= 80) {
     EXPECT_LT(margin_mean, 0.5 * kMarginCapM);
     EXPECT_LT(double(capped) / n, 0.1);
     EXPECT_GT(control_lit, 100u);
   } else {
     std::printf(
         "the pipeline did not keep up (motion to render p50 %.0f ms, p95 %.0f ms; checked at "
-        "<= 100 / 150 ms): margin mean %.3f m, %.0f %% of frames at the cap; the margin bound "
+        "<= 60 / 80 ms): margin mean %.3f m, %.0f %% of frames at the cap; the margin bound "
         "is not checked\n",
         p50, p95, margin_mean, 100.0 * double(capped) / n);
   }

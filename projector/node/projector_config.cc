@@ -74,9 +74,14 @@ runtime::ServiceDefinition projector_service_definition() {
       "      prediction: true      move every mesh forward by its predicted motion\n"
       "      velocity_uncertainty: 0.05  m/s, sigma of the velocity estimate\n"
       "      head_disagreement: 0.5      m/s; a head faster than the mesh by more: no prediction\n"
-      "      max_acceleration: 8.0       m/s^2, physical bound on the actor's acceleration in the\n"
-      "                                  prediction term (the estimate is the median of the last\n"
-      "                                  5 meshes' largest region acceleration: noise-robust)\n"
+      "      max_acceleration: 15.0      m/s^2, physical bound on the actor's acceleration\n"
+      "      acceleration: worst_case    the prediction term's a: worst_case = max_acceleration\n"
+      "                                  always (an actor at rest may start moving during the\n"
+      "                                  latency; the estimate sees it 2-3 meshes late); estimate\n"
+      "                                  = the median of the last 5 meshes' largest region\n"
+      "                                  acceleration, bounded by max_acceleration (smaller\n"
+      "                                  margins, light on an actor starting from rest: the demo\n"
+      "                                  measured 183-2982 px over 60 s)\n"
       "    latency:                the margin covers each mesh's age when the frame is shown\n"
       "                            (capture_ns -> render done + display_lag, planned) plus this\n"
       "                            quantile of how much later than planned frames were shown\n"
@@ -115,6 +120,14 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("velocity_uncertainty", &MarginOptions::velocity_uncertainty_mps).min(0),
         yaml::field("head_disagreement", &MarginOptions::head_disagreement_mps).min(0),
         yaml::field("max_acceleration", &MarginOptions::max_acceleration_mps2).range(0.1, 1000),
+        yaml::field("acceleration", &MarginOptions::worst_case_acceleration,
+                    [](const yaml::Node& n) -> Expected<bool> {
+                      auto s = n.as_string();
+                      if (!s) return std::unexpected(s.error());
+                      if (*s == "worst_case") return true;
+                      if (*s == "estimate") return false;
+                      return fail("acceleration: '" + *s + "' (expected worst_case or estimate)");
+                    }),
     };
     static const yaml::Schema<LatencyOptions> latency_schema{
         yaml::field("window", &LatencyOptions::window).range(1, 100000),

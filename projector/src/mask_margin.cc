@@ -34,7 +34,9 @@ Expected<Margin> security_margin(const MarginOptions& options, double latency_s,
   if (can_predict) {
     m.predicted = true;
     const double a =
-        motion->robust_acceleration_mps2.value_or(*motion->max_acceleration_mps2);
+        options.worst_case_acceleration
+            ? options.max_acceleration_mps2
+            : motion->robust_acceleration_mps2.value_or(*motion->max_acceleration_mps2);
     m.acceleration_bounded = a > options.max_acceleration_mps2;
     m.acceleration_mps2 = std::min(a, options.max_acceleration_mps2);
     m.motion_m = 0.5 * m.acceleration_mps2 * latency_s * (latency_s + motion->dt_s) +

@@ -75,7 +75,8 @@ struct MotionOptions {
   // of surface noise it jumps to 15-35 m/s^2 from frame to frame where the simulated arm swing's
   // true peak is ~5 m/s^2 (projector/margin_noise_test.cc). A true acceleration lasts: an arm
   // swing's acceleration phase spans 5-10 frames at 25 Hz, so the median of 5 keeps it while
-  // a spike in one or two frames is dropped.
+  // a spike in one frame is dropped; two consecutive estimates above the median are taken at
+  // once (a projector that keeps up with only a few meshes a second sees an onset in 2-3).
   int acceleration_window = 5;
   Expected<void> validate() const;
 };
@@ -99,8 +100,10 @@ struct MeshMotion {
   // Over regions with an acceleration, the component along the region's mean normal (the full
   // vector where the region has no dominant normal, |mean normal| < 0.5).
   std::optional<double> max_acceleration_mps2;
-  // MotionTracker only: the median of the last acceleration_window max_acceleration_mps2 (the
-  // margin's acceleration, projector/mask_margin.h); unset from estimate_motion.
+  // MotionTracker only: the median of the last acceleration_window max_acceleration_mps2, or the
+  // smaller of the last two when that is larger (an onset both agree on is not waited for; a
+  // one-estimate spike is dropped): the margin's acceleration, projector/mask_margin.h; unset
+  // from estimate_motion.
   std::optional<double> robust_acceleration_mps2;
   Eigen::Vector3f velocity(size_t vertex) const {
     return regions[vertex_region[vertex]].velocity.cast<float>();
