@@ -18,7 +18,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <cstdio>
 #include <map>
+#include <mutex>
+#include <set>
 #include <span>
 #include <thread>
 
@@ -186,6 +189,11 @@ class TrackedCameraTest : public testing::ProcessTest {
     std::atomic<int> good{0}, short_len{0}, bad_sum{0}, bad_type{0}, unknown{0}, decoy{0};
     std::atomic<uint64_t> last_frame{0};
     std::atomic<int64_t> last_send_ns{0};
+    // Frames whose pose this test sent after the end of its arrival window (the sender thread
+    // woken > 80 ms late on a loaded machine): the listener rightly gives that packet to the
+    // next frame, so the test cannot judge those frames and skips them (counted).
+    std::mutex mutex;
+    std::set<uint64_t> sent_late;
   };
   void send_loop(uint64_t first, int delay, std::atomic<bool>& run, Counts& n) {
     const int fd = socket(AF_INET, SOCK_DGRAM, 0);
@@ -206,6 +214,10 @@ class TrackedCameraTest : public testing::ProcessTest {
       if (!run) break;
       send(encode(1, pose_of(f)));
       n.last_send_ns = realtime_ns();
+      if (n.last_send_ns.load() >= clock_.time_of(f + uint64_t(delay) + 1) - 2'000'000) {
+        std::lock_guard lock(n.mutex);
+        n.sent_late.insert(f);
+      }
       n.last_frame = f;
       ++n.good;
       auto b = encode(1, pose_of(f + 1000));
@@ -223,6 +235,10 @@ class TrackedCameraTest : public testing::ProcessTest {
       sleep_to(window + 80'000'000);
       send(encode(1, pose_of(f + 4000)));
       ++n.decoy;
+      if (realtime_ns() >= clock_.time_of(f + uint64_t(delay) + 1) - 2'000'000) {
+        std::lock_guard lock(n.mutex);  // the decoy fell into the next frame's window
+        n.sent_late.insert(f);
+      }
     }
     close(fd);
   }
@@ -318,8 +334,12 @@ TEST_F(TrackedCameraTest, EveryFrameCarriesItsOwnTrackedPose) {
   // Every frame the tracker covered has its calibration, and each is its own frame's pose.
   const uint64_t last = n.last_frame;
   ASSERT_GT(last, first + 30);
-  int checked = 0;
+  int checked = 0, skipped_late = 0;
   for (uint64_t f = first + 3; f + 1 < last; ++f) {
+    if (n.sent_late.count(f) || n.sent_late.count(f - 1)) {  // f's own or f-1's pose came late
+      ++skipped_late;
+      continue;
+    }
     auto it = got.find(f);
     ASSERT_NE(it, got.end()) << "no tracked calibration for frame " << f;
     const studio_CameraCalibration& c = *it->second;
@@ -341,7 +361,9 @@ TEST_F(TrackedCameraTest, EveryFrameCarriesItsOwnTrackedPose) {
     }
     ++checked;
   }
-  EXPECT_GE(checked, 30);
+  EXPECT_GE(checked, 30 - skipped_late);
+  EXPECT_LE(skipped_late, 5) << "the test's own sender was late too often to judge the frames";
+  if (skipped_late) std::printf("%d frames skipped: the test sent their pose late\n", skipped_late);
   ASSERT_TRUE(commands.wait_for_readers(1, 1s));
 
   // The take: per-frame calibration equal to the published one, pixels rendered from that pose.
