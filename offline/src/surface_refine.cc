@@ -7,23 +7,12 @@
 #include <vector>
 
 #include "offline/view_sampling.h"
+#include "parallel_for.h"
 
 namespace studio::offline {
 namespace {
 
-void parallel_for(std::size_t n, int threads, const auto& body) {
-  threads = std::max(1, std::min<int>(threads, int(n / 256) + 1));
-  if (threads == 1) {
-    body(std::size_t{0}, n);
-    return;
-  }
-  std::vector<std::jthread> pool;
-  const std::size_t chunk = (n + std::size_t(threads) - 1) / std::size_t(threads);
-  for (int w = 0; w < threads; ++w) {
-    const std::size_t a = std::min(n, w * chunk), b = std::min(n, a + chunk);
-    pool.emplace_back([&body, a, b] { body(a, b); });
-  }
-}
+using detail::parallel_for;
 
 }  // namespace
 
