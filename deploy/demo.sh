@@ -25,7 +25,8 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
                      deploy/examples/studio/ (the example studio has proj1; a projector without
                      an example config is listed as missing in the report)
   --gui              open the preview window (default: the preview runs headless and takes
-                     one picture, OUT/preview.png, of the first actor mesh it draws)
+                     its pictures at a low rate, one every 2 s, each replacing OUT/preview.png:
+                     the last shows the studio as the run ends, projector screens included)
   --out DIR          where the report goes (default out/demo)
   --keyer K          inprocess (default: capture servers key) or separate (studio-keyer services,
                      deploy/examples/studio/separate-keyer/)
@@ -230,13 +231,15 @@ for ((p = 1; p <= projectors; p++)); do  # the example studio's projectors are p
   fi
 done
 if have $preview_bin preview.yaml; then
-  say "starting the preview ($([ "$gui" = 1 ] && echo window || echo 'headless: one picture, preview.png'))"
+  say "starting the preview ($([ "$gui" = 1 ] && echo window || echo 'headless: a picture every 2 s, preview.png'))"
   if [ "$gui" = 1 ]; then start preview nice:0 "$preview_bin" --config "$cfg/preview.yaml"
   else
-    # One picture of the first actor mesh it draws (textured from the capture servers' image
-    # rings), then it ends by itself (exit status checked with the others).
-    start preview nice:0 "$preview_bin" --config "$cfg/preview.yaml" --headless --frames 1 \
-      --timeout 90 --screenshot "$out/preview.png"
+    # Low-rate pictures (the issue's "taking its pictures at a low rate"): one mesh drawn every
+    # 2 s, textured from the capture servers' image rings with only its own frame's images
+    # requested; each picture replaces preview.png; SIGTERM at the end like the others (exit 0
+    # when it drew a mesh; exit status checked with the others).
+    start preview nice:0 "$preview_bin" --config "$cfg/preview.yaml" --headless --every 2 \
+      --screenshot "$out/preview.png"
   fi
 fi
 

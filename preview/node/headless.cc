@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,7 @@
 
 #include "preview_node.h"
 #include "runtime/metrics.h"
+#include "runtime/signals.h"
 #include "scene_render/egl_context.h"
 #include "scene_render/render_target.h"
 #include "status_ticker.h"
@@ -33,6 +35,15 @@ bool write_png(const std::string& path, const std::vector<uint8_t>& rgba, int w,
   }
 }
 
+// The picture written beside `path` and renamed over it, so a reader never sees half a PNG.
+bool replace_png(const std::string& path, const std::vector<uint8_t>& rgba, int w, int h) {
+  const std::string tmp = path + ".part.png";
+  if (!write_png(tmp, rgba, w, h)) return false;
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  return !ec;
+}
+
 int error(const std::string& message, int status) {
   std::fprintf(stderr, "studio-preview: %s\n", message.c_str());
   return status;
@@ -41,6 +52,8 @@ int error(const std::string& message, int status) {
 }  // namespace
 
 int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
+  // Before any thread (EGL's, DDS's) exists: they inherit the blocked signals.
+  runtime::SignalWatcher signals({SIGINT, SIGTERM});
   if (!options.record.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(options.record, ec);
@@ -65,6 +78,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   po.wait = std::chrono::milliseconds(config.wait_ms);
   po.asset_root = config.asset_root;
   po.overlays = config.overlays;
+  po.prefetch = options.every_s <= 0;  // low-rate pictures ask only for the meshes they draw
   auto pipeline = ViewPipeline::create(node, po);
   if (!pipeline) return error(pipeline.error().message, 1);
   auto target = scene_render::RenderTarget::create(config.width, config.height);
@@ -74,11 +88,23 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   if (!options.record.empty()) log.open(options.record + "/frames.jsonl");
   std::vector<uint8_t> rgba;
   const auto start = Clock::now();
-  const double limit_s = options.duration_s > 0 ? options.duration_s : options.timeout_s;
+  const bool every = options.every_s > 0;
+  const double limit_s = options.duration_s > 0 ? options.duration_s
+                         : every                ? 1e9  // until a signal
+                                                : options.timeout_s;
   const auto deadline = start + std::chrono::duration<double>(limit_s);
+  const auto interval = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(std::max(options.every_s, 0.0)));
+  auto last_drawn = start - interval;
   int drawn = 0;
   while (Clock::now() < deadline) {
+    if (signals.wait(std::chrono::milliseconds(0))) break;
     status->tick();
+    if (every && Clock::now() - last_drawn < interval) {  // not yet: no render, no requests
+      std::this_thread::sleep_for(std::min<Clock::duration>(interval - (Clock::now() - last_drawn),
+                                                            std::chrono::milliseconds(20)));
+      continue;
+    }
     if (options.frames > 0 && !(*pipeline)->has_work()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(3));
       continue;
@@ -92,6 +118,12 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
     }
     if (!r.new_mesh) continue;
     ++drawn;
+    if (every) {
+      last_drawn = Clock::now();
+      target->read_rgba(rgba);
+      if (!replace_png(options.screenshot, rgba, config.width, config.height))
+        return error("cannot write '" + options.screenshot + "'", 1);
+    }
     if (!options.record.empty()) {
       target->read_rgba(rgba);
       const std::string name = std::to_string(drawn) + ".png";
@@ -104,11 +136,11 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
       log << "]}\n";
       log.flush();
     }
-    if (options.duration_s <= 0 && drawn >= options.frames) break;
+    if (!every && options.duration_s <= 0 && drawn >= options.frames) break;
   }
   target->bind();
   target->read_rgba(rgba);
-  const bool written = write_png(options.screenshot, rgba, config.width, config.height);
+  const bool written = replace_png(options.screenshot, rgba, config.width, config.height);
   const PipelineCounts& c = (*pipeline)->counts();
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   const OverlayCounts o = node.overlays().counts();
@@ -136,7 +168,8 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   status->stopping();
   node.stop();
   if (!written) return error("cannot write '" + options.screenshot + "'", 1);
-  if (options.duration_s <= 0 && drawn < options.frames)
+  if (every && drawn == 0) return error("no mesh drawn", 1);
+  if (!every && options.duration_s <= 0 && drawn < options.frames)
     return error("only " + std::to_string(drawn) + " of " + std::to_string(options.frames) +
                      " meshes within " + std::to_string(int(options.timeout_s)) + " s",
                  1);

@@ -13,12 +13,17 @@ struct HeadlessOptions {
   double timeout_s = 30;   // give up waiting for meshes after this long
   double duration_s = 0;   // > 0: draw every mesh for this long (frames ignored), then stop
   double settle_s = 1.0;   // --frames 0: wait this long for the scene before the screenshot
-  std::string record;      // folder: every drawn mesh's frame as <n>.png + frames.jsonl
-  bool json = false;       // summary as one JSON line
+  // > 0: low-rate pictures (the demo's): at most one new mesh drawn every this many seconds,
+  // the screenshot rewritten (atomically) with each; only drawn meshes' images are requested.
+  // Runs for duration_s, or until SIGINT/SIGTERM when that is 0.
+  double every_s = 0;
+  std::string record;  // folder: every drawn mesh's frame as <n>.png + frames.jsonl
+  bool json = false;   // summary as one JSON line
 };
 
-// Exit status: 0 done; 1 runtime failure (no EGL, DDS, fewer meshes than asked in time; the
-// screenshot is still written); 2 bad input.
+// SIGINT/SIGTERM end the run as its deadline does (the screenshot is written).
+// Exit status: 0 done; 1 runtime failure (no EGL, DDS, fewer meshes than asked in time, or
+// with every_s no mesh drawn; the screenshot is still written); 2 bad input.
 int run_headless(const PreviewConfig& config, const HeadlessOptions& options);
 
 }  // namespace studio::preview

@@ -18,8 +18,8 @@ namespace {
 constexpr const char* kUsage =
     R"(usage: studio-preview [--config preview.yaml] [--viewpoint V] [--texturing blend|nearest]
                       [--size WxH] [--overlays LIST]
-       studio-preview --headless --screenshot PNG [--frames N | --duration S] [--record DIR]
-                      [--timeout S] [--settle S]
+       studio-preview --headless --screenshot PNG [--frames N | --duration S] [--every S]
+                      [--record DIR] [--timeout S] [--settle S]
                       [--json] [same options]
 
 The director's preview and control panel: the virtual scene (studio/scene/node) and the live
@@ -52,10 +52,15 @@ Options:
                     the scene and the overlays' topics arrive (default 1)
   --duration S      headless: draw every mesh that arrives for S seconds, then stop (instead
                     of --frames)
+  --every S         headless: low-rate pictures: at most one new mesh every S seconds, the
+                    screenshot rewritten with each (renamed into place, never half written);
+                    only the drawn meshes' images are requested; runs for --duration, else
+                    until SIGINT/SIGTERM; exit 1 if no mesh was drawn
   --json            headless: the summary as one JSON line ("overlays": the heads, cameras,
                     calibrated projectors and thumbnails received)
   --test-script F   GUI: scripted input for tests (gui.h: one action per line)
 
+Headless, SIGINT/SIGTERM end the run like its deadline (the screenshot is written).
 Exit status: 0 done; 1 runtime failure (no display / EGL, DDS, fewer meshes than asked within
 the timeout: the screenshot is still written); 2 bad arguments or config.
 )";
@@ -113,6 +118,8 @@ int run(int argc, char** argv) {
       h.timeout_s = number<double>(a, value(), 0.1, 86400);
     } else if (a == "--duration") {
       h.duration_s = number<double>(a, value(), 0.1, 86400);
+    } else if (a == "--every") {
+      h.every_s = number<double>(a, value(), 0.04, 3600);
     } else if (a == "--json") {
       h.json = true;
     } else if (a == "--test-script") {

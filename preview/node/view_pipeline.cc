@@ -215,19 +215,20 @@ Expected<std::unique_ptr<ViewPipeline>> ViewPipeline::create(PreviewNode& node,
   impl->prefetch->options = options.blend_options;
   // A new mesh's images are requested on arrival, for the last drawn viewpoint; the render
   // thread's own request for its choice then finds them asked (or here).
-  node.set_prefetch([state = impl->prefetch, n = &node](uint64_t, const Eigen::Vector3d& centre) {
-    bool blend;
-    BlendOptions bo;
-    Eigen::Vector3d eye;
-    {
-      std::lock_guard lock(state->mutex);
-      if (!state->have_eye) return std::vector<std::string>{};
-      blend = state->blend;
-      bo = state->options;
-      eye = state->eye;
-    }
-    return choose(n->cameras(), blend, bo, eye, centre).cameras;
-  });
+  if (options.prefetch)
+    node.set_prefetch([state = impl->prefetch, n = &node](uint64_t, const Eigen::Vector3d& centre) {
+      bool blend;
+      BlendOptions bo;
+      Eigen::Vector3d eye;
+      {
+        std::lock_guard lock(state->mutex);
+        if (!state->have_eye) return std::vector<std::string>{};
+        blend = state->blend;
+        bo = state->options;
+        eye = state->eye;
+      }
+      return choose(n->cameras(), blend, bo, eye, centre).cameras;
+    });
   return std::unique_ptr<ViewPipeline>(new ViewPipeline(std::move(impl)));
 }
 

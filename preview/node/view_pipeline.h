@@ -33,6 +33,10 @@ struct PipelineOptions {
   std::chrono::milliseconds wait{200};
   std::string asset_root;  // relative asset paths of scene nodes resolve here
   OverlayOptions overlays;
+  // Request a new mesh's images when it arrives (on the node's loop thread), so that they are
+  // here when it is drawn; false: only when render() takes the mesh (a preview that draws few of
+  // the meshes it receives, and must not make the capture servers answer for the others).
+  bool prefetch = true;
 };
 
 struct FrameReport {
