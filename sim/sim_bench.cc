@@ -12,10 +12,13 @@
 // as a capture server does (capture/sim_source.h), alternating the default and the reference
 // renderer on the same frames (so load hits both alike), and reports each one's thread CPU ms
 // per camera frame and `speedup` = reference / default.
+// BM_CameraFrameBySegment: the same call per segment of the `sequence` motion (does the pose set
+// change the cost?), from frame 0 and from the studio clock's frame numbers the demo renders.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <ctime>
+#include <vector>
 
 #include "sim/cameras.h"
 #include "sim/studio.h"
@@ -92,6 +95,41 @@ void BM_CaptureCameraFastVsReference(benchmark::State& state) {
   state.counters["speedup"] = cpu_reference / cpu_fast;
 }
 BENCHMARK(BM_CaptureCameraFastVsReference)->Unit(benchmark::kMillisecond)->MinTime(3);
+
+// Cost by pose: each camera of the ring as its own one-camera studio (as a capture server has
+// it), frames every 3rd of one 16 s loop of the `sequence` motion, the thread CPU per camera
+// frame summed per segment (walk 0-5 s, turn 5-8, raise hand 8-12, crouch 12-16). Arg 0: frames
+// from 0 (the other cases' frames); 1: from frame 25 * 1'795'000'000 (2026-11-18, a loop
+// start), the studio clock's frame numbers in the demo. Counters: walk, turn, raise, crouch (ms).
+void BM_CameraFrameBySegment(benchmark::State& state) {
+  const int64_t base = state.range(0) ? int64_t{1'795'000'000} * 25 : 0;
+  std::vector<SimulatedStudio> studios;
+  for (const Camera& c : ring_cameras()) {
+    StudioOptions o;
+    o.threads = 1;
+    studios.push_back(SimulatedStudio::create({c}, o).value());
+  }
+  double cpu[4] = {};
+  int64_t n[4] = {};
+  for (auto _ : state) {
+    for (int64_t k = 0; k < 400; k += 3) {
+      const double t = static_cast<double>(k) / 25.0;  // seconds into the loop
+      const int seg = t < 5 ? 0 : t < 8 ? 1 : t < 12 ? 2 : 3;
+      for (const SimulatedStudio& studio : studios) {
+        Image<Rgb8> image;
+        const double t0 = thread_cpu();
+        studio.render(0, base + k, &image, nullptr);
+        cpu[seg] += thread_cpu() - t0;
+        ++n[seg];
+        benchmark::DoNotOptimize(image.data());
+      }
+    }
+  }
+  const char* names[4] = {"walk", "turn", "raise", "crouch"};
+  for (int s = 0; s < 4; ++s) state.counters[names[s]] = 1e3 * cpu[s] / double(n[s]);
+}
+BENCHMARK(BM_CameraFrameBySegment)->ArgName("demo_frames")->Arg(0)->Arg(1)->Iterations(2)->Unit(
+    benchmark::kMillisecond);
 
 // The naive renderer: per pixel, the world ray against every part; single thread.
 void naive_frame(const SimulatedStudio& studio, int64_t frame, std::vector<Image<Rgb8>>* images,
