@@ -22,9 +22,9 @@
 #include "scene/view.h"
 #include "sim/frame_code.h"
 #include "sim/studio.h"
+#include "testing/studio_fixture.h"
 #include "wire/endpoint.h"
 #include "wire/sample.h"
-#include "testing/studio_fixture.h"
 
 namespace studio::preview::testing {
 namespace {
@@ -273,12 +273,12 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
                        2 * std::atan(0.5 * kHeight / focal) * 180 / std::numbers::pi};
   std::map<std::string, Process*> previews;
   for (const std::string mode : {"nearest", "blend"})
-    previews[mode] = &spawn(
-        mode, "preview/studio-preview",
-        {"--headless", "--config", preview_config(mode, 1000), "--viewpoint", to_string(view),
-         "--texturing", mode, "--size", std::to_string(kWidth) + "x" + std::to_string(kHeight),
-         "--frames", "30", "--timeout", "120", "--record", (dir_ / mode).string(), "--screenshot",
-         (dir_ / (mode + ".png")).string()});
+    previews[mode] = &spawn(mode, "preview/studio-preview",
+                            {"--headless", "--config", preview_config(mode, 1000), "--viewpoint",
+                             to_string(view), "--texturing", mode, "--overlays", "none", "--size",
+                             std::to_string(kWidth) + "x" + std::to_string(kHeight), "--frames",
+                             "30", "--timeout", "120", "--record", (dir_ / mode).string(),
+                             "--screenshot", (dir_ / (mode + ".png")).string()});
   for (auto& [mode, p] : previews) {
     const auto code = p->wait_exit(std::chrono::seconds(150));
     ASSERT_TRUE(code.has_value()) << mode;
@@ -307,12 +307,18 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
   ASSERT_GE(nearest.frames, 10);
   ASSERT_GE(blend.frames, 10);
   EXPECT_GT(blend.psnr(), nearest.psnr());
-  // Issue 16 asks >= 28 dB; measured 19-21 dB here (run to run: the poses differ). Not reached:
-  // ~60-70 % of the error is in pixels of one silhouette only, the visual hull's geometry (the
+  // Only the actor is drawn (--overlays none): the camera frusta, on by default since the
+  // overlays came, counted as rendered and put 39 % of the pixels outside the true silhouette
+  // (blend 11.8-12.2 dB); the actor's own excess is 7-13 % of the pixels in both.
+  EXPECT_LT(double(blend.rendered_only), 0.25 * double(blend.both));
+  // Issue 16 asks >= 28 dB; measured 18.8-23.8 dB here (4 runs, 2026-11-26; run to run the
+  // poses differ). Not reached:
+  // 50-80 % of the error is in pixels of one silhouette only, the visual hull's geometry (the
   // hull of ring cameras 45 degrees apart exceeds a round body between cameras; its facets cut
-  // inside it elsewhere). preview_quality_test separates geometry from texturing: with the
-  // actor's true surface the same blend reaches 27.5 dB. Printed above and reported, not
-  // asserted.
+  // inside it elsewhere), the rest in the interior, which the hull's depth misregisters.
+  // preview_quality_test separates geometry from texturing: with the actor's true surface the
+  // same blend reaches 28.2 dB; preview_error_sources_test measures what limits the hull.
+  // Printed above and reported, not asserted.
 }
 
 }  // namespace
