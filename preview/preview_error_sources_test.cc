@@ -179,7 +179,7 @@ TEST_F(PreviewErrorSourcesTest, MoreCamerasNotAFinerGridShrinkTheHullsExcess) {
   EXPECT_GT(blends[3].psnr(), blends[2].psnr() + 1.0);
 }
 
-// The brief's shape prior (testing/shape_prior.h: 10 Laplacian steps, lambda 0.5, the rims of
+// A shape prior (testing/shape_prior.h: 10 Laplacian steps, lambda 0.5, the rims of
 // the cameras' silhouettes anchored) on the visual hull, anchored at the texturing cameras'
 // rims (what a node would have) or at every camera's. Measured (2026-11-26, blend; unseen
 // points magenta as in this file's other tests, so 0.2-0.3 dB below preview_quality_test's):

@@ -1,6 +1,6 @@
 #pragma once
 // A shape prior on the hull mesh before it is textured, as an analysis aid for
-// preview_error_sources_test (issue 16, "quality against truth"; the brief's direction, measured
+// preview_error_sources_test (issue 16, "quality against truth"; a direction measured
 // and left out of the node): Laplacian steps x += lambda (mean of the neighbours - x) with the
 // rim vertices anchored, as the offline surface stage does (docs/offline.md).
 //
