@@ -271,14 +271,20 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
                                               kWidth, kHeight, focal);
   const Viewpoint view{centre, target,
                        2 * std::atan(0.5 * kHeight / focal) * 180 / std::numbers::pi};
+  // nearest; blend (carving against every camera's mask of the frame, the default); keys: blend
+  // carving against its three cameras' keys only (carve_masks: false).
   std::map<std::string, Process*> previews;
-  for (const std::string mode : {"nearest", "blend"})
-    previews[mode] = &spawn(mode, "preview/studio-preview",
-                            {"--headless", "--config", preview_config(mode, 1000), "--viewpoint",
-                             to_string(view), "--texturing", mode, "--overlays", "none", "--size",
-                             std::to_string(kWidth) + "x" + std::to_string(kHeight), "--frames",
-                             "30", "--timeout", "120", "--record", (dir_ / mode).string(),
-                             "--screenshot", (dir_ / (mode + ".png")).string()});
+  for (const std::string name : {"nearest", "blend", "keys"}) {
+    const std::string mode = name == "nearest" ? "nearest" : "blend";
+    previews[name] =
+        &spawn(name, "preview/studio-preview",
+               {"--headless", "--config",
+                preview_config(name, 1000, name == "keys" ? "carve_masks: false\n" : ""),
+                "--viewpoint", to_string(view), "--texturing", mode, "--overlays", "none", "--size",
+                std::to_string(kWidth) + "x" + std::to_string(kHeight), "--frames", "30",
+                "--timeout", "120", "--record", (dir_ / name).string(), "--screenshot",
+                (dir_ / (name + ".png")).string()});
+  }
   for (auto& [mode, p] : previews) {
     const auto code = p->wait_exit(std::chrono::seconds(150));
     ASSERT_TRUE(code.has_value()) << mode;
@@ -290,12 +296,53 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
   const Score nearest =
       score(read_records(dir_ / "nearest" / "frames.jsonl"), dir_ / "nearest", truth);
   const Score blend = score(read_records(dir_ / "blend" / "frames.jsonl"), dir_ / "blend", truth);
+  const Score keys = score(read_records(dir_ / "keys" / "frames.jsonl"), dir_ / "keys", truth);
   std::printf(
       "held-out camera, union of silhouettes: nearest %.2f dB (%d frames), blend %.2f dB "
-      "(%d frames)\n",
-      nearest.psnr(), nearest.frames, blend.psnr(), blend.frames);
+      "(%d frames), blend carving with its cameras' keys only %.2f dB (%d frames)\n",
+      nearest.psnr(), nearest.frames, blend.psnr(), blend.frames, keys.psnr(), keys.frames);
+  // The masks that carved each drawn mesh (frames.jsonl "carving_masks"): every camera's mask of
+  // the mesh's frame reaches the blend (best-effort: one may be lost), none the others.
+  auto carving = [&](const std::string& name) {
+    std::vector<int> out;
+    std::ifstream in(dir_ / name / "frames.jsonl");
+    const std::regex re(R"re("carving_masks":(\d+))re");
+    for (std::string line; std::getline(in, line);) {
+      std::smatch m;
+      if (std::regex_search(line, m, re)) out.push_back(std::stoi(m[1]));
+    }
+    return out;
+  };
+  // Paired: the meshes both blends drew (same source frame).
+  std::vector<Record> blend_records = read_records(dir_ / "blend" / "frames.jsonl"),
+                      keys_records = read_records(dir_ / "keys" / "frames.jsonl"), both_b, both_k;
+  for (const Record& b : blend_records)
+    for (const Record& k : keys_records)
+      if (b.source_frame == k.source_frame && b.textured && k.textured) {
+        both_b.push_back(b);
+        both_k.push_back(k);
+      }
+  const Score paired_blend = score(both_b, dir_ / "blend", truth),
+              paired_keys = score(both_k, dir_ / "keys", truth);
+  std::printf(
+      "the same %d meshes: carving against every mask %.2f dB (only rendered %llu px, only true "
+      "%llu), against the keys only %.2f dB (%llu, %llu)\n",
+      paired_blend.frames, paired_blend.psnr(), (unsigned long long)paired_blend.rendered_only,
+      (unsigned long long)paired_blend.true_only, paired_keys.psnr(),
+      (unsigned long long)paired_keys.rendered_only, (unsigned long long)paired_keys.true_only);
+  // Measured (3 runs, 2026-11-26): +0.37 / +0.55 / +0.67 dB, 25 % less drawn outside the true
+  // silhouette (preview_quality_test: +0.33 dB in process, deterministic).
+  if (paired_blend.frames >= 3)
+    EXPECT_LT(paired_blend.rendered_only, paired_keys.rendered_only);
+  else
+    std::printf("fewer than 3 meshes drawn by both blends: not compared\n");
+  const auto blend_masks = carving("blend"), keys_masks = carving("keys");
+  ASSERT_FALSE(blend_masks.empty());
+  EXPECT_GE(std::count(blend_masks.begin(), blend_masks.end(), 9),
+            std::ptrdiff_t(0.9 * double(blend_masks.size())));
+  EXPECT_EQ(std::count(keys_masks.begin(), keys_masks.end(), 0), std::ptrdiff_t(keys_masks.size()));
   // Where the error is: the share of the summed squared error in each part of the union.
-  for (const Score* sc : {&nearest, &blend})
+  for (const Score* sc : {&nearest, &blend, &keys})
     std::printf(
         "  pixels in both silhouettes %llu (%.2f dB there, %.0f %% of the error), only rendered "
         "%llu (%.0f %%), only true %llu (%.0f %%)\n",

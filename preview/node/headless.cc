@@ -65,6 +65,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   po.wait = std::chrono::milliseconds(config.wait_ms);
   po.asset_root = config.asset_root;
   po.overlays = config.overlays;
+  po.carve_all_masks = config.carve_masks;
   auto pipeline = ViewPipeline::create(node, po);
   if (!pipeline) return error(pipeline.error().message, 1);
   auto target = scene_render::RenderTarget::create(config.width, config.height);
@@ -101,7 +102,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
           << ",\"textured\":" << (r.textured ? "true" : "false") << ",\"cameras\":[";
       for (std::size_t i = 0; i < r.cameras.size(); ++i)
         log << (i ? "," : "") << "\"" << r.cameras[i] << "\"";
-      log << "]}\n";
+      log << "],\"carving_masks\":" << r.carving_masks << "}\n";
       log.flush();
     }
     if (options.duration_s <= 0 && drawn >= options.frames) break;

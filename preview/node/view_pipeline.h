@@ -33,6 +33,9 @@ struct PipelineOptions {
   std::chrono::milliseconds wait{200};
   std::string asset_root;  // relative asset paths of scene nodes resolve here
   OverlayOptions overlays;
+  // Blend: carve the hull against every camera's actor mask of the mesh's frame
+  // (studio/camera/mask), not only the three texturing cameras' keys.
+  bool carve_all_masks = true;
 };
 
 struct FrameReport {
@@ -41,6 +44,7 @@ struct FrameReport {
   uint64_t source_frame = 0;         // frame of the masks that built the drawn mesh
   std::vector<std::string> cameras;  // texturing cameras (ids), with their weights
   std::vector<float> weights;
+  int carving_masks = 0;  // blend: the cameras' masks of the mesh's frame carving it
 };
 
 // meshes = drawn meshes = textured + untextured; untextured = late (no reply within `wait`) +

@@ -201,6 +201,9 @@ struct Scoring {
   // cameras (the images a node would have), or of every studio camera when shape_all_cameras.
   ShapePriorOptions shape;
   bool shape_all_cameras = false;
+  // Blend's carving also against every studio camera's mask (the true masks the hull was built
+  // from; ActorTexturer::set_carving_masks).
+  bool carve_all_cameras = false;
 };
 
 // Scores every variant over `frames` (a current GL context is needed).
@@ -253,6 +256,11 @@ inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<V
         apply_shape_prior(drawn, kv, setup.shape);
       }
       EXPECT_TRUE(texturer.set_mesh(drawn).has_value());
+      std::vector<ActorTexturer::CarvingMask> carving;
+      if (setup.carve_all_cameras)
+        for (std::size_t c = 0; c < s.cameras.size(); ++c)
+          carving.push_back({&s.cameras[c], masks[c].data()});
+      EXPECT_TRUE(texturer.set_carving_masks(carving).has_value());
       std::array<float, ActorTexturer::kMaxCameras> w{};
       for (std::size_t i = 0; i < chosen.size(); ++i) {
         w[i] = float(chosen[i].weight);

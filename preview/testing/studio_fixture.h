@@ -110,9 +110,11 @@ class PreviewStudioTest : public ::testing::Test {
   }
 
   // Writes preview.yaml; returns its path.
-  std::string preview_config(const std::string& instance, int wait_ms = 400) {
+  // `extra`: more preview.yaml lines.
+  std::string preview_config(const std::string& instance, int wait_ms = 400,
+                             const std::string& extra = "") {
     const auto path = dir_ / (instance + ".yaml");
-    std::ofstream(path) << "instance: " << instance << "\nwait_ms: " << wait_ms << "\n";
+    std::ofstream(path) << "instance: " << instance << "\nwait_ms: " << wait_ms << "\n" << extra;
     return path.string();
   }
 
