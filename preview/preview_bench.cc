@@ -8,6 +8,8 @@
 // BM_PreviewOverlays: the nearest-camera frame plus every overlay (the five cameras' frusta, a
 // projector's frustum and its screen showing a 160x90 thumbnail, a head marker); its baseline
 // is BM_PreviewFrame/cameras:1/image_w:352 of the same run.
+// masks:5: the blend also carves against the five cameras' actor masks (the node's carve_masks;
+// ActorTexturer::set_carving_masks); per new mesh that adds the masks' upload.
 #include <benchmark/benchmark.h>
 
 #define GL_GLEXT_PROTOTYPES 1
@@ -35,6 +37,7 @@ constexpr int kW = 1280, kH = 720;
 struct Samples {
   std::vector<Camera> cameras;
   std::vector<Image<Rgb8>> images;
+  std::vector<Mask> masks;
   scene::ActorMesh mesh;
 };
 
@@ -58,7 +61,7 @@ Samples make_samples(int width) {
   sim::StudioOptions o;
   o.threads = 2;
   auto studio = sim::SimulatedStudio::create(s.cameras, o).value();
-  const sim::FrameTruth truth = studio.render_all(100, &s.images, nullptr);
+  const sim::FrameTruth truth = studio.render_all(100, &s.images, &s.masks);
   const sim::TriangleMesh m = truth.body.mesh(24);
   s.mesh.actor_id = "actor0";
   s.mesh.vertices = m.vertices;
@@ -99,13 +102,16 @@ scene_render::View view() {
   return v;
 }
 
-void upload(Fixture& f, const Samples& s, int cameras) {
+void upload(Fixture& f, const Samples& s, int cameras, int masks) {
   (void)f.texturer.set_mesh(s.mesh);
   // cam0, cam1, cam4: the three nearest of the view (camera_select.h's choice for it).
   const int order[3] = {0, 1, 4};
   for (int i = 0; i < cameras; ++i)
     (void)f.texturer.set_camera(i, s.cameras[order[i]],
                                 reinterpret_cast<const uint8_t*>(s.images[order[i]].data()));
+  std::vector<preview::ActorTexturer::CarvingMask> carving;
+  for (int i = 0; i < masks; ++i) carving.push_back({&s.cameras[i], s.masks[i].data()});
+  (void)f.texturer.set_carving_masks(carving);
 }
 
 // cameras 0: the scene alone; 1: nearest; 3: the blend.
@@ -114,7 +120,7 @@ void BM_PreviewFrame(benchmark::State& state) {
   const int cameras = int(state.range(0));
   const Samples& s = f.samples.at(int(state.range(1)));
   f.target.bind();
-  upload(f, s, std::max(cameras, 1));
+  upload(f, s, std::max(cameras, 1), int(state.range(2)));
   const scene_render::View v = view();
   std::array<float, 3> w{};
   if (cameras == 1) w = {1, 0, 0};
@@ -133,12 +139,14 @@ void BM_PreviewFrame(benchmark::State& state) {
   state.counters["triangles"] = double(s.mesh.triangles.size());
 }
 BENCHMARK(BM_PreviewFrame)
-    ->ArgNames({"cameras", "image_w"})
-    ->Args({0, 352})
-    ->Args({1, 352})
-    ->Args({3, 352})
-    ->Args({1, 704})
-    ->Args({3, 704})
+    ->ArgNames({"cameras", "image_w", "masks"})
+    ->Args({0, 352, 0})
+    ->Args({1, 352, 0})
+    ->Args({3, 352, 0})
+    ->Args({3, 352, 5})
+    ->Args({1, 704, 0})
+    ->Args({3, 704, 0})
+    ->Args({3, 704, 5})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -149,16 +157,18 @@ void BM_PreviewNewMesh(benchmark::State& state) {
   const Samples& s = f.samples.at(int(state.range(1)));
   for (auto _ : state) {
     f.target.bind();
-    upload(f, s, cameras);
+    upload(f, s, cameras, int(state.range(2)));
     glFinish();
   }
 }
 BENCHMARK(BM_PreviewNewMesh)
-    ->ArgNames({"cameras", "image_w"})
-    ->Args({1, 352})
-    ->Args({3, 352})
-    ->Args({1, 704})
-    ->Args({3, 704})
+    ->ArgNames({"cameras", "image_w", "masks"})
+    ->Args({1, 352, 0})
+    ->Args({3, 352, 0})
+    ->Args({3, 352, 5})
+    ->Args({1, 704, 0})
+    ->Args({3, 704, 0})
+    ->Args({3, 704, 5})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -167,7 +177,7 @@ void BM_PreviewOverlays(benchmark::State& state) {
   Fixture& f = fixture();
   const Samples& s = f.samples.at(352);
   f.target.bind();
-  upload(f, s, 1);
+  upload(f, s, 1, 0);
   auto overlay = preview::OverlayRenderer::create().value();
   std::vector<uint8_t> thumb(160 * 90 * 3);
   for (std::size_t i = 0; i < thumb.size(); ++i) thumb[i] = uint8_t(i * 7);

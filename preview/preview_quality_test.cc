@@ -24,14 +24,16 @@ namespace {
 class PreviewQualityTest : public HeldOutTest {
  protected:
   // Nearest and blend over kFrames, printed with where the blend's error is.
-  static std::pair<Breakdown, Breakdown> run(bool hull) {
+  static std::pair<Breakdown, Breakdown> run(bool hull, bool every_mask = false) {
     Scoring s;
     s.hull = hull;
+    s.carve_all_cameras = every_mask;
     s.verbose = true;
     const auto r =
         evaluate(s, {{"nearest", TextureMode::nearest}, {"blend", TextureMode::blend}}, kFrames);
-    std::printf("%s: nearest %s\n%s: blend   %s\n", hull ? "visual hull" : "true surface",
-                r[0].line().c_str(), hull ? "visual hull" : "true surface", r[1].line().c_str());
+    const char* what = !hull ? "true surface" : every_mask ? "hull, every mask" : "hull, keys only";
+    std::printf("%s: nearest %s\n%s: blend   %s\n", what, r[0].line().c_str(), what,
+                r[1].line().c_str());
     return {r[0], r[1]};
   }
 };
@@ -45,11 +47,19 @@ TEST_F(PreviewQualityTest, WithTheTrueSurfaceTheBlendReaches28dB) {
 }
 
 // Measured 20.8 dB (nearest 15.8): two thirds of the error is in pixels of one silhouette only,
-// most of it the hull's excess (rendered where the held-out camera sees the backing).
+// most of it the hull's excess (rendered where the held-out camera sees the backing). Carving
+// against every camera's mask (the node's default, carve_masks; the image-based visual hull of
+// all nine at their pixel resolution instead of the hull's 31 mm grid) as well as the three
+// texturing cameras' keys: 21.1 dB, excess 2 899 -> 2 483 px, interior 25.8 -> 26.3 dB. The
+// issue's 28 dB is out of reach of the visual hull of these cameras: docs/preview.md,
+// preview_error_sources_test.
 TEST_F(PreviewQualityTest, WithTheVisualHullTheBlendBeatsNearest) {
-  const auto [nearest, blend] = run(true);
+  const auto [nearest, keys] = run(true);
+  const auto [nearest_too, blend] = run(true, true);
   EXPECT_GT(blend.psnr(), nearest.psnr() + 3);
-  EXPECT_GE(blend.psnr(), 20.0);
+  EXPECT_GE(blend.psnr(), 21.0);
+  EXPECT_GT(blend.psnr(), keys.psnr() + 0.2);
+  EXPECT_LT(blend.rendered_only.px, keys.rendered_only.px);
 }
 
 }  // namespace

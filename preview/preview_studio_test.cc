@@ -22,9 +22,9 @@
 #include "scene/view.h"
 #include "sim/frame_code.h"
 #include "sim/studio.h"
+#include "testing/studio_fixture.h"
 #include "wire/endpoint.h"
 #include "wire/sample.h"
-#include "testing/studio_fixture.h"
 
 namespace studio::preview::testing {
 namespace {
@@ -271,14 +271,20 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
                                               kWidth, kHeight, focal);
   const Viewpoint view{centre, target,
                        2 * std::atan(0.5 * kHeight / focal) * 180 / std::numbers::pi};
+  // nearest; blend (carving against every camera's mask of the frame, the default); keys: blend
+  // carving against its three cameras' keys only (carve_masks: false).
   std::map<std::string, Process*> previews;
-  for (const std::string mode : {"nearest", "blend"})
-    previews[mode] = &spawn(
-        mode, "preview/studio-preview",
-        {"--headless", "--config", preview_config(mode, 1000), "--viewpoint", to_string(view),
-         "--texturing", mode, "--size", std::to_string(kWidth) + "x" + std::to_string(kHeight),
-         "--frames", "30", "--timeout", "120", "--record", (dir_ / mode).string(), "--screenshot",
-         (dir_ / (mode + ".png")).string()});
+  for (const std::string name : {"nearest", "blend", "keys"}) {
+    const std::string mode = name == "nearest" ? "nearest" : "blend";
+    previews[name] =
+        &spawn(name, "preview/studio-preview",
+               {"--headless", "--config",
+                preview_config(name, 1000, name == "keys" ? "carve_masks: false\n" : ""),
+                "--viewpoint", to_string(view), "--texturing", mode, "--overlays", "none", "--size",
+                std::to_string(kWidth) + "x" + std::to_string(kHeight), "--frames", "30",
+                "--timeout", "120", "--record", (dir_ / name).string(), "--screenshot",
+                (dir_ / (name + ".png")).string()});
+  }
   for (auto& [mode, p] : previews) {
     const auto code = p->wait_exit(std::chrono::seconds(150));
     ASSERT_TRUE(code.has_value()) << mode;
@@ -290,12 +296,54 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
   const Score nearest =
       score(read_records(dir_ / "nearest" / "frames.jsonl"), dir_ / "nearest", truth);
   const Score blend = score(read_records(dir_ / "blend" / "frames.jsonl"), dir_ / "blend", truth);
+  const Score keys = score(read_records(dir_ / "keys" / "frames.jsonl"), dir_ / "keys", truth);
   std::printf(
       "held-out camera, union of silhouettes: nearest %.2f dB (%d frames), blend %.2f dB "
-      "(%d frames)\n",
-      nearest.psnr(), nearest.frames, blend.psnr(), blend.frames);
+      "(%d frames), blend carving with its cameras' keys only %.2f dB (%d frames)\n",
+      nearest.psnr(), nearest.frames, blend.psnr(), blend.frames, keys.psnr(), keys.frames);
+  // The masks that carved each drawn mesh (frames.jsonl "carving_masks"): every camera's mask of
+  // the mesh's frame reaches the blend (best-effort: one may be lost), none the others.
+  auto carving = [&](const std::string& name) {
+    std::vector<int> out;
+    std::ifstream in(dir_ / name / "frames.jsonl");
+    const std::regex re(R"re("carving_masks":(\d+))re");
+    for (std::string line; std::getline(in, line);) {
+      std::smatch m;
+      if (std::regex_search(line, m, re)) out.push_back(std::stoi(m[1]));
+    }
+    return out;
+  };
+  // Paired: the meshes both blends drew (same source frame).
+  std::vector<Record> blend_records = read_records(dir_ / "blend" / "frames.jsonl"),
+                      keys_records = read_records(dir_ / "keys" / "frames.jsonl"), both_b, both_k;
+  for (const Record& b : blend_records)
+    for (const Record& k : keys_records)
+      if (b.source_frame == k.source_frame && b.textured && k.textured) {
+        both_b.push_back(b);
+        both_k.push_back(k);
+      }
+  const Score paired_blend = score(both_b, dir_ / "blend", truth),
+              paired_keys = score(both_k, dir_ / "keys", truth);
+  std::printf(
+      "the same %d meshes: carving against every mask %.2f dB (only rendered %llu px, only true "
+      "%llu), against the keys only %.2f dB (%llu, %llu)\n",
+      paired_blend.frames, paired_blend.psnr(), (unsigned long long)paired_blend.rendered_only,
+      (unsigned long long)paired_blend.true_only, paired_keys.psnr(),
+      (unsigned long long)paired_keys.rendered_only, (unsigned long long)paired_keys.true_only);
+  // Measured (3 runs, 2026-11-26): +0.37 / +0.55 / +0.67 dB, 25 % less drawn outside the true
+  // silhouette (preview_quality_test: +0.33 dB in process, deterministic).
+  if (paired_blend.frames >= 3)
+    EXPECT_LT(paired_blend.rendered_only, paired_keys.rendered_only);
+  else
+    std::printf("fewer than 3 meshes drawn by both blends: not compared\n");
+  const auto blend_masks = carving("blend"), keys_masks = carving("keys");
+  ASSERT_FALSE(blend_masks.empty());
+  // Measured: 9 of 9 in every record of 10 runs; best-effort under load may lose one.
+  EXPECT_GE(std::count_if(blend_masks.begin(), blend_masks.end(), [](int n) { return n >= 8; }),
+            std::ptrdiff_t(0.8 * double(blend_masks.size())));
+  EXPECT_EQ(std::count(keys_masks.begin(), keys_masks.end(), 0), std::ptrdiff_t(keys_masks.size()));
   // Where the error is: the share of the summed squared error in each part of the union.
-  for (const Score* sc : {&nearest, &blend})
+  for (const Score* sc : {&nearest, &blend, &keys})
     std::printf(
         "  pixels in both silhouettes %llu (%.2f dB there, %.0f %% of the error), only rendered "
         "%llu (%.0f %%), only true %llu (%.0f %%)\n",
@@ -307,12 +355,18 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
   ASSERT_GE(nearest.frames, 10);
   ASSERT_GE(blend.frames, 10);
   EXPECT_GT(blend.psnr(), nearest.psnr());
-  // Issue 16 asks >= 28 dB; measured 19-21 dB here (run to run: the poses differ). Not reached:
-  // ~60-70 % of the error is in pixels of one silhouette only, the visual hull's geometry (the
+  // Only the actor is drawn (--overlays none): the camera frusta, on by default since the
+  // overlays came, counted as rendered and put 39 % of the pixels outside the true silhouette
+  // (blend 11.8-12.2 dB); the actor's own excess is 7-13 % of the pixels in both.
+  EXPECT_LT(double(blend.rendered_only), 0.25 * double(blend.both));
+  // Issue 16 asks >= 28 dB; measured 19.5-24.7 dB here (9 runs, 2026-11-26; run to run the
+  // poses differ). Not reached:
+  // 50-80 % of the error is in pixels of one silhouette only, the visual hull's geometry (the
   // hull of ring cameras 45 degrees apart exceeds a round body between cameras; its facets cut
-  // inside it elsewhere). preview_quality_test separates geometry from texturing: with the
-  // actor's true surface the same blend reaches 27.5 dB. Printed above and reported, not
-  // asserted.
+  // inside it elsewhere), the rest in the interior, which the hull's depth misregisters.
+  // preview_quality_test separates geometry from texturing: with the actor's true surface the
+  // same blend reaches 28.2 dB; preview_error_sources_test measures what limits the hull.
+  // Printed above and reported, not asserted.
 }
 
 }  // namespace

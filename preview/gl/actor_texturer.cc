@@ -5,6 +5,7 @@
 #include <GL/gl.h>
 #include <GL/glext.h>
 
+#include <algorithm>
 #include <string>
 
 #include "gl_program.h"
@@ -59,6 +60,9 @@ uniform vec3 centre[3];
 uniform sampler2D colour0, colour1, colour2;
 uniform sampler2D depth0, depth1, depth2;
 uniform float key_threshold;
+uniform int mask_count;
+uniform mat4 mask_clip[16];
+uniform sampler2DArray masks;
 out vec4 frag;
 vec3 shade(vec3 c) {
   vec3 nn = normalize(n);
@@ -86,6 +90,18 @@ bool outside(int i, sampler2D colour, vec3 x) {
   vec2 uv, st;
   if (!project(i, x, uv, st)) return false;
   return backing(texture(colour, uv));
+}
+// x is outside one of the carving masks (set_carving_masks) that sees it.
+bool outside_masks(vec3 x) {
+  for (int i = 0; i < mask_count; ++i) {
+    vec4 q = mask_clip[i] * vec4(x, 1);
+    if (q.w <= 0.0) continue;
+    vec2 ndc = q.xy / q.w;
+    if (any(greaterThan(abs(ndc), vec2(1.0)))) continue;
+    vec2 st = ndc * 0.5 + 0.5;
+    if (texture(masks, vec3(st.x, 1.0 - st.y, float(i))).r < key_threshold) return true;
+  }
+  return false;
 }
 void add(int i, sampler2D colour, sampler2D depth, vec3 x, float tol, inout vec3 sum,
          inout float wsum, inout int keyed) {
@@ -121,7 +137,8 @@ void main() {
     bool found = false;
     for (int s = 0; s < carve_steps; ++s) {
       vec3 y = p + d * (float(s) * carve_step);
-      if (!outside(0, colour0, y) && !outside(1, colour1, y) && !outside(2, colour2, y)) {
+      if (!outside(0, colour0, y) && !outside(1, colour1, y) && !outside(2, colour2, y) &&
+          !outside_masks(y)) {
         x = y;
         carved = float(s) * carve_step;
         found = true;
@@ -195,6 +212,9 @@ struct ActorTexturer::Impl {
   GLsizei index_count = 0;
   std::vector<float> interleaved;
   std::array<Slot, kMaxCameras> slots;
+  GLuint mask_array = 0;
+  int mask_count = 0, mask_width = 0, mask_height = 0, mask_layers = 0;
+  std::vector<Eigen::Matrix4d> mask_clip;
 
   ~Impl() {
     for (auto& s : slots) {
@@ -203,6 +223,7 @@ struct ActorTexturer::Impl {
       glDeleteFramebuffers(1, &s.fbo);
       glDeleteRenderbuffers(1, &s.depth_rb);
     }
+    glDeleteTextures(1, &mask_array);
     glDeleteBuffers(1, &vbo);
     glDeleteBuffers(1, &ebo);
     glDeleteVertexArrays(1, &vao);
@@ -337,6 +358,43 @@ Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const u
   return {};
 }
 
+Expected<void> ActorTexturer::set_carving_masks(const std::vector<CarvingMask>& masks) {
+  Impl& r = *impl_;
+  if (int(masks.size()) > kMaxMasks) return fail("actor texturer: more than 16 carving masks");
+  for (const CarvingMask& m : masks)
+    if (!m.camera || !m.mask || m.camera->width != masks[0].camera->width ||
+        m.camera->height != masks[0].camera->height)
+      return fail("actor texturer: carving masks need a camera, a mask and one size");
+  r.mask_count = 0;
+  r.mask_clip.clear();
+  if (masks.empty()) return {};
+  const int w = masks[0].camera->width, h = masks[0].camera->height, n = int(masks.size());
+  if (!r.mask_array) glGenTextures(1, &r.mask_array);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, r.mask_array);
+  if (w != r.mask_width || h != r.mask_height || n > r.mask_layers) {
+    r.mask_width = w;
+    r.mask_height = h;
+    r.mask_layers = std::max(n, r.mask_layers);
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R8, w, h, r.mask_layers, 0, GL_RED, GL_UNSIGNED_BYTE,
+                 nullptr);
+    for (GLenum p : {GL_TEXTURE_MIN_FILTER, GL_TEXTURE_MAG_FILTER})
+      glTexParameteri(GL_TEXTURE_2D_ARRAY, p, GL_LINEAR);
+    for (GLenum p : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T})
+      glTexParameteri(GL_TEXTURE_2D_ARRAY, p, GL_CLAMP_TO_EDGE);
+  }
+  std::vector<uint8_t> layer(std::size_t(w) * h);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  for (int i = 0; i < n; ++i) {
+    for (std::size_t k = 0; k < layer.size(); ++k) layer[k] = masks[i].mask[k] ? 255 : 0;
+    glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, i, w, h, 1, GL_RED, GL_UNSIGNED_BYTE,
+                    layer.data());
+    r.mask_clip.push_back(clip_from_camera(*masks[i].camera) * cam_from_world(*masks[i].camera));
+  }
+  glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+  r.mask_count = n;
+  return {};
+}
+
 void ActorTexturer::draw(const DrawView& view, TextureMode mode,
                          const std::array<float, kMaxCameras>& weights, double angle_threshold) {
   Impl& r = *impl_;
@@ -384,7 +442,14 @@ void ActorTexturer::draw(const DrawView& view, TextureMode mode,
     glBindTexture(GL_TEXTURE_2D, s.depth);
     glUniform1i(at("depth" + std::to_string(i)), 2 * i + 1);
   }
+  glUniform1i(at("mask_count"), m == 2 ? r.mask_count : 0);
+  for (int i = 0; i < r.mask_count; ++i)
+    gl::set_matrix(p, ("mask_clip[" + std::to_string(i) + "]").c_str(), r.mask_clip[i]);
+  glActiveTexture(GL_TEXTURE0 + 2 * kMaxCameras);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, r.mask_array);
+  glUniform1i(at("masks"), 2 * kMaxCameras);
   r.draw_mesh();
+  glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
   glDisable(GL_CULL_FACE);
   glActiveTexture(GL_TEXTURE0);
 }

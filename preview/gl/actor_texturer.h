@@ -87,6 +87,16 @@ class ActorTexturer {
   // row first). Renders the slot's visibility depth map of the current mesh: call after
   // set_mesh().
   Expected<void> set_camera(int slot, const Camera& camera, const uint8_t* rgb);
+  // Blend mode's carving also against these silhouettes (up to kMaxMasks cameras, one size;
+  // mask: width*height bytes, top row first, 0 backing, else actor): the march stops at the
+  // first point inside every selected camera's key and every mask here, the image-based visual
+  // hull of all of them. An empty list: the selected cameras' keys only.
+  static constexpr int kMaxMasks = 16;
+  struct CarvingMask {
+    const Camera* camera = nullptr;
+    const uint8_t* mask = nullptr;
+  };
+  Expected<void> set_carving_masks(const std::vector<CarvingMask>& masks);
   // Draws the mesh into the bound framebuffer (viewport set to width x height). weights[slot] > 0
   // selects a slot (nearest: slot 0 only); blend: per-point ULR weights with threshold angle
   // `angle_threshold` (radians) replace the weights' values.

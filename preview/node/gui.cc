@@ -198,6 +198,7 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
     po.wait = std::chrono::milliseconds(config.wait_ms);
     po.asset_root = config.asset_root;
     po.overlays = config.overlays;
+    po.carve_all_masks = config.carve_masks;
     auto pipeline = ViewPipeline::create(node, po);
     if (!pipeline) return error(pipeline.error().message);
     PanelState panels;

@@ -79,6 +79,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   po.asset_root = config.asset_root;
   po.overlays = config.overlays;
   po.prefetch = options.every_s <= 0;  // low-rate pictures ask only for the meshes they draw
+  po.carve_all_masks = config.carve_masks;
   auto pipeline = ViewPipeline::create(node, po);
   if (!pipeline) return error(pipeline.error().message, 1);
   auto target = scene_render::RenderTarget::create(config.width, config.height);
@@ -133,7 +134,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
           << ",\"textured\":" << (r.textured ? "true" : "false") << ",\"cameras\":[";
       for (std::size_t i = 0; i < r.cameras.size(); ++i)
         log << (i ? "," : "") << "\"" << r.cameras[i] << "\"";
-      log << "]}\n";
+      log << "],\"carving_masks\":" << r.carving_masks << "}\n";
       log.flush();
     }
     if (!every && options.duration_s <= 0 && drawn >= options.frames) break;

@@ -36,8 +36,9 @@ Publishes its own studio/service/status (service "preview", the config's instanc
 Options:
   --config FILE     preview.yaml (keys below); without it, the defaults and the environment
   --viewpoint V     eye=X,Y,Z,at=X,Y,Z[,fov=DEG] (studio frame, metres, y up)
-  --texturing T     blend (up to three cameras: the hull carved per pixel by their keys,
-                    visibility by depth maps, per-point ULR weights) or nearest (the paper's)
+  --texturing T     blend (up to three cameras: the hull carved per pixel by their keys and
+                    every camera's mask of the mesh's frame, visibility by depth maps,
+                    per-point ULR weights) or nearest (the paper's)
   --size WxH        window or screenshot size
   --overlays LIST   which overlays the 3D view draws: any of head, cameras, projectors,
                     screens (comma separated), all or none (default all; preview.yaml's

@@ -11,6 +11,7 @@ struct Keys {
   std::string dds_config, log, viewpoint, texturing = "blend", asset_root, take = "take";
   std::vector<int> size{1280, 720};
   int blend_cameras = 3, wait_ms = 200;
+  bool carve_masks = true;
   bool head_marker = true, camera_frusta = true, projector_frusta = true, projector_screens = true;
   double camera_frustum_m = 0.5;
 };
@@ -27,6 +28,7 @@ const yaml::Schema<Keys> kSchema{
     yaml::field("wait_ms", &Keys::wait_ms).range(0, 10000),
     yaml::field("asset_root", &Keys::asset_root).relative_path(),
     yaml::field("take", &Keys::take),
+    yaml::field("carve_masks", &Keys::carve_masks),
     yaml::field("head_marker", &Keys::head_marker),
     yaml::field("camera_frusta", &Keys::camera_frusta),
     yaml::field("camera_frustum_m", &Keys::camera_frustum_m).range(0.01, 20),
@@ -63,6 +65,7 @@ Expected<PreviewConfig> read_preview_config(const std::string& path) {
   c.wait_ms = k->wait_ms;
   c.asset_root = k->asset_root;
   c.take = k->take;
+  c.carve_masks = k->carve_masks;
   c.overlays.head = k->head_marker;
   c.overlays.camera_frusta = k->camera_frusta;
   c.overlays.camera_frustum_m = k->camera_frustum_m;

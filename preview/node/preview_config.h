@@ -25,6 +25,7 @@ struct PreviewConfig {
   std::string asset_root;          // relative asset paths of scene nodes resolve here
   std::string take = "take";       // the capture panel's default take name
   OverlayOptions overlays;         // head marker, frusta, projector screens in the 3D view
+  bool carve_masks = true;         // blend: carve against every camera's mask of the frame
   Expected<void> validate() const;
 };
 
@@ -42,6 +43,9 @@ inline constexpr const char* kConfigHelp =
     "                                draw it untextured (counted)\n"
     "  asset_root: DIR               relative asset paths of scene nodes resolve here\n"
     "  take: take                    the capture panel's default take name\n"
+    "  carve_masks: true             blend: carve the hull per pixel against every camera's\n"
+    "                                actor mask of the mesh's frame (studio/camera/mask), not\n"
+    "                                only the three texturing cameras' keys\n"
     "  head_marker: true             the tracked head (studio/actor/head): a yellow sphere,\n"
     "                                its velocity (orange) and sight lines to each screen\n"
     "  camera_frusta: true           each studio camera's frustum (cyan, from\n"

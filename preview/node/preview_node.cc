@@ -12,7 +12,8 @@ namespace studio::preview {
 namespace {
 
 constexpr const char* kLog = "preview";
-constexpr std::size_t kKeptImages = 24;  // (camera, frame) images kept for the renderer
+constexpr std::size_t kKeptImages = 24;      // (camera, frame) images kept for the renderer
+constexpr std::size_t kKeptMaskFrames = 25;  // per camera: a second of masks at 25 fps
 
 }  // namespace
 
@@ -55,6 +56,17 @@ struct PreviewNode::Impl {
                                     on_reply(s);
                                     return runtime::Outcome{};
                                   });
+    loop.input<studio_AlphaMask>(
+        {.received = "masks_in", .rate = false},
+        [this](const studio_AlphaMask& s, const wire::SampleMeta&) -> runtime::Outcome {
+          auto m = wire::to_core(s);
+          if (!m) return runtime::reject("mask", m.error().message);
+          std::lock_guard lock(mutex);
+          auto& kept = masks[std::string(wire::str(s.camera_id))];
+          kept[s.frame] = std::move(*m);
+          while (kept.size() > kKeptMaskFrames) kept.erase(kept.begin());
+          return {};
+        });
     loop.input<studio_ServiceStatus>(
         {.received = "statuses_in", .rate = false, .instance_changes = true},
         [this](const studio_ServiceStatus& s, const wire::SampleMeta& m) {
@@ -129,6 +141,7 @@ struct PreviewNode::Impl {
   std::condition_variable changed;
   std::map<std::string, Camera> calibrations;
   std::map<std::string, LiveMesh> meshes;
+  std::map<std::string, std::map<uint64_t, RunMask>> masks;  // camera → frame → mask
   uint64_t mesh_sequence = 0;
   std::map<std::string, scene::Node> nodes;
   uint64_t scene_version = 0;
@@ -178,6 +191,14 @@ const OverlayInputs& PreviewNode::overlays() const { return impl_->overlays; }
 std::map<std::string, Camera> PreviewNode::cameras() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->calibrations;
+}
+
+std::map<std::string, RunMask> PreviewNode::masks(uint64_t frame) const {
+  std::lock_guard lock(impl_->mutex);
+  std::map<std::string, RunMask> out;
+  for (const auto& [camera, kept] : impl_->masks)
+    if (auto m = kept.find(frame); m != kept.end()) out.emplace(camera, m->second);
+  return out;
 }
 
 std::optional<LiveMesh> PreviewNode::mesh_after(uint64_t sequence) const {

@@ -6,6 +6,8 @@
 //        studio/actor/mesh → the newest mesh per actor with its source frame
 //        studio/camera/calibration → cameras;  studio/camera/state → the camera panel
 //        studio/camera/image_reply → frame-exact camera images (only replies to this requester)
+//        studio/camera/mask → every camera's actor mask of the last kKeptMaskFrames frames
+//        (the blend carves the hull against all of them, frame-exactly)
 //        studio/service/status → the services panel
 //        studio/actor/head, studio/projector/calibration, studio/projector/frame → the overlays
 //        (overlay_inputs.h)
@@ -33,6 +35,7 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "core/run_mask.h"
 #include "overlay_inputs.h"
 #include "preview/frame_images.h"
 #include "runtime/service_loop.h"
@@ -100,6 +103,9 @@ class PreviewNode : public runtime::Node {
   // The images of exactly `frame` of every named camera, once all have arrived; waits up to
   // `wait`. Missing: `refused` (a capture server answered EVICTED or NOT_YET) or late (no reply
   // yet).
+  // The actor masks of exactly `frame` that arrived (camera id → mask; cameras whose mask of
+  // that frame was lost or is older than the kept frames are absent).
+  std::map<std::string, RunMask> masks(uint64_t frame) const;
   using Missing = FrameImageStore::Missing;
   std::expected<std::vector<FrameImage>, Missing> images(uint64_t frame,
                                                          const std::vector<std::string>& cameras,

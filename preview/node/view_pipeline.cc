@@ -75,6 +75,9 @@ struct ViewPipeline::Impl {
   FrameReport current;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   PipelineCounts counts;
+  std::vector<Camera> carving_cameras;  // the carving masks' cameras and masks (kept: uploaded)
+  std::vector<Mask> carving_masks;
+  std::size_t carving_count = 0;
   std::shared_ptr<PrefetchState> prefetch = std::make_shared<PrefetchState>();
 
   Impl(PreviewNode& n, const PipelineOptions& o, scene_render::Renderer r, ActorTexturer t,
@@ -152,6 +155,36 @@ struct ViewPipeline::Impl {
     node->request_images(pending->source_frame, pending_cameras);
   }
 
+  // The blend's carving masks: every calibrated camera's mask of exactly `frame` that arrived
+  // (one size: the most common), else none.
+  void set_carving_masks(const std::map<std::string, Camera>& cams, uint64_t frame) {
+    carving_cameras.clear();
+    carving_masks.clear();
+    if (options.blend && options.carve_all_masks) {
+      for (auto& [id, m] : node->masks(frame)) {
+        const auto c = cams.find(id);
+        if (c == cams.end() || m.width() != c->second.width || m.height() != c->second.height)
+          continue;
+        carving_cameras.push_back(c->second);
+        carving_masks.push_back(m.to_mask());
+      }
+      // One size for the texture array: keep the cameras of the first camera's size.
+      for (std::size_t i = carving_cameras.size(); i-- > 0;)
+        if (carving_cameras[i].width != carving_cameras[0].width ||
+            carving_cameras[i].height != carving_cameras[0].height ||
+            int(i) >= ActorTexturer::kMaxMasks) {
+          carving_cameras.erase(carving_cameras.begin() + i);
+          carving_masks.erase(carving_masks.begin() + i);
+        }
+    }
+    std::vector<ActorTexturer::CarvingMask> list;
+    for (std::size_t i = 0; i < carving_cameras.size(); ++i)
+      list.push_back({&carving_cameras[i], carving_masks[i].data()});
+    if (auto ok = texturer.set_carving_masks(list); !ok)
+      STUDIO_LOG(warn, "preview") << ok.error().message;
+    carving_count = list.size();
+  }
+
   // Promotes the pending mesh when its images are here (textured) or it waited too long.
   bool promote(bool block) {
     if (!pending) return false;
@@ -171,8 +204,9 @@ struct ViewPipeline::Impl {
       return false;
     }
     bool textured = imgs.has_value();
+    const auto cams = node->cameras();
+    set_carving_masks(cams, pending->source_frame);
     if (textured) {
-      const auto cams = node->cameras();
       for (std::size_t i = 0; i < imgs->size() && textured; ++i) {
         const FrameImage& img = (*imgs)[i];
         const auto c = cams.find(pending_cameras[i]);
@@ -187,6 +221,7 @@ struct ViewPipeline::Impl {
     current.source_frame = pending->source_frame;
     current.cameras = pending_cameras;
     current.weights = pending_weights;
+    current.carving_masks = int(carving_count);
     current_threshold = pending_threshold;
     have_current = true;
     ++counts.meshes;

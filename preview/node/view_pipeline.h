@@ -37,6 +37,9 @@ struct PipelineOptions {
   // here when it is drawn; false: only when render() takes the mesh (a preview that draws few of
   // the meshes it receives, and must not make the capture servers answer for the others).
   bool prefetch = true;
+  // Blend: carve the hull against every camera's actor mask of the mesh's frame
+  // (studio/camera/mask), not only the three texturing cameras' keys.
+  bool carve_all_masks = true;
 };
 
 struct FrameReport {
@@ -45,6 +48,7 @@ struct FrameReport {
   uint64_t source_frame = 0;         // frame of the masks that built the drawn mesh
   std::vector<std::string> cameras;  // texturing cameras (ids), with their weights
   std::vector<float> weights;
+  int carving_masks = 0;  // blend: the cameras' masks of the mesh's frame carving it
 };
 
 // meshes = drawn meshes = textured + untextured; untextured = late (no reply within `wait`) +

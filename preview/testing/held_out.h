@@ -33,6 +33,7 @@
 #include "scene/view.h"
 #include "scene_render/egl_context.h"
 #include "scene_render/render_target.h"
+#include "shape_prior.h"
 #include "sim/cameras.h"
 #include "sim/studio.h"
 #include "support/cameras.h"
@@ -121,7 +122,9 @@ struct Studio {
 };
 
 // `count` cameras: count - 1 on the ring, one overhead (default 8 + 1).
-inline Studio make_studio(int count = 9) {
+// The held-out camera at azimuth `held_az_deg` (cam0 at 0, cam1 at 360 / (count - 1)), height
+// `held_y` m, 3.6 m from the centre's axis, looking at (0, 1.1, 0).
+inline Studio make_studio(int count = 9, double held_az_deg = 20, double held_y = 1.8) {
   sim::RingOptions r;
   r.count = count;
   r.width = kW;
@@ -130,8 +133,8 @@ inline Studio make_studio(int count = 9) {
   Studio s;
   s.cameras = sim::ring_cameras(r);
   for (const Camera& c : s.cameras) s.poses.push_back({c.id, c.centre_in_world()});
-  const double az = 20 * std::numbers::pi / 180;
-  s.eye = {3.6 * std::sin(az), 1.8, 3.6 * std::cos(az)};
+  const double az = held_az_deg * std::numbers::pi / 180;
+  s.eye = {3.6 * std::sin(az), held_y, 3.6 * std::cos(az)};
   const double focal = 560.0 * kW / 704.0;
   s.held =
       support::look_at_camera("held", s.eye, s.target, Eigen::Vector3d::UnitY(), kW, kH, focal);
@@ -189,16 +192,24 @@ struct Scoring {
   bool hull = false;       // geometry: the visual hull of the true masks, else the true surface
   sim::StudioOptions sim;  // the realism knobs, for the feeding cameras and the held-out one
   TexturerOptions texturer;
-  int cameras = 9;       // studio cameras: cameras - 1 on the ring + overhead
+  int cameras = 9;                        // studio cameras: cameras - 1 on the ring + overhead
+  double held_az_deg = 20, held_y = 1.8;  // the held-out camera (make_studio)
   int hull_cells = 96;   // the hull's grid (cells along x and z), as the node's `grid`
   bool verbose = false;  // per frame PSNR
   std::string dump_dir;  // when set: <frame>_truth.png and <frame>_<variant>.png there
+  // The shape prior on the hull (testing/shape_prior.h), anchored at the rims of the texturing
+  // cameras (the images a node would have), or of every studio camera when shape_all_cameras.
+  ShapePriorOptions shape;
+  bool shape_all_cameras = false;
+  // Blend's carving also against every studio camera's mask (the true masks the hull was built
+  // from; ActorTexturer::set_carving_masks).
+  bool carve_all_cameras = false;
 };
 
 // Scores every variant over `frames` (a current GL context is needed).
 inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<Variant>& variants,
                                        const std::vector<int64_t>& frames) {
-  const Studio s = make_studio(setup.cameras);
+  const Studio s = make_studio(setup.cameras, setup.held_az_deg, setup.held_y);
   sim::StudioOptions o = setup.sim;
   o.threads = 2;
   auto studio = sim::SimulatedStudio::create(s.cameras, o).value();
@@ -220,7 +231,6 @@ inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<V
     const scene::ActorMesh mesh =
         setup.hull ? hull_mesh(s.cameras, masks, setup.hull_cells) : true_mesh(t.body);
     if (mesh.triangles.empty()) continue;
-    EXPECT_TRUE(texturer.set_mesh(mesh).has_value());
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
     for (const auto& v : mesh.vertices) {
       lo = lo.cwiseMin(v.cast<double>());
@@ -233,6 +243,24 @@ inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<V
       std::vector<CameraWeight> chosen =
           blend ? preview::blend(s.poses, s.eye, centre) : preview::nearest(s.poses, s.eye, centre);
       if (!blend && var.camera >= 0) chosen = {{var.camera, 0, 1}};
+      scene::ActorMesh drawn = mesh;
+      if (setup.shape.steps > 0) {
+        std::vector<KeyedView> kv;
+        if (setup.shape_all_cameras)
+          for (std::size_t c = 0; c < s.cameras.size(); ++c)
+            kv.push_back({&s.cameras[c], reinterpret_cast<const uint8_t*>(images[c].data())});
+        else
+          for (const CameraWeight& c : chosen)
+            kv.push_back(
+                {&s.cameras[c.index], reinterpret_cast<const uint8_t*>(images[c.index].data())});
+        apply_shape_prior(drawn, kv, setup.shape);
+      }
+      EXPECT_TRUE(texturer.set_mesh(drawn).has_value());
+      std::vector<ActorTexturer::CarvingMask> carving;
+      if (setup.carve_all_cameras)
+        for (std::size_t c = 0; c < s.cameras.size(); ++c)
+          carving.push_back({&s.cameras[c], masks[c].data()});
+      EXPECT_TRUE(texturer.set_carving_masks(carving).has_value());
       std::array<float, ActorTexturer::kMaxCameras> w{};
       for (std::size_t i = 0; i < chosen.size(); ++i) {
         w[i] = float(chosen[i].weight);

@@ -6,6 +6,7 @@
 // enough for a 40-second run on a loaded 2-core machine.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <deque>
 #include <fstream>
 #include <numbers>
@@ -32,7 +33,8 @@ class PreviewStudioTest : public ::testing::Test {
   }
   void TearDown() override {
     for (auto& p : processes_) p.stop();
-    if (HasFailure()) {
+    // PREVIEW_KEEP_TEST_DIR=1 keeps the directory (recordings, logs) of a passing test too.
+    if (HasFailure() || std::getenv("PREVIEW_KEEP_TEST_DIR")) {
       std::fprintf(stderr, "test dir: %s\n", dir_.c_str());
       for (auto& p : processes_)
         std::fprintf(stderr, "---- %s log ----\n%s\n", p.name().c_str(), p.log().c_str());
@@ -108,9 +110,11 @@ class PreviewStudioTest : public ::testing::Test {
   }
 
   // Writes preview.yaml; returns its path.
-  std::string preview_config(const std::string& instance, int wait_ms = 400) {
+  // `extra`: more preview.yaml lines.
+  std::string preview_config(const std::string& instance, int wait_ms = 400,
+                             const std::string& extra = "") {
     const auto path = dir_ / (instance + ".yaml");
-    std::ofstream(path) << "instance: " << instance << "\nwait_ms: " << wait_ms << "\n";
+    std::ofstream(path) << "instance: " << instance << "\nwait_ms: " << wait_ms << "\n" << extra;
     return path.string();
   }
 
