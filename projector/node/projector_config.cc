@@ -30,6 +30,8 @@ MaskPlannerOptions ProjectorNodeOptions::mask_options() const {
   m.latency_window = std::size_t(std::max(latency.window, 1));
   m.latency_quantile = latency.quantile;
   m.initial_latency_s = latency.initial;
+  m.parallel_mesh_work = parallel_mesh_work;
+  m.grow.presimplify = mask_presimplify;
   return m;
 }
 
@@ -68,6 +70,15 @@ runtime::ServiceDefinition projector_service_definition() {
       "    head_timeout: 2.0       seconds; an older head pose keeps the last good eye\n"
       "    frame_every: 1          publish studio/projector/frame every N frames (0: never)\n"
       "    thumbnail: [160, 90]    RGB8 thumbnail size in studio/projector/frame ([0, 0]: none)\n"
+      "    parallel_mesh_work: true  a new mesh's mask simplification runs on a second thread\n"
+      "                            while its motion is fitted (the mesh waits for the longer\n"
+      "                            of the two, not their sum; same result and CPU); false: one\n"
+      "                            after the other on the render thread\n"
+      "    mask_presimplify: true  a hull mesh of more than 12000 triangles is clustered\n"
+      "                            (meshoptimizer sloppy) to ~12000 before the edge collapse\n"
+      "                            to the mask's 3000 (about 4x less CPU per mesh; both\n"
+      "                            errors x 1.5 added to the mask's push); false: the edge\n"
+      "                            collapse alone (projector/mask_geometry.h)\n"
       "    margin:                 the mask's security margin (projector/mask_margin.h)\n"
       "      floor: 0.01           metres, what motion does not explain (hull error, ...)\n"
       "      cap: 0.20             metres, largest margin (clamped and flagged above)\n"
@@ -157,6 +168,8 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("head_timeout", &ProjectorNodeOptions::head_timeout_s).min(0.01),
         yaml::field("frame_every", &ProjectorNodeOptions::frame_every).range(0, 100000),
         yaml::field("thumbnail", &ProjectorNodeOptions::thumbnail).size(2),
+        yaml::field("parallel_mesh_work", &ProjectorNodeOptions::parallel_mesh_work),
+        yaml::field("mask_presimplify", &ProjectorNodeOptions::mask_presimplify),
         yaml::field("margin", &ProjectorNodeOptions::margin, margin_schema),
         yaml::field("latency", &ProjectorNodeOptions::latency, latency_schema),
         yaml::field("scene_cache", &ProjectorNodeOptions::scene_cache, cache_schema),
