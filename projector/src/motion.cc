@@ -192,22 +192,8 @@ namespace {
 
 using Target = MotionTarget;
 
-// The vertex grid's cell from the mesh's density: side sqrt(k * area per vertex) (the mesh's
-// area over its vertex count), about k vertices where the surface crosses a cell, so a query
-// near the surface reads a few vertices per cell of its 3 x 3 x 3 neighbourhood; at least 5 mm
-// (bounded grid size and shells), at most the former fixed cell max_correspondence_m / 8, which
-// holds ~20 vertices of a dense hull mesh per surface cell. The search stays exact (the nearest
-// vertex; ties between coincident vertices may fall differently).
-double grid_cell(const MotionOptions& options, const ActorMesh& mesh) {
-  constexpr double k = 6;  // hull meshes of the demo (44k vertices): 18.4 vs 21.3 ms per fit
-  const double coarse = std::max(0.01, options.max_correspondence_m / 8);
-  double area = 0;
-  for (const auto& t : mesh.triangles)
-    area += 0.5 * double((mesh.vertices[t[1]] - mesh.vertices[t[0]])
-                             .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
-                             .norm());
-  if (!(area > 0) || mesh.vertices.empty()) return coarse;
-  return std::clamp(std::sqrt(k * area / double(mesh.vertices.size())), 0.005, coarse);
+double grid_cell(const MotionOptions& options) {
+  return std::max(0.01, options.max_correspondence_m / 8);
 }
 
 // A stratified sample of at most `budget` of `indices` (every k-th, evenly over the list; the
@@ -484,7 +470,7 @@ Expected<void> check_pair(const ActorMesh& previous, const ActorMesh& current,
 Expected<MeshMotion> estimate_motion(const ActorMesh& previous, const ActorMesh& current,
                                      const MotionOptions& options) {
   if (auto ok = check_pair(previous, current, options); !ok) return std::unexpected(ok.error());
-  const MotionTarget target(previous, grid_cell(options, previous));
+  const MotionTarget target(previous, grid_cell(options));
   return estimate(target, current, options, nullptr);
 }
 
@@ -526,7 +512,7 @@ Expected<std::optional<MeshMotion>> MotionTracker::update(const ActorMesh& mesh)
     }
   }
   // This mesh is the next one's target: its structure is built once, here.
-  last_ = std::make_unique<MotionTarget>(mesh, grid_cell(options_, mesh));
+  last_ = std::make_unique<MotionTarget>(mesh, grid_cell(options_));
   last_motion_ = std::move(motion);
   return last_motion_;
 }
