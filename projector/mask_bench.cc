@@ -10,6 +10,8 @@
 //                                  (set_mesh + plan), before and after
 #include <benchmark/benchmark.h>
 
+#include <string>
+
 #include "projector/mask_geometry.h"
 #include "projector/mask_planner.h"
 #include "projector/motion.h"
@@ -80,7 +82,31 @@ void BM_SetMesh(benchmark::State& state) {
   state.counters["motion_ms"] = planner.last_mesh_cost().motion_s * 1e3;
   state.counters["simplify_ms"] = planner.last_mesh_cost().simplify_s * 1e3;
 }
-BENCHMARK(BM_SetMesh)->Unit(benchmark::kMillisecond)->MinTime(2);
+BENCHMARK(BM_SetMesh)->Unit(benchmark::kMillisecond)->MinTime(2)->MeasureProcessCPUTime();
+
+// set_mesh's two stages one after the other with the edge collapse alone (the baseline: before
+// session 9), with the clustering first, and both on two threads (the default; process CPU).
+void BM_SetMeshStages(benchmark::State& state) {
+  projector::MaskPlannerOptions o;
+  o.grow.presimplify = state.range(0) != 0;
+  o.parallel_mesh_work = state.range(1) != 0;
+  projector::MaskPlanner planner(o);
+  Feed feed;
+  for (auto _ : state) {
+    auto ok = planner.set_mesh("actor0", feed.k, feed.next());
+    if (!ok) state.SkipWithError(ok.error().message.c_str());
+  }
+  state.SetLabel(std::string(o.grow.presimplify ? "clustered+collapse" : "collapse") +
+                 (o.parallel_mesh_work ? ", parallel" : ", serial"));
+}
+BENCHMARK(BM_SetMeshStages)
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 // One mesh and its frame. old: the motion estimate, then for the frame the whole mesh predicted,
 // simplified and grown (the planner before); new: MaskPlanner::set_mesh + plan.

@@ -23,13 +23,14 @@ struct FrameMetrics {
         margin_mm(loop.metrics().gauge("margin_mm")),
         latency_p_ms(loop.metrics().gauge("latency_p_ms")),
         render_ms(loop.metrics().gauge("render_ms")),
-        overrun_p_ms(loop.metrics().gauge("overrun_p_ms")) {
+        overrun_p_ms(loop.metrics().gauge("overrun_p_ms")),
+        mesh_triangles(loop.metrics().gauge("mesh_triangles")) {
     loop.count_as_output(rendered);
   }
   runtime::Counter &rendered, &eye_rejected, &head_stale, &scene_left_out, &assets_failed,
       &superseded, &mesh_errors, &from_cache, &rerendered;
   runtime::Gauge &moving_nodes, &cache_move_mm, &cpu_per_frame_ms, &margin_mm, &latency_p_ms,
-      &render_ms, &overrun_p_ms;
+      &render_ms, &overrun_p_ms, &mesh_triangles;
 };
 
 }  // namespace studio::projector

@@ -30,6 +30,8 @@ MaskPlannerOptions ProjectorNodeOptions::mask_options() const {
   m.latency_window = std::size_t(std::max(latency.window, 1));
   m.latency_quantile = latency.quantile;
   m.initial_latency_s = latency.initial;
+  m.parallel_mesh_work = parallel_mesh_work;
+  m.grow.presimplify = mask_presimplify;
   return m;
 }
 
@@ -68,6 +70,16 @@ runtime::ServiceDefinition projector_service_definition() {
       "    head_timeout: 2.0       seconds; an older head pose keeps the last good eye\n"
       "    frame_every: 1          publish studio/projector/frame every N frames (0: never)\n"
       "    thumbnail: [160, 90]    RGB8 thumbnail size in studio/projector/frame ([0, 0]: none)\n"
+      "    parallel_mesh_work: true  a new mesh's mask simplification runs on a second thread\n"
+      "                            while its motion is fitted (the mesh waits for the longer\n"
+      "                            of the two, not their sum; same result and CPU); false: one\n"
+      "                            after the other on the render thread\n"
+      "    mask_presimplify: true  a hull mesh of more than 12000 triangles is clustered\n"
+      "                            (meshoptimizer sloppy) to ~12000 before the edge collapse\n"
+      "                            to the mask's 3000 (2-4x less CPU for it on the demo's\n"
+      "                            hull meshes; both errors x 1.5 added to the mask's push,\n"
+      "                            so the mask is ~1 cm fatter); false: the edge\n"
+      "                            collapse alone (projector/mask_geometry.h)\n"
       "    margin:                 the mask's security margin (projector/mask_margin.h)\n"
       "      floor: 0.01           metres, what motion does not explain (hull error, ...)\n"
       "      cap: 0.20             metres, largest margin (clamped and flagged above)\n"
@@ -102,7 +114,8 @@ runtime::ServiceDefinition projector_service_definition() {
       "  studio/projector/calibration, studio/projector/frame, studio/service/status out\n"
       "  (latency = motion to photon; margin_mm, latency_p_ms, overrun_p_ms (frames shown later\n"
       "  than planned: the margin covers the mesh's age at display + this), render_ms,\n"
-      "  eye_rejected, meshes_rejected, meshes_superseded, mesh_motion_errors; where a mesh's\n"
+      "  eye_rejected, meshes_rejected, meshes_superseded, mesh_motion_errors, mesh_triangles\n"
+      "  (of the last mesh received); where a mesh's\n"
       "  time goes, ms: stage_wait_ms, stage_motion_ms, stage_simplify_ms, stage_mask_ms,\n"
       "  stage_draw_ms, stage_finish_ms, stage_readback_ms, stage_publish_ms, stage_present_ms,\n"
       "  mesh_to_frame_ms: see projector/node/frame_stages.h; the scene cache: frames_from_cache,\n"
@@ -157,6 +170,8 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("head_timeout", &ProjectorNodeOptions::head_timeout_s).min(0.01),
         yaml::field("frame_every", &ProjectorNodeOptions::frame_every).range(0, 100000),
         yaml::field("thumbnail", &ProjectorNodeOptions::thumbnail).size(2),
+        yaml::field("parallel_mesh_work", &ProjectorNodeOptions::parallel_mesh_work),
+        yaml::field("mask_presimplify", &ProjectorNodeOptions::mask_presimplify),
         yaml::field("margin", &ProjectorNodeOptions::margin, margin_schema),
         yaml::field("latency", &ProjectorNodeOptions::latency, latency_schema),
         yaml::field("scene_cache", &ProjectorNodeOptions::scene_cache, cache_schema),

@@ -128,6 +128,7 @@ class ProjectorNode : public runtime::Node {
     if (s.vertices._length == 0 || s.triangles._length == 0)
       return runtime::reject("empty", "actor " + id + ": empty mesh (previous mask kept)");
     ActorMesh mesh = mesh_of(s);
+    m_.mesh_triangles.set(double(s.triangles._length / 3));  // what the per-mesh work scales with
     std::lock_guard lock(mutex_);
     auto replaced = inbox_.offer(id, s.frame, std::move(mesh));
     if (!replaced) return runtime::reject("mesh", replaced.error().message);

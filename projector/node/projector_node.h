@@ -58,6 +58,10 @@ struct ProjectorNodeOptions {
   double head_timeout_s = 2.0;  // an older head pose falls back to the last good eye (counted)
   int frame_every = 1;          // publish studio/projector/frame every N rendered frames (0: never)
   std::vector<int> thumbnail{160, 90};
+  // A mesh's simplification on a second thread beside its motion fit (MaskPlannerOptions).
+  bool parallel_mesh_work = true;
+  // Hull meshes clustered before the edge collapse (GrowOptions::presimplify).
+  bool mask_presimplify = true;
   MarginOptions margin;
   LatencyOptions latency;
   // The static scene rendered once and reused while it is unchanged and the eye stays within

@@ -23,12 +23,29 @@ std::pair<ActorMesh, double> simplified(const ActorMesh& mesh, const GrowOptions
   const float* xyz = mesh.vertices.front().data();
   const uint32_t* in = mesh.triangles.front().data();
   const std::size_t stride = sizeof(Eigen::Vector3f);
-  std::vector<uint32_t> out(mesh.triangles.size() * 3);
+  std::size_t in_count = mesh.triangles.size() * 3;
   float error = 0;
-  const std::size_t n =
-      meshopt_simplify(out.data(), in, out.size(), xyz, mesh.vertices.size(), stride,
-                       options.max_triangles * 3, static_cast<float>(options.max_error), 0, &error);
-  if (n == 0 || n >= out.size()) return {mesh, 0.0};
+  std::vector<uint32_t> clustered;
+  if (options.presimplify && mesh.triangles.size() > 4 * options.max_triangles) {
+    clustered.resize(in_count);
+    float sloppy_error = 0;
+    const std::size_t k = meshopt_simplifySloppy(
+        clustered.data(), in, in_count, xyz, mesh.vertices.size(), stride,
+        4 * options.max_triangles * 3, static_cast<float>(options.max_error), &sloppy_error);
+    if (k > 0 && k < in_count) {  // else the edge collapse alone
+      in = clustered.data();
+      in_count = k;
+      error = sloppy_error;
+    }
+  }
+  std::vector<uint32_t> out(in_count);
+  float collapse_error = 0;
+  const std::size_t n = meshopt_simplify(out.data(), in, in_count, xyz, mesh.vertices.size(),
+                                         stride, options.max_triangles * 3,
+                                         static_cast<float>(options.max_error), 0, &collapse_error);
+  error += collapse_error;  // the two stages' errors add up (triangle inequality)
+  if (n == 0 || (n >= in_count && clustered.empty())) return {mesh, 0.0};
+  if (n >= in_count) out.assign(in, in + in_count);
   ActorMesh s = mesh;
   s.triangles.resize(n / 3);
   for (std::size_t t = 0; t < n / 3; ++t)

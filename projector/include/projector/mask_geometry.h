@@ -31,6 +31,14 @@ struct GrowOptions {
   std::size_t max_triangles = 3000;
   double max_error = 0.01;
   double error_safety = 1.5;
+  // A mesh of more than 4 x max_triangles is first clustered to about that many by
+  // meshoptimizer's sloppy simplifier (vertex clustering on a grid: the vertices kept are
+  // original ones), then edge-collapsed to max_triangles; both stages' errors add up (x
+  // error_safety) in the push. On the demo's hull meshes (89k triangles, 25 frames): 7.9 instead
+  // of 32.6 ms CPU per mesh, error 2.6 instead of 1.7 cm, and silhouettes from 6 views at a
+  // 1 cm margin left 0 pixels of the mesh uncovered (the edge collapse alone: 15 of 4.4 M).
+  // false: the edge collapse alone on the whole mesh.
+  bool presimplify = true;
 };
 
 // Errors: invalid mesh, negative or non-finite margin. = grow_mask(simplify_for_mask(mesh)).

@@ -17,7 +17,8 @@
 // actor from set_head_speed(), 0 when unknown).
 //
 // Cost: set_mesh() does the per-mesh work once — the motion estimate and the mask mesh's
-// simplification (mask_geometry.h simplify_for_mask) — and times both (last_mesh_cost());
+// simplification (mask_geometry.h simplify_for_mask), by default on two threads at once
+// (MaskPlannerOptions::parallel_mesh_work) — and times both (last_mesh_cost());
 // plan() per frame only moves the simplified mesh forward and grows it.
 //
 // A mesh without a motion estimate (the first after a gap longer than MotionOptions::max_dt_s,
@@ -47,6 +48,10 @@ struct MaskPlannerOptions {
   std::size_t latency_window = 100;  // frames
   double latency_quantile = 0.95;
   double initial_latency_s = 0.04;
+  // set_mesh() simplifies the mask mesh on a second thread while it fits the motion (wall time
+  // per mesh: the longer stage, not the sum; the same results and CPU). false: one after the
+  // other on the calling thread.
+  bool parallel_mesh_work = true;
   Expected<void> validate() const;
 };
 
@@ -58,7 +63,8 @@ struct MaskPlan {
   std::int64_t display_ns = 0;  // the instant it was planned for
 };
 
-// Wall time of set_mesh()'s two stages, seconds (steady clock).
+// Wall time of set_mesh()'s two stages, seconds (steady clock); in parallel, motion_s is the
+// whole set_mesh's wait (the motion fit, then the join of the simplification).
 struct MeshCost {
   double motion_s = 0;    // MotionTracker::update
   double simplify_s = 0;  // simplify_for_mask
