@@ -49,6 +49,10 @@ Expected<void> SurfaceRefineOptions::validate() const {
       !(rim_cos >= 0 && rim_cos <= 1))
     return fail(
         "surface refine: shape_steps must be 0..1000, shape_lambda in (0, 1], rim_cos in [0, 1]");
+  if (shape_order != 1 && shape_order != 2)
+    return fail("surface refine: shape_order must be 1 or 2");
+  if (shape_order == 2 && shape_lambda > 0.25)
+    return fail("surface refine: shape_lambda must be <= 0.25 with shape_order 2 (stability)");
   if (threads < 1 || threads > 64) return fail("surface refine: threads must be 1..64");
   return {};
 }
@@ -57,6 +61,8 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
                                              std::span<const ColourView> views,
                                              const SurfaceRefineOptions& o) {
   if (auto ok = o.validate(); !ok) return std::unexpected(ok.error());
+  if (o.inside_hull && views.size() > 64)
+    return fail("surface refine: inside_hull takes at most 64 cameras");
   auto sampled = prepare_views(views, o.edge_margin_px);
   if (!sampled) return std::unexpected(sampled.error());
   const std::vector<SampledView>& cams = *sampled;
@@ -283,15 +289,47 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
         }
       });
     }
-    std::vector<Eigen::Vector3f> moved(nv);
+    // Per vertex, the cameras whose silhouette contains its projection (bit c), for inside_hull.
+    const auto silhouettes = [&](const Eigen::Vector3f& xf) {
+      uint64_t bits = 0;
+      const Eigen::Vector3d x = xf.cast<double>();
+      for (std::size_t c = 0; c < views.size(); ++c) {
+        Eigen::Vector2d p;
+        if (!views[c].camera->project(x, &p)) continue;
+        const int px = int(std::lround(p.x())), py = int(std::lround(p.y()));
+        if (views[c].mask->contains(px, py)) bits |= uint64_t(1) << c;
+      }
+      return bits;
+    };
+    std::vector<Eigen::Vector3f> moved(nv), lap(nv);
+    const auto umbrella = [&](const std::vector<Eigen::Vector3f>& f, std::size_t n) {
+      Eigen::Vector3f m = Eigen::Vector3f::Zero();
+      for (const uint32_t j : adjacent[n]) m += f[j];
+      return Eigen::Vector3f(m / float(adjacent[n].size()) - f[n]);
+    };
     for (int step = 0; step < o.shape_steps; ++step) {
+      if (o.shape_order == 2)
+        parallel_for(nv, o.threads, [&](std::size_t a, std::size_t b) {
+          for (std::size_t n = a; n < b; ++n)
+            lap[n] = adjacent[n].empty() ? Eigen::Vector3f::Zero() : umbrella(mesh.vertices, n);
+        });
       parallel_for(nv, o.threads, [&](std::size_t a, std::size_t b) {
         for (std::size_t n = a; n < b; ++n) {
           moved[n] = mesh.vertices[n];
           if (anchored[n] || adjacent[n].empty()) continue;
-          Eigen::Vector3f m = Eigen::Vector3f::Zero();
-          for (const uint32_t j : adjacent[n]) m += mesh.vertices[j];
-          moved[n] += float(o.shape_lambda) * (m / float(adjacent[n].size()) - mesh.vertices[n]);
+          Eigen::Vector3f d = o.shape_order == 2
+                                  ? Eigen::Vector3f(-float(o.shape_lambda) * umbrella(lap, n))
+                                  : Eigen::Vector3f(float(o.shape_lambda) * umbrella(mesh.vertices, n));
+          if (!o.inside_hull) {
+            moved[n] += d;
+            continue;
+          }
+          const uint64_t before = silhouettes(mesh.vertices[n]);
+          for (int halve = 0; halve < 4; ++halve, d *= 0.5f)
+            if ((silhouettes(mesh.vertices[n] + d) & before) == before) {
+              moved[n] += d;
+              break;
+            }
         }
       });
       mesh.vertices.swap(moved);
