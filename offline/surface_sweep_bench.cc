@@ -54,9 +54,9 @@ double silhouette_loss(const hull::Mesh& m, const std::vector<ColourView>& views
 int main(int argc, char** argv) {
   const int grid = std::getenv("GRID") ? std::atoi(std::getenv("GRID")) : 256;
   std::vector<Pose> poses = {
-      {sim::Motion::idle, 10, 1, true},    {sim::Motion::crouch, 45, 1, true},
-      {sim::Motion::crouch, 25, 1, false}, {sim::Motion::crouch, 50, 2, false},
-      {sim::Motion::idle, 40, 3, false},   {sim::Motion::walk, 20, 1, false},
+      {sim::Motion::idle, 10, 1, true},      {sim::Motion::crouch, 45, 1, true},
+      {sim::Motion::crouch, 25, 1, false},   {sim::Motion::crouch, 50, 2, false},
+      {sim::Motion::idle, 40, 3, false},     {sim::Motion::walk, 20, 1, false},
       {sim::Motion::arm_swing, 30, 2, false}};
   if (std::getenv("POSES")) {
     std::vector<Pose> sel;
@@ -105,14 +105,24 @@ int main(int argc, char** argv) {
       const auto eq = item.find('=');
       const std::string k = item.substr(0, eq);
       const double v = std::atof(item.substr(eq + 1).c_str());
-      if (k == "steps") o.shape_steps = int(v);
-      else if (k == "lambda") o.shape_lambda = v;
-      else if (k == "rim") o.rim_cos = v;
-      else if (k == "anchor") o.anchor_rims = v != 0;
-      else if (k == "hull") o.inside_hull = v != 0;
-      else if (k == "order") o.shape_order = int(v);
-      else if (k == "fromhull") from_hull = v != 0;
-      else { std::fprintf(stderr, "unknown key %s\n", k.c_str()); return 1; }
+      if (k == "steps")
+        o.shape_steps = int(v);
+      else if (k == "lambda")
+        o.shape_lambda = v;
+      else if (k == "rim")
+        o.rim_cos = v;
+      else if (k == "anchor")
+        o.anchor_rims = v != 0;
+      else if (k == "hull")
+        o.inside_hull = v != 0;
+      else if (k == "order")
+        o.shape_order = int(v);
+      else if (k == "fromhull")
+        from_hull = v != 0;
+      else {
+        std::fprintf(stderr, "unknown key %s\n", k.c_str());
+        return 1;
+      }
     }
     double hm[2] = {0, 0}, hp[2] = {0, 0}, m[2] = {0, 0}, q[2] = {0, 0};
     std::printf("variant %s\n", variant.c_str());
@@ -122,12 +132,14 @@ int main(int argc, char** argv) {
       const auto s = testing::surface_distance(r.mesh, p.f.truth.body);
       const int k = poses[i].train ? 0 : 1;
       hm[k] += p.hull.both.mean, hp[k] += p.hull.both.p95, m[k] += s.both.mean, q[k] += s.both.p95;
-      std::printf("  %-9s f%-3lld s%llu: %.2f / %.2f (%+.1f %% / %+.1f %%) acc %.2f compl %.2f anchored %zu/%zu loss %.4f\n",
-                  sim::motion_name(poses[i].motion), (long long)poses[i].frame,
-                  (unsigned long long)poses[i].seed, 1e3 * s.both.mean, 1e3 * s.both.p95,
-                  100 * (s.both.mean / p.hull.both.mean - 1), 100 * (s.both.p95 / p.hull.both.p95 - 1),
-                  1e3 * s.accuracy.mean, 1e3 * s.completeness.mean, r.anchored,
-                  r.mesh.vertices.size(), silhouette_loss(r.mesh, p.views));
+      std::printf(
+          "  %-9s f%-3lld s%llu: %.2f / %.2f (%+.1f %% / %+.1f %%) acc %.2f compl %.2f anchored "
+          "%zu/%zu loss %.4f\n",
+          sim::motion_name(poses[i].motion), (long long)poses[i].frame,
+          (unsigned long long)poses[i].seed, 1e3 * s.both.mean, 1e3 * s.both.p95,
+          100 * (s.both.mean / p.hull.both.mean - 1), 100 * (s.both.p95 / p.hull.both.p95 - 1),
+          1e3 * s.accuracy.mean, 1e3 * s.completeness.mean, r.anchored, r.mesh.vertices.size(),
+          silhouette_loss(r.mesh, p.views));
       std::fflush(stdout);
     }
     for (int k = 0; k < 2; ++k)
