@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <tuple>
 
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
@@ -153,14 +154,21 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
                    double(a.b - b.b) * (a.b - b.b);
           ++px[k];
         }
+      // Where the mesh falls short of the true silhouette: interior pixels (the true mask
+      // without its 2-px border) that no sub-pixel of the render covers.
+      std::size_t short_px = 0;
+      for (int y = 0; y < both.height(); ++y)
+        for (int x = 0; x < both.width(); ++x)
+          short_px += actor.view().row(y)[x] && !covered.view().row(y)[x];
       const double total = se[0] + se[1] + se[2];
       std::printf(
           "  %s union: %zu px interior (%.0f %% of the squared error), %zu border (%.0f %%), "
-          "%zu outside the true mask (%.0f %%)\n",
+          "%zu outside the true mask (%.0f %%); %zu interior px uncovered\n",
           m == &mesh          ? "refined"
           : m == &carved_mesh ? "carved"
                               : "hull",
-          px[0], 100 * se[0] / total, px[1], 100 * se[1] / total, px[2], 100 * se[2] / total);
+          px[0], 100 * se[0] / total, px[1], 100 * se[1] / total, px[2], 100 * se[2] / total,
+          short_px);
     }
   }
   std::printf("%s frame %lld, %d^2 columns: carved %zu of %zu voxels in %d iterations\n",
@@ -247,6 +255,70 @@ TEST(SurfaceRefine, CloserToTheTruthThanCarvingAndTheHull) {
   EXPECT_GE(p95_gain, 0.21);
 }
 
+// Poses the surface stage's settings (steps, anchors, the hull constraint) were not chosen on:
+// other actors (seeds 2 and 3: other proportions, clothing and phase) and other frames of the
+// concave motions. Surface distances only (hull, carved, carved + surface stage).
+struct ShapeCase {
+  testing::SurfaceScore hull, carved, refined;
+};
+
+ShapeCase evaluate_shape(sim::Motion motion, int64_t frame, uint64_t seed) {
+  sim::StudioOptions so;
+  so.actor.motion = motion;
+  so.actor.seed = seed;
+  auto studio = sim::SimulatedStudio::create(rig(), so).value();
+  const testing::Frame f = testing::render_frame(studio, frame);
+  auto views = f.views();
+  views.pop_back();  // the held-out camera
+  std::vector<hull::View> cut_views;
+  for (const auto& v : views) cut_views.push_back({v.camera, v.mask});
+  const hull::SegmentSet set = hull::visual_hull(testing::studio_grid(kGrid), cut_views).value();
+  hull::Mesh hull_mesh = hull::segment_marching_cubes(set);
+  EXPECT_TRUE(hull::refine_crossings(hull_mesh, set, cut_views).has_value());
+  CarveOptions o;
+  o.threads = 2;
+  const hull::Mesh carved =
+      refined_mesh(photo_carve(set, views, o).value().set, set, views, 2).value();
+  SurfaceRefineOptions sro;
+  sro.cell = 3.0 / kGrid;
+  sro.threads = 2;
+  const hull::Mesh refined = refine_surface(carved, views, sro).value().mesh;
+  ShapeCase c;
+  c.hull = testing::surface_distance(hull_mesh, f.truth.body);
+  c.carved = testing::surface_distance(carved, f.truth.body);
+  c.refined = testing::surface_distance(refined, f.truth.body);
+  std::printf(
+      "%s frame %lld actor seed %llu (validation): surface distance mean / p95 (mm) hull %.2f / "
+      "%.2f, carved %.2f / %.2f, carved + surface %.2f / %.2f\n",
+      sim::motion_name(motion), (long long)frame, (unsigned long long)seed, 1e3 * c.hull.both.mean,
+      1e3 * c.hull.both.p95, 1e3 * c.carved.both.mean, 1e3 * c.carved.both.p95,
+      1e3 * c.refined.both.mean, 1e3 * c.refined.both.p95);
+  return c;
+}
+
+TEST(SurfaceRefine, ValidationPosesNotTunedOn) {
+  const double cell = 3.0 / kGrid;
+  double hull_mean = 0, hull_p95 = 0, mean = 0, p95 = 0;
+  for (const auto& [motion, frame, seed] : std::vector<std::tuple<sim::Motion, int64_t, uint64_t>>{
+           {sim::Motion::crouch, 50, 2},   // another actor, deepest crouch
+           {sim::Motion::idle, 40, 3}}) {  // another actor standing, arms at the sides
+    const ShapeCase c = evaluate_shape(motion, frame, seed);
+    EXPECT_LE(c.refined.both.mean, c.hull.both.mean + cell);
+    EXPECT_LE(c.refined.both.p95, c.hull.both.p95 + cell);
+    EXPECT_LT(c.refined.both.mean, c.carved.both.mean) << sim::motion_name(motion);
+    EXPECT_LT(c.refined.both.p95, c.carved.both.p95) << sim::motion_name(motion);
+    hull_mean += c.hull.both.mean, hull_p95 += c.hull.both.p95;
+    mean += c.refined.both.mean, p95 += c.refined.both.p95;
+  }
+  const double mean_gain = 1 - mean / hull_mean, p95_gain = 1 - p95 / hull_p95;
+  std::printf(
+      "validation poses: carved + surface mean %.1f %% lower, p95 %.1f %% lower than the hull\n",
+      100 * mean_gain, 100 * p95_gain);
+  // Measured 18.8 % / 22.5 % (docs/offline.md; the 30 % is not reached).
+  EXPECT_GE(mean_gain, 0.16);
+  EXPECT_GE(p95_gain, 0.20);
+}
+
 TEST(Texture, HeldOutViewPsnr) {
   for (const auto& [motion, frame] : kPoses) {
     const Case& c = evaluate(motion, frame);
@@ -306,6 +378,26 @@ TEST(PhotoCarve, IndependentOfThreadsAndRefusesBadInput) {
   EXPECT_GT(r1.anchored, 0u);
   EXPECT_EQ(r1.mesh.vertices, r2.mesh.vertices);
   EXPECT_EQ(r1.mesh.triangles, m.triangles);
+  // The shape prior keeps every vertex inside each silhouette that contained it (the visual
+  // hull contains the true surface); without the constraint, Laplacian steps move creases out.
+  const auto left_silhouettes = [&](const hull::Mesh& before, const hull::Mesh& after) {
+    int left = 0;
+    for (std::size_t n = 0; n < before.vertices.size(); ++n)
+      for (const auto& v : views) {
+        const auto in = [&](const Eigen::Vector3f& x) {
+          Eigen::Vector2d p;
+          return v.camera->project(x.cast<double>(), &p) &&
+                 v.mask->contains(int(std::lround(p.x())), int(std::lround(p.y())));
+        };
+        left += in(before.vertices[n]) && !in(after.vertices[n]);
+      }
+    return left;
+  };
+  SurfaceRefineOptions shape;
+  shape.cell = 3.0 / 96;
+  EXPECT_EQ(left_silhouettes(m, refine_surface(m, views, shape).value().mesh), 0);
+  shape.inside_hull = false;
+  EXPECT_GT(left_silhouettes(m, refine_surface(m, views, shape).value().mesh), 0);
   SurfaceRefineOptions s_bad = s1;
   s_bad.cell = 0;
   ASSERT_FALSE(refine_surface(m, views, s_bad));

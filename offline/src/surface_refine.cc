@@ -49,6 +49,10 @@ Expected<void> SurfaceRefineOptions::validate() const {
       !(rim_cos >= 0 && rim_cos <= 1))
     return fail(
         "surface refine: shape_steps must be 0..1000, shape_lambda in (0, 1], rim_cos in [0, 1]");
+  if (shape_order != 1 && shape_order != 2)
+    return fail("surface refine: shape_order must be 1 or 2");
+  if (shape_order == 2 && shape_lambda > 0.25)
+    return fail("surface refine: shape_lambda must be <= 0.25 with shape_order 2 (stability)");
   if (threads < 1 || threads > 64) return fail("surface refine: threads must be 1..64");
   return {};
 }
@@ -57,6 +61,8 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
                                              std::span<const ColourView> views,
                                              const SurfaceRefineOptions& o) {
   if (auto ok = o.validate(); !ok) return std::unexpected(ok.error());
+  if (o.inside_hull && views.size() > 64)
+    return fail("surface refine: inside_hull takes at most 64 cameras");
   auto sampled = prepare_views(views, o.edge_margin_px);
   if (!sampled) return std::unexpected(sampled.error());
   const std::vector<SampledView>& cams = *sampled;
@@ -283,15 +289,81 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
         }
       });
     }
-    std::vector<Eigen::Vector3f> moved(nv);
+    // For inside_hull: the cameras (bit c) whose silhouette contains x's projection (nearest
+    // pixel), and whether x is inside all of the silhouettes `bits` (stops at the first miss).
+    // (Camera::project with the view's rotation matrix, and the masks as dense bytes: the test
+    // runs ~20 times per vertex and step.)
+    std::vector<std::vector<uint8_t>> dense(o.inside_hull ? views.size() : 0);
+    for (std::size_t c = 0; c < dense.size(); ++c) {
+      const RunMask& m = *views[c].mask;
+      dense[c].assign(std::size_t(m.width()) * m.height(), 0);
+      for (int y = 0; y < m.height(); ++y)
+        for (const auto& r : m.row(y))
+          std::fill(dense[c].begin() + std::ptrdiff_t(y) * m.width() + r.begin,
+                    dense[c].begin() + std::ptrdiff_t(y) * m.width() + r.end, uint8_t(1));
+    }
+    const auto in_silhouette = [&](std::size_t c, const Eigen::Vector3f& x) {
+      const Eigen::Vector3d xc = cams[c].R * x.cast<double>() + cams[c].t;
+      if (!(xc.z() > 0)) return false;
+      const Camera& cam = *views[c].camera;
+      const Eigen::Vector2d n =
+          distort(cam.distortion, Eigen::Vector2d(xc.x() / xc.z(), xc.y() / xc.z()));
+      const Intrinsics& k = cam.intrinsics;
+      const long px = std::lround(k.fx * n.x() + k.skew * n.y() + k.cx);
+      const long py = std::lround(k.fy * n.y() + k.cy);
+      return px >= 0 && py >= 0 && px < cam.width && py < cam.height &&
+             dense[c][std::size_t(py) * std::size_t(cam.width) + std::size_t(px)] != 0;
+    };
+    const auto silhouettes = [&](const Eigen::Vector3f& x, uint64_t skip = 0) {
+      uint64_t bits = 0;
+      for (std::size_t c = 0; c < views.size(); ++c)
+        if (!(skip >> c & 1) && in_silhouette(c, x)) bits |= uint64_t(1) << c;
+      return bits;
+    };
+    const auto inside_all = [&](uint64_t bits, const Eigen::Vector3f& x) {
+      for (std::size_t c = 0; c < views.size(); ++c)
+        if ((bits >> c & 1) && !in_silhouette(c, x)) return false;
+      return true;
+    };
+    // Per vertex, the silhouettes its current position is inside (kept up to date as it moves:
+    // a move is only taken inside all of them, so only the others are tested again).
+    std::vector<uint64_t> inside(o.inside_hull ? nv : 0);
+    if (o.inside_hull)
+      parallel_for(nv, o.threads, [&](std::size_t a, std::size_t b) {
+        for (std::size_t n = a; n < b; ++n) inside[n] = silhouettes(mesh.vertices[n]);
+      });
+    std::vector<Eigen::Vector3f> moved(nv), lap(nv);
+    const auto umbrella = [&](const std::vector<Eigen::Vector3f>& f, std::size_t n) {
+      Eigen::Vector3f m = Eigen::Vector3f::Zero();
+      for (const uint32_t j : adjacent[n]) m += f[j];
+      return Eigen::Vector3f(m / float(adjacent[n].size()) - f[n]);
+    };
     for (int step = 0; step < o.shape_steps; ++step) {
+      if (o.shape_order == 2)
+        parallel_for(nv, o.threads, [&](std::size_t a, std::size_t b) {
+          for (std::size_t n = a; n < b; ++n)
+            lap[n] = adjacent[n].empty() ? Eigen::Vector3f::Zero() : umbrella(mesh.vertices, n);
+        });
       parallel_for(nv, o.threads, [&](std::size_t a, std::size_t b) {
         for (std::size_t n = a; n < b; ++n) {
           moved[n] = mesh.vertices[n];
           if (anchored[n] || adjacent[n].empty()) continue;
-          Eigen::Vector3f m = Eigen::Vector3f::Zero();
-          for (const uint32_t j : adjacent[n]) m += mesh.vertices[j];
-          moved[n] += float(o.shape_lambda) * (m / float(adjacent[n].size()) - mesh.vertices[n]);
+          Eigen::Vector3f d =
+              o.shape_order == 2
+                  ? Eigen::Vector3f(-float(o.shape_lambda) * umbrella(lap, n))
+                  : Eigen::Vector3f(float(o.shape_lambda) * umbrella(mesh.vertices, n));
+          if (!o.inside_hull) {
+            moved[n] += d;
+            continue;
+          }
+          const uint64_t before = inside[n];
+          for (int halve = 0; halve < 4; ++halve, d *= 0.5f)
+            if (inside_all(before, mesh.vertices[n] + d)) {
+              moved[n] += d;
+              // Still inside `before`; other silhouettes it may have entered:
+              inside[n] = before | silhouettes(moved[n], before);
+              break;
+            }
         }
       });
       mesh.vertices.swap(moved);

@@ -1,0 +1,150 @@
+// Development sweep (not a test): surface-stage variants on simulated poses, scored against the
+// truth. Usage: offline_surface_sweep "variant;variant;..." where a variant is key=value,...
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <string>
+
+#include "hull/crossing_refine.h"
+#include "hull/segment_mesh.h"
+#include "hull/silhouette_cut.h"
+#include "offline/photo_carve.h"
+#include "offline/surface_refine.h"
+#include "offline/view_sampling.h"
+#include "sim/cameras.h"
+#include "testing/truth.h"
+
+using namespace studio;
+using namespace studio::offline;
+
+struct Pose {
+  sim::Motion motion;
+  int64_t frame;
+  uint64_t seed;
+  bool train;
+};
+
+struct Prepared {
+  testing::Frame f;
+  std::vector<ColourView> views;
+  hull::Mesh hull_mesh, carved_mesh;
+  testing::SurfaceScore hull, carved;
+};
+
+// Share of the mask pixels (eroded by 1 px) the mesh's projection does not cover.
+double silhouette_loss(const hull::Mesh& m, const std::vector<ColourView>& views) {
+  auto sv = prepare_views(views, 1).value();
+  double lost = 0, total = 0;
+  for (std::size_t c = 0; c < sv.size(); ++c) {
+    DepthBuffer d;
+    d.reset(sv[c]);
+    for (const auto& t : m.triangles)
+      d.triangle(sv[c], m.vertices[t[0]].cast<double>(), m.vertices[t[1]].cast<double>(),
+                 m.vertices[t[2]].cast<double>());
+    for (int y = 0; y < sv[c].camera->height; ++y)
+      for (int x = 0; x < sv[c].camera->width; ++x)
+        if (sv[c].inside(x, y)) {
+          ++total;
+          lost += !std::isfinite(d.at(x, y));
+        }
+  }
+  return lost / total;
+}
+
+int main(int argc, char** argv) {
+  const int grid = std::getenv("GRID") ? std::atoi(std::getenv("GRID")) : 256;
+  std::vector<Pose> poses = {
+      {sim::Motion::idle, 10, 1, true},      {sim::Motion::crouch, 45, 1, true},
+      {sim::Motion::crouch, 25, 1, false},   {sim::Motion::crouch, 50, 2, false},
+      {sim::Motion::idle, 40, 3, false},     {sim::Motion::walk, 20, 1, false},
+      {sim::Motion::arm_swing, 30, 2, false}};
+  if (std::getenv("POSES")) {
+    std::vector<Pose> sel;
+    for (char ch : std::string(std::getenv("POSES"))) sel.push_back(poses[ch - '0']);
+    poses = sel;
+  }
+  std::vector<Prepared> prep(poses.size());
+  sim::RingOptions ring;
+  ring.count = 9;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    sim::StudioOptions so;
+    so.actor.motion = poses[i].motion;
+    so.actor.seed = poses[i].seed;
+    auto studio = sim::SimulatedStudio::create(sim::ring_cameras(ring), so).value();
+    Prepared& p = prep[i];
+    p.f = testing::render_frame(studio, poses[i].frame);
+    p.views = p.f.views();
+    std::vector<hull::View> cut;
+    for (const auto& v : p.views) cut.push_back({v.camera, v.mask});
+    const auto set = hull::visual_hull(testing::studio_grid(grid), cut).value();
+    p.hull_mesh = hull::segment_marching_cubes(set);
+    (void)hull::refine_crossings(p.hull_mesh, set, cut);
+    CarveOptions co;
+    co.threads = 2;
+    const auto carved = photo_carve(set, p.views, co).value();
+    p.carved_mesh = refined_mesh(carved.set, set, p.views, 2).value();
+    p.hull = testing::surface_distance(p.hull_mesh, p.f.truth.body);
+    p.carved = testing::surface_distance(p.carved_mesh, p.f.truth.body);
+    std::printf("pose %s f%lld seed %llu %s: hull %.2f / %.2f, carved %.2f / %.2f (loss %.4f)\n",
+                sim::motion_name(poses[i].motion), (long long)poses[i].frame,
+                (unsigned long long)poses[i].seed, poses[i].train ? "train" : "valid",
+                1e3 * p.hull.both.mean, 1e3 * p.hull.both.p95, 1e3 * p.carved.both.mean,
+                1e3 * p.carved.both.p95, silhouette_loss(p.carved_mesh, p.views));
+    std::fflush(stdout);
+  }
+  std::stringstream all(argc > 1 ? argv[1] : "");
+  std::string variant;
+  while (std::getline(all, variant, ';')) {
+    SurfaceRefineOptions o;
+    o.cell = 3.0 / grid;
+    o.threads = 2;
+    bool from_hull = false;
+    std::stringstream kv(variant);
+    std::string item;
+    while (std::getline(kv, item, ',')) {
+      const auto eq = item.find('=');
+      const std::string k = item.substr(0, eq);
+      const double v = std::atof(item.substr(eq + 1).c_str());
+      if (k == "steps")
+        o.shape_steps = int(v);
+      else if (k == "lambda")
+        o.shape_lambda = v;
+      else if (k == "rim")
+        o.rim_cos = v;
+      else if (k == "anchor")
+        o.anchor_rims = v != 0;
+      else if (k == "hull")
+        o.inside_hull = v != 0;
+      else if (k == "order")
+        o.shape_order = int(v);
+      else if (k == "fromhull")
+        from_hull = v != 0;
+      else {
+        std::fprintf(stderr, "unknown key %s\n", k.c_str());
+        return 1;
+      }
+    }
+    double hm[2] = {0, 0}, hp[2] = {0, 0}, m[2] = {0, 0}, q[2] = {0, 0};
+    std::printf("variant %s\n", variant.c_str());
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      const Prepared& p = prep[i];
+      const auto r = refine_surface(from_hull ? p.hull_mesh : p.carved_mesh, p.views, o).value();
+      const auto s = testing::surface_distance(r.mesh, p.f.truth.body);
+      const int k = poses[i].train ? 0 : 1;
+      hm[k] += p.hull.both.mean, hp[k] += p.hull.both.p95, m[k] += s.both.mean, q[k] += s.both.p95;
+      std::printf(
+          "  %-9s f%-3lld s%llu: %.2f / %.2f (%+.1f %% / %+.1f %%) acc %.2f compl %.2f anchored "
+          "%zu/%zu loss %.4f\n",
+          sim::motion_name(poses[i].motion), (long long)poses[i].frame,
+          (unsigned long long)poses[i].seed, 1e3 * s.both.mean, 1e3 * s.both.p95,
+          100 * (s.both.mean / p.hull.both.mean - 1), 100 * (s.both.p95 / p.hull.both.p95 - 1),
+          1e3 * s.accuracy.mean, 1e3 * s.completeness.mean, r.anchored, r.mesh.vertices.size(),
+          silhouette_loss(r.mesh, p.views));
+      std::fflush(stdout);
+    }
+    for (int k = 0; k < 2; ++k)
+      if (hm[k] > 0)
+        std::printf("  %s: mean %+.1f %%, p95 %+.1f %%\n", k ? "valid" : "train",
+                    100 * (m[k] / hm[k] - 1), 100 * (q[k] / hp[k] - 1));
+  }
+}
