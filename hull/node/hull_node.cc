@@ -5,15 +5,13 @@
 #include <optional>
 #include <utility>
 
+#include "actor_outputs.h"
+#include "core/clock.h"
 #include "core/frame_assembler.h"
 #include "core/log.h"
 #include "hull/camera_poses.h"
-#include "hull/crossing_refine.h"
-#include "hull/projector_mask.h"
-#include "hull/segment_mesh.h"
 #include "hull/visibility.h"
 #include "hull_stages.h"
-#include "core/clock.h"
 #include "runtime/service_loop.h"
 #include "wire/actor_convert.h"
 #include "wire/convert.h"
@@ -25,20 +23,6 @@ namespace {
 constexpr const char* kLog = "hull";
 using SteadyClock = std::chrono::steady_clock;
 using Assembler = FrameAssembler<RunMask>;
-
-// Straight from the mesh's arrays (3 packed floats / indices per element) into the sample's.
-void mesh_to_wire(const Mesh& mesh, studio_ActorMesh& s) {
-  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
-  static_assert(sizeof(std::array<uint32_t, 3>) == 3 * sizeof(uint32_t));
-  const auto floats = [](const std::vector<Eigen::Vector3f>& v) {
-    return std::span<const float>(v.empty() ? nullptr : v.front().data(), 3 * v.size());
-  };
-  wire::assign(s.vertices, floats(mesh.vertices));
-  wire::assign(s.normals, floats(mesh.normals));
-  wire::assign(s.triangles, std::span<const uint32_t>(
-                                mesh.triangles.empty() ? nullptr : mesh.triangles.front().data(),
-                                3 * mesh.triangles.size()));
-}
 
 Assembler::Options assembler_options(const HullNodeOptions& o, const std::vector<Camera>& cams) {
   Assembler::Options a;
@@ -60,9 +44,8 @@ class HullNode : public runtime::Node {
         projectors_(std::move(projectors)),
         stages_(ctx.metrics),
         loop_(ctx, kLog) {
+    outputs_.emplace(loop_, options_);
     if (options_.projector_masks) {
-      projector_masks_ =
-          &loop_.output<studio_ProjectorMask>({.counter = "projector_masks_out", .rate = false});
       // The projectors' own calibrations (studio-projector publishes its rig entry, transient
       // local): a projector not in our rig joins, one in it is replaced.
       loop_.input<studio_ProjectorCalibration>(
@@ -74,8 +57,6 @@ class HullNode : public runtime::Node {
             return on_projector_calibration(s);
           });
     }
-    segs_ = &loop_.output<studio_SegmentSet>({.counter = "segment_sets_out"});
-    meshes_ = &loop_.output<studio_ActorMesh>({.counter = "meshes_out", .rate = false});
     // Every per-frame pose of a tracked camera, even when a cut holds this node up (the topic
     // keeps only the newest per camera).
     loop_.input<studio_CameraCalibration>(
@@ -207,93 +188,21 @@ class HullNode : public runtime::Node {
     const std::vector<SegmentSet> actors = connected_components(*hull, options_.min_actor_volume);
     const auto cut_done = SteadyClock::now();
     stages_.add(HullStages::cut, cut_done - t);
-    Durations d;
+    ActorOutputs::Durations d;
+    const ActorOutputs::FrameId id{frame.frame, frame.capture_ns};
     for (std::size_t k = 0; k < actors.size(); ++k)
-      publish(actors[k], options_.actor_prefix + std::to_string(k), frame, views, cut, d);
+      outputs_->actor(actors[k], options_.actor_prefix + std::to_string(k), id, views, cut, d);
     stages_.add(HullStages::mesh, d.mesh);
     stages_.add(HullStages::refine, d.refine);
     stages_.add(HullStages::publish, d.publish);
     if (last_mask && !actors.empty())
       stages_.add(HullStages::mask_to_mesh, SteadyClock::now() - *last_mask);
     for (std::size_t k = actors.size(); k < published_actors_; ++k)
-      dispose(options_.actor_prefix + std::to_string(k));
+      outputs_->dispose(options_.actor_prefix + std::to_string(k));
     published_actors_ = actors.size();
     loop_.completed(frame.frame, frame.capture_ns);
     last_partial_ = views.size() < poses_.size();
-    if (projector_masks_) publish_projector_masks(frame, views, cut);
-  }
-
-  // Every projector's actor mask by the viewpoint cut (hull/projector_mask.h).
-  void publish_projector_masks(const Assembler::Frame& frame, std::span<const View> views,
-                               const CutOptions& cut) {
-    const GridSpec g = options_.grid_spec();
-    ProjectorMaskOptions po;
-    po.step = options_.projector_mask_step;
-    po.cut = cut;
-    for (const Camera& projector : projectors_) {
-      auto mask = projector_mask(projector, Eigen::AlignedBox3d(g.box_min, g.box_max), views, po);
-      if (!mask) {
-        STUDIO_LOG(warn, kLog) << "frame " << frame.frame << ": projector " << projector.id << ": "
-                               << mask.error().message;
-        continue;
-      }
-      wire::Owned<studio_ProjectorMask> s;
-      wire::set(s->projector_id, projector.id);
-      s->frame = frame.frame;
-      s->capture_ns = frame.capture_ns;
-      s->step = uint32_t(po.step);
-      wire::from_core(*mask, *s);
-      (void)projector_masks_->write(*s);
-    }
-  }
-
-  struct Durations {
-    SteadyClock::duration mesh{}, refine{}, publish{};
-  };
-  void publish(const SegmentSet& set, const std::string& actor_id, const Assembler::Frame& frame,
-               std::span<const View> views, const CutOptions& cut, Durations& d) {
-    auto t = SteadyClock::now();
-    const auto lap = [&t](SteadyClock::duration& into) {
-      const auto now = SteadyClock::now();
-      into += now - t;
-      t = now;
-    };
-    wire::Owned<studio_SegmentSet> s;
-    wire::set(s->actor_id, actor_id);
-    s->frame = frame.frame;
-    s->capture_ns = frame.capture_ns;
-    wire::from_core(set, *s);
-    (void)segs_->write(*s);
-    lap(d.publish);
-    if (!options_.mesh) return;
-    wire::Owned<studio_ActorMesh> m;
-    wire::set(m->actor_id, actor_id);
-    m->frame = frame.frame;
-    m->capture_ns = frame.capture_ns;
-    m->source_frame = frame.frame;
-    // With exact crossings the normals come after the vertices moved (refine_crossings).
-    Mesh mesh = segment_marching_cubes(set, {.normals = !options_.refine});
-    lap(d.mesh);
-    if (options_.refine) {
-      // Only fails on a mask of the wrong size, which the frame's cut already rejected.
-      if (auto ok = refine_crossings(mesh, set, views, cut); !ok) {
-        STUDIO_LOG(warn, kLog) << "frame " << frame.frame << ": " << ok.error().message;
-        compute_normals(mesh);
-      }
-      lap(d.refine);
-    }
-    mesh_to_wire(mesh, *m);
-    (void)meshes_->write(*m);
-    lap(d.publish);
-  }
-
-  void dispose(const std::string& actor_id) {
-    wire::Owned<studio_SegmentSet> s;
-    wire::set(s->actor_id, actor_id);
-    (void)segs_->dispose(*s);
-    wire::Owned<studio_ActorMesh> m;
-    wire::set(m->actor_id, actor_id);
-    (void)meshes_->dispose(*m);
+    outputs_->projector_masks(id, projectors_, views, cut);
   }
 
   HullNodeOptions options_;
@@ -302,10 +211,8 @@ class HullNode : public runtime::Node {
   FrameAssemblerCounts seen_;
   std::size_t published_actors_ = 0;
   std::atomic<bool> last_partial_{false};
-  runtime::Output<studio_SegmentSet>* segs_ = nullptr;
-  runtime::Output<studio_ActorMesh>* meshes_ = nullptr;
   std::vector<Camera> projectors_;
-  runtime::Output<studio_ProjectorMask>* projector_masks_ = nullptr;
+  std::optional<ActorOutputs> outputs_;  // made on loop_ in the constructor
   std::vector<runtime::Counter*> frame_counts_;
   runtime::Counter* stale_ = nullptr;
   runtime::Counter* invalid_ = nullptr;
