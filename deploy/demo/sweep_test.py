@@ -5,7 +5,9 @@ MaskPlanner, at 60 ms from capture to the frame rendered (issue 20's bound on th
 motion-to-photon p99: the latency the demo's projector must reach, and then passes to the sweep
 itself) + the simulator's 16 ms display lag, 100 frames (more than one swing). Asserts issue 15's
 "with prediction the margin needed for 0 lit pixels is <= 30 mm", that the sweep can fail (without
-prediction the same margin lights the actor, and a zero margin lights it with prediction too),
+prediction a zero margin and the margin prediction needs both light the actor; with prediction a
+zero margin may light nothing, since the mask is pushed out by its simplification's error on top
+of any margin: 2.5-2.6 cm with the projector's default two-stage simplification, mask_presimplify),
 that wasted pixels grow with the margin, and that the JSON and the PNG plot are written."""
 import argparse
 import json
@@ -48,7 +50,8 @@ def main():
     check(r["frames_scored"] >= 90, f"only {r['frames_scored']} frames scored")
     check(r["actor_px_mean"] > 5000, "the actor is hardly in the projector's image")
     check(need is not None and need <= 0.030, f"with prediction the margin needed is {need} m > 0.030")
-    check(pred["points"][0]["lit_actor_px"] > 0, "a zero margin lights nothing: the sweep cannot fail")
+    check(none["points"][0]["margin_m"] == 0 and none["points"][0]["lit_actor_px"] > 0,
+          "without prediction a zero margin lights nothing: the sweep cannot fail")
     at = {p["margin_m"]: p for p in none["points"]}
     if need is not None:
         check(at[need]["lit_actor_px"] > 0,
