@@ -49,6 +49,33 @@ std::vector<Camera> rig() {
   return cams;
 }
 
+// A frame of the simulated actor and the visual hull of its studio cameras' masks (the held-out
+// camera, last, left out), its mesh with exact crossings: where every evaluation here starts.
+struct HullFrame {
+  explicit HullFrame(sim::SimulatedStudio s) : studio(std::move(s)) {}
+  sim::SimulatedStudio studio;
+  testing::Frame f;
+  std::vector<ColourView> views;
+  std::vector<hull::View> cut_views;
+  hull::SegmentSet set;
+  hull::Mesh hull_mesh;
+};
+
+HullFrame hull_frame(sim::Motion motion, int64_t frame, uint64_t seed) {
+  sim::StudioOptions so;
+  so.actor.motion = motion;
+  so.actor.seed = seed;
+  HullFrame h(sim::SimulatedStudio::create(rig(), so).value());
+  h.f = testing::render_frame(h.studio, frame);
+  h.views = h.f.views();
+  h.views.pop_back();  // the held-out camera
+  for (const auto& v : h.views) h.cut_views.push_back({v.camera, v.mask});
+  h.set = hull::visual_hull(testing::studio_grid(kGrid), h.cut_views).value();
+  h.hull_mesh = hull::segment_marching_cubes(h.set);
+  EXPECT_TRUE(hull::refine_crossings(h.hull_mesh, h.set, h.cut_views).has_value());
+  return h;
+}
+
 struct Case {
   testing::SurfaceScore hull, carved_score, refined;  // refined = carved + surface refinement
   double psnr_hull = 0, psnr_refined = 0;             // interior (2-px border excluded)
@@ -62,17 +89,12 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
   static std::map<std::pair<int, int64_t>, Case> cache;
   const auto key = std::make_pair(int(motion), frame);
   if (auto it = cache.find(key); it != cache.end()) return it->second;
-  sim::StudioOptions so;
-  so.actor.motion = motion;
-  auto studio = sim::SimulatedStudio::create(rig(), so).value();
-  const testing::Frame f = testing::render_frame(studio, frame);
-  auto views = f.views();
-  views.pop_back();  // the held-out camera
-  std::vector<hull::View> cut_views;
-  for (const auto& v : views) cut_views.push_back({v.camera, v.mask});
-  const hull::SegmentSet set = hull::visual_hull(testing::studio_grid(kGrid), cut_views).value();
-  hull::Mesh hull_mesh = hull::segment_marching_cubes(set);
-  EXPECT_TRUE(hull::refine_crossings(hull_mesh, set, cut_views).has_value());
+  HullFrame h = hull_frame(motion, frame, 1);
+  sim::SimulatedStudio& studio = h.studio;
+  const testing::Frame& f = h.f;
+  const auto& views = h.views;
+  const hull::SegmentSet& set = h.set;
+  const hull::Mesh& hull_mesh = h.hull_mesh;
   CarveOptions o;
   o.threads = 2;
   const CarveResult carved = photo_carve(set, views, o).value();
@@ -263,18 +285,11 @@ struct ShapeCase {
 };
 
 ShapeCase evaluate_shape(sim::Motion motion, int64_t frame, uint64_t seed) {
-  sim::StudioOptions so;
-  so.actor.motion = motion;
-  so.actor.seed = seed;
-  auto studio = sim::SimulatedStudio::create(rig(), so).value();
-  const testing::Frame f = testing::render_frame(studio, frame);
-  auto views = f.views();
-  views.pop_back();  // the held-out camera
-  std::vector<hull::View> cut_views;
-  for (const auto& v : views) cut_views.push_back({v.camera, v.mask});
-  const hull::SegmentSet set = hull::visual_hull(testing::studio_grid(kGrid), cut_views).value();
-  hull::Mesh hull_mesh = hull::segment_marching_cubes(set);
-  EXPECT_TRUE(hull::refine_crossings(hull_mesh, set, cut_views).has_value());
+  const HullFrame h = hull_frame(motion, frame, seed);
+  const testing::Frame& f = h.f;
+  const auto& views = h.views;
+  const hull::SegmentSet& set = h.set;
+  const hull::Mesh& hull_mesh = h.hull_mesh;
   CarveOptions o;
   o.threads = 2;
   const hull::Mesh carved =
