@@ -35,10 +35,10 @@ class ProjectorNode : public runtime::Node {
         view_(std::move(view)),
         projector_(projector),
         mirror_(options_.scene_cache.settle_s),
-        planner_(options_.mask_options()),
         eye_(Eigen::Vector3d(options_.default_eye[0], options_.default_eye[1],
                              options_.default_eye[2]),
              options_.head_timeout_s),
+        planner_(options_.mask_options()),
         loop_(ctx, kLog),
         stages_(loop_.metrics()),
         m_(loop_) {
