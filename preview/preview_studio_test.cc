@@ -100,6 +100,8 @@ TEST_F(PreviewStudioTest, BadInputIsOneLineAndExitTwo) {
       {"--viewpoint", "eye=1,2,at=0,0,0", "--headless", "--screenshot", "a.png"},
       {"--headless"},
       {"--frames", "-3", "--headless", "--screenshot", "a.png"},
+      {"--every", "0.01", "--headless", "--screenshot", "a.png"},
+      {"--every", "2", "--frames", "0", "--headless", "--screenshot", "a.png"},
       {"--screenshot", "a.png"},
       {"--bogus"}};
   for (const auto& args : cases) {

@@ -154,6 +154,8 @@ int run(int argc, char** argv) {
     die("log: bad spec '" + config->log + "'");
   if (headless) {
     if (h.screenshot.empty()) die("--headless needs --screenshot PNG (see --help)");
+    if (h.every_s > 0 && h.frames == 0)
+      die("--every draws meshes; --frames 0 draws the scene only: use one of them");
     return preview::run_headless(*config, h);
   }
   if (!h.screenshot.empty() || !h.record.empty())
