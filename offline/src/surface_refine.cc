@@ -293,15 +293,8 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
     // pixel), and whether x is inside all of the silhouettes `bits` (stops at the first miss).
     // (Camera::project with the view's rotation matrix, and the masks as dense bytes: the test
     // runs ~20 times per vertex and step.)
-    std::vector<std::vector<uint8_t>> dense(o.inside_hull ? views.size() : 0);
-    for (std::size_t c = 0; c < dense.size(); ++c) {
-      const RunMask& m = *views[c].mask;
-      dense[c].assign(std::size_t(m.width()) * m.height(), 0);
-      for (int y = 0; y < m.height(); ++y)
-        for (const auto& r : m.row(y))
-          std::fill(dense[c].begin() + std::ptrdiff_t(y) * m.width() + r.begin,
-                    dense[c].begin() + std::ptrdiff_t(y) * m.width() + r.end, uint8_t(1));
-    }
+    std::vector<Mask> dense(o.inside_hull ? views.size() : 0);
+    for (std::size_t c = 0; c < dense.size(); ++c) dense[c] = views[c].mask->to_mask();
     const auto in_silhouette = [&](std::size_t c, const Eigen::Vector3f& x) {
       const Eigen::Vector3d xc = cams[c].R * x.cast<double>() + cams[c].t;
       if (!(xc.z() > 0)) return false;
@@ -311,8 +304,8 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
       const Intrinsics& k = cam.intrinsics;
       const long px = std::lround(k.fx * n.x() + k.skew * n.y() + k.cx);
       const long py = std::lround(k.fy * n.y() + k.cy);
-      return px >= 0 && py >= 0 && px < cam.width && py < cam.height &&
-             dense[c][std::size_t(py) * std::size_t(cam.width) + std::size_t(px)] != 0;
+      return px >= 0 && py >= 0 && px < dense[c].width() && py < dense[c].height() &&
+             dense[c](int(px), int(py)) != 0;
     };
     const auto silhouettes = [&](const Eigen::Vector3f& x, uint64_t skip = 0) {
       uint64_t bits = 0;

@@ -155,8 +155,8 @@ struct ViewPipeline::Impl {
     node->request_images(pending->source_frame, pending_cameras);
   }
 
-  // The blend's carving masks: every calibrated camera's mask of exactly `frame` that arrived
-  // (one size: the most common), else none.
+  // The blend's carving masks: every calibrated camera's mask of exactly `frame` that arrived,
+  // of the first such camera's size (one texture array), at most kMaxMasks; else none.
   void set_carving_masks(const std::map<std::string, Camera>& cams, uint64_t frame) {
     carving_cameras.clear();
     carving_masks.clear();

@@ -47,10 +47,10 @@ Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t 
     simplify_s = std::chrono::duration<double>(Clock::now() - s0).count();
   };
   std::optional<Expected<std::optional<MeshMotion>>> motion;
-  std::thread worker;
+  std::jthread worker;  // joined on every way out, a throwing motion fit included
   if (options_.parallel_mesh_work) {
     try {
-      worker = std::thread(simplify);
+      worker = std::jthread(simplify);
     } catch (const std::system_error&) {  // no thread to be had: one after the other
     }
   }
