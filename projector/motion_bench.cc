@@ -1,11 +1,24 @@
-// The projector's per-mesh motion estimate (projector/motion.h) on meshes of the simulated actor
-// swinging its arm at 1.5 m/s (sim/ arm_swing), at about the hull's mesh size in the demo (the
-// body's parts tessellated to ~10k vertices), 25 Hz: what the node pays for every mesh. Baseline
-// in the same run: the same fit on every vertex (fit_vertices = global_fit_vertices = 0, the
-// estimate before the budget), so the ratio is the budget's gain.
+// The projector's per-mesh motion estimate (projector/motion.h): what the node pays for every mesh.
+//
+// Live-like meshes (BM_MotionHull*): the hull's own meshes of the simulated actor swinging its
+// arm at 1.5 m/s (sim/ arm_swing, true masks of the 6-camera ring -> silhouette cut at the demo's
+// 160 columns -> segment marching cubes -> exact crossings; testing/hull_meshes.h), ~35-40k
+// triangles, 25 Hz: the demo's live meshes are 35-51k triangles. BM_MotionHullVsLegacy runs the
+// default fit and the fit before issue 15's cost work (MotionOptions::legacy(), the baseline)
+// interleaved mesh by mesh on two trackers, thread CPU per mesh of each, and how far their
+// velocity fields are apart (per vertex, m/s).
+//
+// Tessellated simulated body (BM_MotionEveryVertex, BM_MotionBudget*; testing/swing_meshes.h,
+// ~11k vertices): the earlier figures' input, kept for comparison with BENCHMARKS.md.
 #include <benchmark/benchmark.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
 
 #include "projector/motion.h"
+#include "testing/hull_meshes.h"
 #include "testing/swing_meshes.h"
 
 using namespace studio;
@@ -16,47 +29,129 @@ constexpr int64_t kFrameNs = projector::testing::kSwingFrameNs;
 
 using projector::testing::swing_meshes;
 
-void run(benchmark::State& state, const projector::MotionOptions& options) {
-  const auto& m = swing_meshes();
+const std::vector<projector::ActorMesh>& hull_swing() {
+  // Frames 50-65 (2.0-2.6 s): the swing's fast part.
+  static const std::vector<projector::ActorMesh> m =
+      projector::testing::hull_meshes(sim::Motion::arm_swing, 50, 16);
+  return m;
+}
+
+double thread_cpu() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + double(ts.tv_nsec) * 1e-9;
+}
+
+// The k-th mesh of the sequence, its capture time moved on so times keep increasing on wrap.
+projector::ActorMesh nth(const std::vector<projector::ActorMesh>& m, size_t k) {
+  projector::ActorMesh mesh = m[k % m.size()];
+  const int64_t span = m.back().capture_ns - m.front().capture_ns + kFrameNs;
+  mesh.capture_ns += int64_t(k / m.size()) * span;
+  return mesh;
+}
+
+void run(benchmark::State& state, const std::vector<projector::ActorMesh>& m,
+         const projector::MotionOptions& options) {
   projector::MotionTracker tracker(options);
-  int64_t shift = 0;
   size_t k = 0;
+  double triangles = 0, queries = 0, fits = 0, iterations = 0, motions = 0;
   for (auto _ : state) {
-    projector::ActorMesh mesh = m[k % m.size()];
-    mesh.capture_ns += shift;  // keeps capture times increasing when the sequence wraps
-    if (++k % m.size() == 0) shift += int64_t(m.size()) * kFrameNs;
+    state.PauseTiming();
+    projector::ActorMesh mesh = nth(m, k++);
+    triangles += double(mesh.triangles.size());
+    state.ResumeTiming();
     auto r = tracker.update(mesh);
-    if (!r) state.SkipWithError(r.error().message.c_str());
+    if (!r) {
+      state.SkipWithError(r.error().message.c_str());
+      break;
+    }
+    if (*r) {
+      queries += double((*r)->closest_queries);
+      fits += (*r)->fits;
+      iterations += (*r)->iterations;
+      ++motions;
+    }
     benchmark::DoNotOptimize(r);
   }
   state.counters["vertices"] = double(m[0].vertices.size());
+  state.counters["triangles"] = triangles / double(std::max<size_t>(k, 1));
+  state.counters["queries_per_mesh"] = queries / std::max(motions, 1.0);
+  state.counters["fits_per_mesh"] = fits / std::max(motions, 1.0);
+  state.counters["iterations_per_fit"] = iterations / std::max(fits, 1.0);
 }
 
 void BM_MotionEveryVertex(benchmark::State& state) {
-  projector::MotionOptions o;
+  projector::MotionOptions o = projector::MotionOptions::legacy();
   o.fit_vertices = 0;
   o.global_fit_vertices = 0;
   o.converged_m = 1e-7;  // the fit before the budget
-  run(state, o);
+  run(state, swing_meshes(), o);
 }
 BENCHMARK(BM_MotionEveryVertex)->Unit(benchmark::kMillisecond)->MinTime(2);
 
-void BM_MotionBudget(benchmark::State& state) { run(state, {}); }
+void BM_MotionBudget(benchmark::State& state) { run(state, swing_meshes(), {}); }
 BENCHMARK(BM_MotionBudget)->Unit(benchmark::kMillisecond)->MinTime(2);
 
-void BM_MotionBudgetArgs(benchmark::State& state) {
-  projector::MotionOptions o;
-  o.fit_vertices = int(state.range(0));
-  o.global_fit_vertices = int(state.range(1));
-  o.iterations = int(state.range(2));
-  run(state, o);
+void BM_MotionBudgetLegacy(benchmark::State& state) {
+  run(state, swing_meshes(), projector::MotionOptions::legacy());
 }
-BENCHMARK(BM_MotionBudgetArgs)
-    ->Args({24, 300, 15})
-    ->Args({48, 600, 8})
-    ->Args({24, 300, 8})
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(1);
+BENCHMARK(BM_MotionBudgetLegacy)->Unit(benchmark::kMillisecond)->MinTime(2);
+
+void BM_MotionHull(benchmark::State& state) { run(state, hull_swing(), {}); }
+BENCHMARK(BM_MotionHull)->Unit(benchmark::kMillisecond)->MinTime(2);
+
+void BM_MotionHullLegacy(benchmark::State& state) {
+  run(state, hull_swing(), projector::MotionOptions::legacy());
+}
+BENCHMARK(BM_MotionHullLegacy)->Unit(benchmark::kMillisecond)->MinTime(2);
+
+// Both fits on every mesh, interleaved (same conditions): CPU per mesh of each, the ratio, and the
+// difference of their velocity fields over all vertices of all meshes (mean and max, m/s).
+void BM_MotionHullVsLegacy(benchmark::State& state) {
+  const auto& m = hull_swing();
+  projector::MotionTracker now{projector::MotionOptions{}};
+  projector::MotionTracker legacy{projector::MotionOptions::legacy()};
+  double cpu_now = 0, cpu_legacy = 0, diff_sum = 0, diff_max = 0, speed_sum = 0;
+  int64_t meshes = 0, compared = 0;
+  size_t k = 0;
+  for (auto _ : state) {
+    const projector::ActorMesh mesh = nth(m, k++);
+    const bool now_first = k % 2 == 0;  // alternate which runs first
+    double t0 = thread_cpu();
+    auto a = now_first ? now.update(mesh) : legacy.update(mesh);
+    const double t1 = thread_cpu();
+    auto b = now_first ? legacy.update(mesh) : now.update(mesh);
+    const double t2 = thread_cpu();
+    if (!a || !b) {
+      state.SkipWithError("motion failed");
+      break;
+    }
+    cpu_now += now_first ? t1 - t0 : t2 - t1;
+    cpu_legacy += now_first ? t2 - t1 : t1 - t0;
+    ++meshes;
+    const auto& fast = now_first ? *a : *b;
+    const auto& slow = now_first ? *b : *a;
+    if (fast && slow) {
+      for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+        const double d = double((fast->velocity(v) - slow->velocity(v)).norm());
+        diff_sum += d;
+        diff_max = std::max(diff_max, d);
+        speed_sum += double(slow->velocity(v).norm());
+        ++compared;
+      }
+    }
+  }
+  state.counters["now_cpu_ms_per_mesh"] = 1e3 * cpu_now / double(std::max<int64_t>(meshes, 1));
+  state.counters["legacy_cpu_ms_per_mesh"] =
+      1e3 * cpu_legacy / double(std::max<int64_t>(meshes, 1));
+  state.counters["speedup"] = cpu_legacy / std::max(cpu_now, 1e-12);
+  state.counters["velocity_diff_mean_mps"] = diff_sum / double(std::max<int64_t>(compared, 1));
+  state.counters["velocity_diff_max_mps"] = diff_max;
+  state.counters["legacy_speed_mean_mps"] = speed_sum / double(std::max<int64_t>(compared, 1));
+  state.counters["vertices"] = double(m[0].vertices.size());
+  state.counters["triangles"] = double(m[0].triangles.size());
+}
+BENCHMARK(BM_MotionHullVsLegacy)->Unit(benchmark::kMillisecond)->MinTime(4);
 
 }  // namespace
 

@@ -211,6 +211,8 @@ struct Fit {
   Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  // sum n n^T of the last iteration
   double rms = 0;
   int used = 0;
+  int iterations = 0;       // run
+  int64_t queries = 0;      // closest-point queries
 };
 
 // Point-to-plane ICP of the translation t with current = previous moved by t, over the current
@@ -222,6 +224,8 @@ Fit icp_translation(const ActorMesh& current, const std::vector<int>& indices, c
   Fit fit;
   fit.translation = start;
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
+    ++fit.iterations;
+    fit.queries += int64_t(indices.size());
     Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
     double sum = 0;
@@ -272,6 +276,12 @@ Expected<MeshMotion> estimate(const Target& target, const ActorMesh& current,
   const Fit global = icp_translation(current, stratified(all, options.global_fit_vertices), target,
                                      Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), options);
   motion.global_velocity = global.translation / dt;
+  auto count = [&motion](const Fit& fit) {
+    ++motion.fits;
+    motion.iterations += fit.iterations;
+    motion.closest_queries += fit.queries;
+  };
+  count(global);
 
   std::unordered_map<int64_t, int> region_of_cell;
   std::vector<Eigen::Vector3i> region_cell;
@@ -305,6 +315,7 @@ Expected<MeshMotion> estimate(const Target& target, const ActorMesh& current,
     const std::vector<int> sample = stratified(members[r], options.fit_vertices);
     const Fit fit = icp_translation(current, sample, target, global.translation, global.translation,
                                     options, double(members[r].size()) / double(sample.size()));
+    count(fit);
     if (fit.used < std::min<int>(sample.size(), options.min_region_vertices) / 2) continue;
     translation[r] = fit.translation;
     information[r] = fit.information;
@@ -436,6 +447,11 @@ Expected<MeshMotion> estimate(const Target& target, const ActorMesh& current,
 }
 
 }  // namespace
+
+MotionOptions MotionOptions::legacy() {
+  MotionOptions o;
+  return o;
+}
 
 Expected<void> MotionOptions::validate() const {
   if (!(region_size_m > 0) || !std::isfinite(region_size_m))

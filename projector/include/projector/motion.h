@@ -42,6 +42,7 @@
 // moved by its velocity, lands nearest, divided by the time between the two mean velocities.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -78,6 +79,9 @@ struct MotionOptions {
   // a spike in one frame is dropped; two consecutive estimates above the median are taken at
   // once (a projector that keeps up with only a few meshes a second sees an onset in 2-3).
   int acceleration_window = 5;
+  // The options of the fit before issue 15's cost work (session 10): the baseline of
+  // projector_motion_bench and of the tests that compare the two.
+  static MotionOptions legacy();
   Expected<void> validate() const;
 };
 
@@ -105,6 +109,10 @@ struct MeshMotion {
   // one-estimate spike is dropped): the margin's acceleration, projector/mask_margin.h; unset
   // from estimate_motion.
   std::optional<double> robust_acceleration_mps2;
+  // What the fit cost: closest-point queries against the previous mesh, ICP fits (the whole
+  // mesh's and the regions') and their iterations.
+  int64_t closest_queries = 0;
+  int fits = 0, iterations = 0;
   Eigen::Vector3f velocity(size_t vertex) const {
     return regions[vertex_region[vertex]].velocity.cast<float>();
   }
