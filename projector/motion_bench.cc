@@ -2,13 +2,15 @@
 //
 // Live-like meshes (BM_MotionHull*): the hull's own meshes of the simulated actor swinging its
 // arm at 1.5 m/s (sim/ arm_swing, true masks of the 6-camera ring -> silhouette cut at the demo's
-// 160 columns -> segment marching cubes -> exact crossings; testing/hull_meshes.h), ~35-40k
-// triangles, 25 Hz: the demo's live meshes are 35-51k triangles. BM_MotionHullVsLegacy runs the
-// default fit and the fit before issue 15's cost work (MotionOptions::legacy(), the baseline)
-// interleaved mesh by mesh on two trackers, thread CPU per mesh of each, and how far their
-// velocity fields are apart (per vertex, m/s).
+// 160 columns -> segment marching cubes -> exact crossings; testing/hull_meshes.h), ~29k
+// triangles, 25 Hz, played forward and back; the demo's live meshes are 35-51k triangles.
+// Counters: closest-point queries, fits and ICP iterations per mesh.
+// BM_MotionHullConverged: the default fit and a variant (ICP convergence threshold arg 0 in um,
+// iteration cap arg 1) interleaved mesh by mesh on two trackers (same conditions): thread CPU
+// per mesh of each, the ratio, and how far the variant's velocity field is from the default's
+// (per vertex, m/s).
 //
-// Tessellated simulated body (BM_MotionEveryVertex, BM_MotionBudget*; testing/swing_meshes.h,
+// Tessellated simulated body (BM_MotionEveryVertex, BM_MotionBudget; testing/swing_meshes.h,
 // ~11k vertices): the earlier figures' input, kept for comparison with BENCHMARKS.md.
 #include <benchmark/benchmark.h>
 #include <time.h>
@@ -42,11 +44,12 @@ double thread_cpu() {
   return double(ts.tv_sec) + double(ts.tv_nsec) * 1e-9;
 }
 
-// The k-th mesh of the sequence, its capture time moved on so times keep increasing on wrap.
+// The k-th mesh of the sequence played forward and back (0 1 .. n-1 n-2 .. 1 0 1 ..: every
+// pair is two consecutive frames, never a jump back to the start), captured 40 ms apart.
 projector::ActorMesh nth(const std::vector<projector::ActorMesh>& m, size_t k) {
-  projector::ActorMesh mesh = m[k % m.size()];
-  const int64_t span = m.back().capture_ns - m.front().capture_ns + kFrameNs;
-  mesh.capture_ns += int64_t(k / m.size()) * span;
+  const size_t period = 2 * m.size() - 2, phase = k % period;
+  projector::ActorMesh mesh = m[phase < m.size() ? phase : period - phase];
+  mesh.capture_ns = m.front().capture_ns + int64_t(k) * kFrameNs;
   return mesh;
 }
 
@@ -81,7 +84,7 @@ void run(benchmark::State& state, const std::vector<projector::ActorMesh>& m,
 }
 
 void BM_MotionEveryVertex(benchmark::State& state) {
-  projector::MotionOptions o = projector::MotionOptions::legacy();
+  projector::MotionOptions o;
   o.fit_vertices = 0;
   o.global_fit_vertices = 0;
   o.converged_m = 1e-7;  // the fit before the budget
@@ -92,46 +95,55 @@ BENCHMARK(BM_MotionEveryVertex)->Unit(benchmark::kMillisecond)->MinTime(2);
 void BM_MotionBudget(benchmark::State& state) { run(state, swing_meshes(), {}); }
 BENCHMARK(BM_MotionBudget)->Unit(benchmark::kMillisecond)->MinTime(2);
 
-void BM_MotionBudgetLegacy(benchmark::State& state) {
-  run(state, swing_meshes(), projector::MotionOptions::legacy());
-}
-BENCHMARK(BM_MotionBudgetLegacy)->Unit(benchmark::kMillisecond)->MinTime(2);
-
 void BM_MotionHull(benchmark::State& state) { run(state, hull_swing(), {}); }
 BENCHMARK(BM_MotionHull)->Unit(benchmark::kMillisecond)->MinTime(2);
 
-void BM_MotionHullLegacy(benchmark::State& state) {
-  run(state, hull_swing(), projector::MotionOptions::legacy());
+// The default fit and `options` on every mesh, interleaved (same conditions): CPU per mesh of
+// each, the ratio, and the difference of their velocity fields over all vertices of all meshes
+// (mean and max, m/s).
+void compare(benchmark::State& state, const projector::MotionOptions& options);
+void BM_MotionHullConverged(benchmark::State& state) {
+  projector::MotionOptions o;
+  o.converged_m = 1e-6 * double(state.range(0));
+  o.iterations = int(state.range(1));
+  compare(state, o);
 }
-BENCHMARK(BM_MotionHullLegacy)->Unit(benchmark::kMillisecond)->MinTime(2);
+BENCHMARK(BM_MotionHullConverged)
+    ->Args({10, 15})
+    ->Args({100, 15})
+    ->Args({300, 15})
+    ->Args({1000, 15})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2);
 
-// Both fits on every mesh, interleaved (same conditions): CPU per mesh of each, the ratio, and the
-// difference of their velocity fields over all vertices of all meshes (mean and max, m/s).
-void BM_MotionHullVsLegacy(benchmark::State& state) {
+void compare(benchmark::State& state, const projector::MotionOptions& options) {
   const auto& m = hull_swing();
-  projector::MotionTracker now{projector::MotionOptions{}};
-  projector::MotionTracker legacy{projector::MotionOptions::legacy()};
-  double cpu_now = 0, cpu_legacy = 0, diff_sum = 0, diff_max = 0, speed_sum = 0;
+  projector::MotionTracker variant{options};
+  projector::MotionTracker baseline{projector::MotionOptions{}};
+  double cpu_variant = 0, cpu_default = 0, diff_sum = 0, diff_max = 0, speed_sum = 0;
   int64_t meshes = 0, compared = 0;
   size_t k = 0;
   for (auto _ : state) {
     const projector::ActorMesh mesh = nth(m, k++);
-    const bool now_first = k % 2 == 0;  // alternate which runs first
+    const bool variant_first = k % 2 == 0;  // alternate which runs first
     double t0 = thread_cpu();
-    auto a = now_first ? now.update(mesh) : legacy.update(mesh);
+    auto a = variant_first ? variant.update(mesh) : baseline.update(mesh);
     const double t1 = thread_cpu();
-    auto b = now_first ? legacy.update(mesh) : now.update(mesh);
+    auto b = variant_first ? baseline.update(mesh) : variant.update(mesh);
     const double t2 = thread_cpu();
     if (!a || !b) {
       state.SkipWithError("motion failed");
       break;
     }
-    cpu_now += now_first ? t1 - t0 : t2 - t1;
-    cpu_legacy += now_first ? t2 - t1 : t1 - t0;
+    cpu_variant += variant_first ? t1 - t0 : t2 - t1;
+    cpu_default += variant_first ? t2 - t1 : t1 - t0;
     ++meshes;
-    const auto& fast = now_first ? *a : *b;
-    const auto& slow = now_first ? *b : *a;
-    if (fast && slow) {
+    const auto& fast = variant_first ? *a : *b;
+    const auto& slow = variant_first ? *b : *a;
+    // Not the first mesh after a reversal of the sequence (an instant turnaround of the
+    // velocity, which no actor makes).
+    const size_t phase = (k - 1) % (2 * m.size() - 2);
+    if (fast && slow && phase != 1 && phase != m.size()) {
       for (size_t v = 0; v < mesh.vertices.size(); ++v) {
         const double d = double((fast->velocity(v) - slow->velocity(v)).norm());
         diff_sum += d;
@@ -141,17 +153,17 @@ void BM_MotionHullVsLegacy(benchmark::State& state) {
       }
     }
   }
-  state.counters["now_cpu_ms_per_mesh"] = 1e3 * cpu_now / double(std::max<int64_t>(meshes, 1));
-  state.counters["legacy_cpu_ms_per_mesh"] =
-      1e3 * cpu_legacy / double(std::max<int64_t>(meshes, 1));
-  state.counters["speedup"] = cpu_legacy / std::max(cpu_now, 1e-12);
+  state.counters["variant_cpu_ms_per_mesh"] =
+      1e3 * cpu_variant / double(std::max<int64_t>(meshes, 1));
+  state.counters["default_cpu_ms_per_mesh"] =
+      1e3 * cpu_default / double(std::max<int64_t>(meshes, 1));
+  state.counters["speedup"] = cpu_default / std::max(cpu_variant, 1e-12);
   state.counters["velocity_diff_mean_mps"] = diff_sum / double(std::max<int64_t>(compared, 1));
   state.counters["velocity_diff_max_mps"] = diff_max;
-  state.counters["legacy_speed_mean_mps"] = speed_sum / double(std::max<int64_t>(compared, 1));
+  state.counters["default_speed_mean_mps"] = speed_sum / double(std::max<int64_t>(compared, 1));
   state.counters["vertices"] = double(m[0].vertices.size());
   state.counters["triangles"] = double(m[0].triangles.size());
 }
-BENCHMARK(BM_MotionHullVsLegacy)->Unit(benchmark::kMillisecond)->MinTime(4);
 
 }  // namespace
 

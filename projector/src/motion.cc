@@ -448,11 +448,6 @@ Expected<MeshMotion> estimate(const Target& target, const ActorMesh& current,
 
 }  // namespace
 
-MotionOptions MotionOptions::legacy() {
-  MotionOptions o;
-  return o;
-}
-
 Expected<void> MotionOptions::validate() const {
   if (!(region_size_m > 0) || !std::isfinite(region_size_m))
     return fail("motion: region_size_m must be > 0");

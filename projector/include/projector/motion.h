@@ -79,9 +79,6 @@ struct MotionOptions {
   // a spike in one frame is dropped; two consecutive estimates above the median are taken at
   // once (a projector that keeps up with only a few meshes a second sees an onset in 2-3).
   int acceleration_window = 5;
-  // The options of the fit before issue 15's cost work (session 10): the baseline of
-  // projector_motion_bench and of the tests that compare the two.
-  static MotionOptions legacy();
   Expected<void> validate() const;
 };
 
