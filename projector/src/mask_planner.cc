@@ -116,6 +116,7 @@ int MaskPlanner::fit_pending() {
   for (auto& [id, a] : actors_) {
     if (!a.pending) continue;
     a.pending = false;
+    ++fitted;
     const auto t0 = Clock::now();
     auto m = a.tracker.update(a.mesh);
     const auto t1 = Clock::now();
@@ -131,7 +132,6 @@ int MaskPlanner::fit_pending() {
       a.field_motion = a.motion;
     }
     field_s += std::chrono::duration<double>(Clock::now() - t1).count();
-    ++fitted;
   }
   last_cost_.motion_s = motion_s;
   last_cost_.field_s = field_s;

@@ -96,7 +96,8 @@ class MaskPlanner {
   // own motion fit left for fit_pending(). Errors: those of set_mesh().
   Expected<void> latch_mesh(const std::string& actor_id, std::uint64_t frame, ActorMesh mesh);
   // Fits the motion of every latched mesh not fitted yet (MotionTracker::update against the
-  // actor's previous mesh) and builds its velocity field. Returns the meshes fitted; the cost
+  // actor's previous mesh) and builds its velocity field. Returns the meshes tried (the first
+  // mesh of an actor gives no motion yet); the cost
   // lands in last_mesh_cost().motion_s / field_s. A failed fit leaves the mesh unpredicted.
   int fit_pending();
   void remove(const std::string& actor_id);
