@@ -75,6 +75,54 @@ TEST(MaskPlanner, StillActorGetsTheFloorAndMovingActorIsPredicted) {
   EXPECT_GT(p2->margin.margin_m, plan->margin.margin_m);
 }
 
+// Late latching: a latched mesh is drawn before its own fit, moved forward by the previous fit's
+// velocities with a margin that counts their age; fit_pending() then gives it its own motion,
+// and its plan is set_mesh's.
+TEST(MaskPlanner, LatchedMeshUsesThePreviousFitUntilItsOwnIsFitted) {
+  MaskPlannerOptions o;
+  o.initial_latency_s = 0.04;
+  MaskPlanner late(o), eager(o);
+  // 1 m/s along x.
+  auto at = [](int k) { return sphere({0.04f * k, 1, 0}, 0.2f, kT0 + k * kDt); };
+  const int64_t display = kT0 + 3 * kDt + 30'000'000;  // 30 ms after the last capture
+  for (int k = 0; k < 4; ++k) {
+    ASSERT_TRUE(late.latch_mesh("a", k, at(k)));
+    ASSERT_TRUE(eager.set_mesh("a", k, at(k)));
+    if (k == 0) {  // no fit yet: not predicted
+      auto first = late.plan(kT0 + kDt);
+      ASSERT_TRUE(first);
+      EXPECT_FALSE(first->margin.predicted);
+    }
+    if (k < 3) EXPECT_EQ(late.fit_pending(), 1);
+  }
+  auto latched = late.plan(display);
+  auto fitted = eager.plan(display);
+  ASSERT_TRUE(latched && fitted);
+  ASSERT_TRUE(latched->margin.predicted && fitted->margin.predicted);
+  EXPECT_EQ(latched->newest_frame, 3u);
+  // Moved by the previous fit's 1 m/s: 0.12 + 0.03 (the grown sphere's centroid).
+  EXPECT_NEAR(centroid(latched->masks[0]).x(), 0.15f, 0.01f);
+  EXPECT_NEAR(latched->margin.velocity_age_s, 0.06, 1e-6);  // 40 ms + half the fit's 40 ms
+  EXPECT_NEAR(fitted->margin.velocity_age_s, 0.02, 1e-6);
+  const double L = latched->margin.latency_s, a = latched->margin.acceleration_mps2;
+  EXPECT_NEAR(latched->margin.motion_m - fitted->margin.motion_m, a * L * (0.12 - 0.04) / 2, 1e-9);
+  // Fitted: the same as set_mesh's.
+  EXPECT_EQ(late.fit_pending(), 1);
+  EXPECT_EQ(late.fit_pending(), 0);
+  auto after = late.plan(display);
+  ASSERT_TRUE(after);
+  EXPECT_NEAR(after->margin.margin_m, fitted->margin.margin_m, 1e-12);
+  EXPECT_NEAR(centroid(after->masks[0]).x(), centroid(fitted->masks[0]).x(), 1e-5f);
+  // A latched mesh after a gap longer than max_dt_s: not predicted, the known speed instead.
+  ASSERT_TRUE(late.latch_mesh("a", 5, sphere({0.2f, 1, 0}, 0.2f, kT0 + 3 * kDt + 600'000'000)));
+  auto gap = late.plan(kT0 + 3 * kDt + 640'000'000);
+  ASSERT_TRUE(gap);
+  EXPECT_FALSE(gap->margin.predicted);
+  EXPECT_GT(gap->margin.speed_mps, 0.9);
+  // Refused like set_mesh: capture time not after the previous one.
+  EXPECT_FALSE(late.latch_mesh("a", 6, sphere({0.2f, 1, 0}, 0.2f, kT0)));
+}
+
 // A mesh older at display than the measured latency (no newer mesh came): the margin covers its
 // real age, up to the cap.
 TEST(MaskPlanner, StaleMeshIsCoveredForItsAge) {

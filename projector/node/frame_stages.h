@@ -3,12 +3,22 @@
 // frame rendered with it, published as status gauges (ms, a running mean over about the last 20
 // frames that had the stage; issue 15: "the per-stage breakdown says where the time goes"):
 //   stage_wait_ms      mesh handed over by the handler -> the render thread takes it (the render
-//                      thread was busy with the previous frame, its read-back or publish)
-//   stage_motion_ms    the mesh's motion estimate (once per mesh, MaskPlanner::set_mesh)
+//                      thread was busy with the previous frame, its read-back or publish; late
+//                      latching: the scene drawn ahead or the previous mesh's fit)
+//   stage_motion_ms    the mesh's motion estimate (once per mesh, MaskPlanner::set_mesh; late
+//                      latching: after the mesh's first frame, off its path, fit_pending with
+//                      the velocity field it builds)
 //   stage_simplify_ms  the mask mesh simplified (once per mesh)
+//   stage_latch_ms     late latching: the previous fit's velocities looked up for the new mesh's
+//                      vertices (once per mesh, MaskPlanner::latch_mesh)
+//   stage_ahead_ms     late latching: the next frame's scene drawn ahead after a frame (GL
+//                      submission + flush; llvmpipe rasterises it while the thread waits), off
+//                      the mesh's path except for the very first frame
 //   stage_mask_ms      per frame: the masks moved forward to the display instant and grown
-//   stage_draw_ms      per frame: GL commands for the scene and the masks (submission)
-//   stage_finish_ms    per frame: glFinish, i.e. llvmpipe rasterising the frame
+//   stage_draw_ms      per frame: GL commands for the scene and the masks (submission; late
+//                      latching: the masks only)
+//   stage_finish_ms    per frame: glFinish, i.e. llvmpipe rasterising the frame (late latching:
+//                      the masks and what is left of the scene drawn ahead)
 //   stage_readback_ms  per published frame: glReadPixels, blackout runs, thumbnail
 //   stage_publish_ms   per published frame: the studio/projector/frame sample written
 //   mesh_to_frame_ms   mesh arrival -> frame rendered (finished), frames with a new mesh
@@ -37,14 +47,16 @@ class FrameStages {
     publish,
     mesh_to_frame,
     present,
+    latch,
+    ahead,
     kCount
   };
 
   explicit FrameStages(runtime::Metrics& metrics) {
     static constexpr const char* kNames[kCount] = {
-        "stage_wait_ms",    "stage_motion_ms", "stage_simplify_ms", "stage_mask_ms",
-        "stage_draw_ms",    "stage_finish_ms", "stage_readback_ms", "stage_publish_ms",
-        "mesh_to_frame_ms", "stage_present_ms"};
+        "stage_wait_ms",    "stage_motion_ms",  "stage_simplify_ms", "stage_mask_ms",
+        "stage_draw_ms",    "stage_finish_ms",  "stage_readback_ms", "stage_publish_ms",
+        "mesh_to_frame_ms", "stage_present_ms", "stage_latch_ms",    "stage_ahead_ms"};
     for (int i = 0; i < kCount; ++i) gauges_[i] = &metrics.gauge(kNames[i]);
   }
   // One measurement of a stage, seconds.

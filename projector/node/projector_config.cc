@@ -70,10 +70,18 @@ runtime::ServiceDefinition projector_service_definition() {
       "    head_timeout: 2.0       seconds; an older head pose keeps the last good eye\n"
       "    frame_every: 1          publish studio/projector/frame every N frames (0: never)\n"
       "    thumbnail: [160, 90]    RGB8 thumbnail size in studio/projector/frame ([0, 0]: none)\n"
-      "    parallel_mesh_work: true  a new mesh's mask simplification runs on a second thread\n"
-      "                            while its motion is fitted (the mesh waits for the longer\n"
-      "                            of the two, not their sum; same result and CPU); false: one\n"
-      "                            after the other on the render thread\n"
+      "    late_latch: true        take the mesh off the long path: after each frame the next\n"
+      "                            frame's scene is drawn ahead (from the head moved on by its\n"
+      "                            velocity to that frame's display) and the new meshes' motion\n"
+      "                            fitted; a new mesh then only waits for its simplification,\n"
+      "                            the previous fit's velocities looked up per vertex, its mask\n"
+      "                            drawn over the prepared scene, finish and read-back (the\n"
+      "                            margin counts the older velocity: projector/mask_margin.h);\n"
+      "                            false: motion fit, scene and masks after the mesh arrives\n"
+      "    parallel_mesh_work: true  late_latch false: a new mesh's mask simplification runs on\n"
+      "                            a second thread while its motion is fitted (the mesh waits\n"
+      "                            for the longer of the two, not their sum; same result and\n"
+      "                            CPU); false: one after the other on the render thread\n"
       "    mask_presimplify: true  a hull mesh of more than 12000 triangles is clustered\n"
       "                            (meshoptimizer sloppy) to ~12000 before the edge collapse\n"
       "                            to the mask's 3000 (2-4x less CPU for it on the demo's\n"
@@ -118,6 +126,7 @@ runtime::ServiceDefinition projector_service_definition() {
       "  (of the last mesh received); where a mesh's\n"
       "  time goes, ms: stage_wait_ms, stage_motion_ms, stage_simplify_ms, stage_mask_ms,\n"
       "  stage_draw_ms, stage_finish_ms, stage_readback_ms, stage_publish_ms, stage_present_ms,\n"
+      "  stage_latch_ms, stage_ahead_ms,\n"
       "  mesh_to_frame_ms: see projector/node/frame_stages.h; the scene cache: frames_from_cache,\n"
       "  scene_rerendered (frames that drew the static scene), scene_moving_nodes,\n"
       "  scene_cache_move_mm (eye move the cached layer allows); cpu_per_frame_ms: the process's\n"
@@ -170,6 +179,7 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("head_timeout", &ProjectorNodeOptions::head_timeout_s).min(0.01),
         yaml::field("frame_every", &ProjectorNodeOptions::frame_every).range(0, 100000),
         yaml::field("thumbnail", &ProjectorNodeOptions::thumbnail).size(2),
+        yaml::field("late_latch", &ProjectorNodeOptions::late_latch),
         yaml::field("parallel_mesh_work", &ProjectorNodeOptions::parallel_mesh_work),
         yaml::field("mask_presimplify", &ProjectorNodeOptions::mask_presimplify),
         yaml::field("margin", &ProjectorNodeOptions::margin, margin_schema),

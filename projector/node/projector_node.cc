@@ -1,5 +1,6 @@
 #include "projector_node.h"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <future>
@@ -144,7 +145,10 @@ class ProjectorNode : public runtime::Node {
     std::lock_guard lock(mutex_);
     if (options_.actor != s.actor_id) return {};  // another actor's head
     head_speed_ = v.norm();
-    eye_.head(p, seconds(SteadyClock::now().time_since_epoch()));
+    const double now = seconds(SteadyClock::now().time_since_epoch());
+    eye_.head(p, now);
+    if (v.allFinite()) head_velocity_ = v;
+    head_at_ = now;
     return {};
   }
 
@@ -161,7 +165,22 @@ class ProjectorNode : public runtime::Node {
       head_speed = head_speed_;
       if (!taken.meshes.empty()) arrived = mesh_arrived_;
     }
-    if (arrived) {
+    if (arrived && options_.late_latch) {
+      stages_.add(FrameStages::wait, seconds(SteadyClock::now() - *arrived));
+      // Removals, then each new mesh latched: simplified and given the previous fit's
+      // velocities; its own fit waits until after the frame (fit_after_frame).
+      for (const std::string& id : taken.removed) planner_.remove(id);
+      int refused = 0;
+      for (auto& [id, p] : taken.meshes) {
+        if (auto ok = planner_.latch_mesh(id, p.frame, std::move(p.mesh)); !ok) {
+          if (refused++ == 0) STUDIO_LOG(debug, kLog) << ok.error().message;
+        } else {
+          stages_.add(FrameStages::simplify, planner_.last_mesh_cost().simplify_s);
+          stages_.add(FrameStages::latch, planner_.last_mesh_cost().latch_s);
+        }
+      }
+      if (refused > 0) m_.mesh_errors.add(refused);
+    } else if (arrived) {
       stages_.add(FrameStages::wait, seconds(SteadyClock::now() - *arrived));
       std::string error;
       if (const int refused = apply(std::move(taken), planner_, &error); refused > 0) {
@@ -190,6 +209,30 @@ class ProjectorNode : public runtime::Node {
     return eye;
   }
 
+  // What the render thread keeps from frame to frame.
+  struct Frame {
+    RenderScene scene;
+    projector_render::Readback readback;
+    CpuPerFrame cpu;
+    double render_s = 0;  // smoothed render time: a frame is shown about this much later
+    uint64_t count = 0;
+    // Late latching: the scene of the next frame is drawn (prepared), from `eye`, with `drawn`.
+    bool prepared = false;
+    Eigen::Vector3d eye = Eigen::Vector3d::Zero();
+    Expected<projector_render::FrameInfo> drawn = projector_render::FrameInfo{};
+  };
+  // Late latching: the eye for a frame drawn ahead, shown about ahead_s from now: the followed
+  // head moved on by its velocity (at most 0.1 s of it) while its pose is fresh, else eye_now().
+  Eigen::Vector3d eye_ahead(double ahead_s) {
+    std::lock_guard lock(mutex_);
+    const double now = seconds(SteadyClock::now().time_since_epoch());
+    bool stale = false;
+    const Eigen::Vector3d eye = eye_.eye(now, &stale);
+    if (stale) m_.head_stale.add();
+    if (!head_at_ || now - *head_at_ >= options_.head_timeout_s) return eye;
+    return eye + head_velocity_ * std::clamp(now + ahead_s - *head_at_, 0.0, 0.1);
+  }
+
   // The render thread: its own GL context (EGL surfaceless, or the full-screen window's), one
   // frame per period.
   void render_loop() {
@@ -204,6 +247,9 @@ class ProjectorNode : public runtime::Node {
     // A frame when a new mesh arrives (at once: the mesh's motion-to-photon latency is its
     // transport + motion estimate + one render), else one period after the last frame (the
     // scene and the eye move without meshes too).
+    // Late latching (the default): after each frame the next frame's scene is drawn ahead
+    // (flushed: llvmpipe rasterises it on its threads) and the frame's meshes' motion fitted,
+    // so a new mesh waits only for its simplification, its mask and the finish.
     while (loop_.running()) {
       {
         std::unique_lock lock(mutex_);
@@ -212,19 +258,31 @@ class ProjectorNode : public runtime::Node {
       }
       next = SteadyClock::now() + period;
       render_one(*fr, state, out.window ? &*out.window : nullptr);
+      if (options_.late_latch) {
+        prepare_ahead(*fr, state, seconds(next - SteadyClock::now()));
+        const auto t = SteadyClock::now();
+        if (planner_.fit_pending() > 0)
+          stages_.add(FrameStages::motion, seconds(SteadyClock::now() - t));
+      }
     }
   }
 
-  // What the render thread keeps from frame to frame.
-  struct Frame {
-    RenderScene scene;
-    projector_render::Readback readback;
-    CpuPerFrame cpu;
-    double render_s = 0;  // smoothed render time: a frame is shown about this much later
-    uint64_t count = 0;
-  };
+  // Late latching: the next frame's scene (rebuilt first when the mirror changed) drawn from the
+  // eye expected when it is shown (eye_ahead), masks left for the frame.
+  void prepare_ahead(projector_render::FrameRenderer& fr, Frame& st, double until_next_s) {
+    const auto t = SteadyClock::now();
+    st.eye = eye_ahead(std::max(until_next_s, 0.0) + st.render_s + options_.display_lag_s);
+    st.drawn = draw_scene(fr, st, st.eye, {}, true);
+    st.prepared = true;
+    stages_.add(FrameStages::ahead, seconds(SteadyClock::now() - t));
+  }
 
-  void render_one(projector_render::FrameRenderer& fr, Frame& st, WindowOutput* window) {
+  // The scene from `eye` (the last good eye when the projection refuses it: `eye` is replaced),
+  // the masks over it (ahead: none, the scene only, FrameRenderer::prepare). The scene is rebuilt
+  // first when the mirror changed.
+  Expected<projector_render::FrameInfo> draw_scene(projector_render::FrameRenderer& fr, Frame& st,
+                                                   Eigen::Vector3d& eye,
+                                                   std::span<const ActorMesh> masks, bool ahead) {
     std::optional<std::map<scene::NodeId, scene::Node>> nodes;
     std::set<scene::NodeId> moving;
     {
@@ -242,8 +300,29 @@ class ProjectorNode : public runtime::Node {
       m_.assets_failed.add(r.assets_failed);
       m_.moving_nodes.set(double(st.scene.layers.moving_nodes));
     }
+    const bool cache = options_.scene_cache.enabled;
+    auto draw = [&](const Eigen::Vector3d& e) {
+      return ahead ? st.scene.prepare(fr, e, cache) : st.scene.draw(fr, e, masks, cache);
+    };
+    auto drawn = draw(eye);
+    if (!drawn) {  // an eye the projection refuses: the last good eye (checked at start)
+      m_.eye_rejected.add();
+      STUDIO_LOG(debug, kLog) << drawn.error().message;
+      eye = eye_now(true);
+      drawn = draw(eye);
+    }
+    if (drawn) (drawn->from_cache ? m_.from_cache : m_.rerendered).add();
+    if (drawn && cache) m_.cache_move_mm.set(fr.cache_allowed_move_m(eye) * 1e3);
+    return drawn;
+  }
+
+
+
+  void render_one(projector_render::FrameRenderer& fr, Frame& st, WindowOutput* window) {
+    const bool late = options_.late_latch;
+    if (late && !st.prepared) prepare_ahead(fr, st, 0);  // the first frame, on the path
     const auto arrived = take_inputs();
-    Eigen::Vector3d eye = eye_now();
+    Eigen::Vector3d eye = late ? st.eye : eye_now();
     const int64_t start_ns = realtime_ns();
     auto t = SteadyClock::now();
     auto stage = [&](FrameStages::Stage s) {
@@ -258,16 +337,14 @@ class ProjectorNode : public runtime::Node {
     stage(FrameStages::mask);
     const std::span<const ActorMesh> masks =
         plan ? std::span<const ActorMesh>(plan->masks) : std::span<const ActorMesh>();
-    const bool cache = options_.scene_cache.enabled;
-    auto drawn = st.scene.draw(fr, eye, masks, cache);
-    if (!drawn) {  // an eye the projection refuses: the last good eye (checked at start)
-      m_.eye_rejected.add();
-      STUDIO_LOG(debug, kLog) << drawn.error().message;
-      eye = eye_now(true);
-      drawn = st.scene.draw(fr, eye, masks, cache);
+    Expected<projector_render::FrameInfo> drawn = projector_render::FrameInfo{};
+    if (late) {  // the masks over the scene drawn ahead
+      drawn = std::move(st.drawn);
+      st.prepared = false;
+      if (drawn) drawn->masks = fr.draw_masks(masks);
+    } else {
+      drawn = draw_scene(fr, st, eye, masks, false);
     }
-    if (drawn) (drawn->from_cache ? m_.from_cache : m_.rerendered).add();
-    if (drawn && cache) m_.cache_move_mm.set(fr.cache_allowed_move_m(eye) * 1e3);
     stage(FrameStages::draw);
     fr.finish();
     stage(FrameStages::finish);
@@ -309,13 +386,15 @@ class ProjectorNode : public runtime::Node {
   SceneMirror mirror_;
   MeshInbox inbox_;  // meshes for the render thread
   std::optional<double> head_speed_;
+  Eigen::Vector3d head_velocity_ = Eigen::Vector3d::Zero();  // of the followed head
+  std::optional<double> head_at_;  // when its last pose arrived (steady clock, seconds)
   EyeSource eye_;
   SteadyClock::time_point mesh_arrived_;  // of the newest mesh offered
   std::promise<Expected<void>> init_;
   std::atomic<bool> degraded_{false};
   runtime::Output<studio_ProjectorCalibration>* calibration_ = nullptr;
   runtime::Output<studio_ProjectorFrame>* frames_ = nullptr;
-  MaskPlanner planner_;  // the render thread's alone
+  MaskPlanner planner_;        // the render thread's alone
   runtime::ServiceLoop loop_;  // stopped before the state above goes
   FrameStages stages_;         // the render thread's (gauges of loop_'s metrics)
   FrameMetrics m_;

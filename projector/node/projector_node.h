@@ -58,7 +58,14 @@ struct ProjectorNodeOptions {
   double head_timeout_s = 2.0;  // an older head pose falls back to the last good eye (counted)
   int frame_every = 1;          // publish studio/projector/frame every N rendered frames (0: never)
   std::vector<int> thumbnail{160, 90};
-  // A mesh's simplification on a second thread beside its motion fit (MaskPlannerOptions).
+  // Late latching (issues 15/20): after each frame the next frame's scene is drawn ahead from the
+  // eye expected at its display, and the frame's new meshes' motion is fitted; a new mesh then
+  // needs only its simplification, the previous fit's velocities per vertex
+  // (MaskPlanner::latch_mesh), its mask over the prepared scene, the finish and read-back.
+  // false: the whole frame (motion fit, scene, masks) after the mesh arrives.
+  bool late_latch = true;
+  // A mesh's simplification on a second thread beside its motion fit (MaskPlannerOptions; the
+  // path without late latching).
   bool parallel_mesh_work = true;
   // Hull meshes clustered before the edge collapse (GrowOptions::presimplify).
   bool mask_presimplify = true;

@@ -56,6 +56,13 @@ Expected<projector_render::FrameInfo> RenderScene::draw(projector_render::FrameR
   return projector_render::FrameInfo{.masks = *n};
 }
 
+Expected<projector_render::FrameInfo> RenderScene::prepare(projector_render::FrameRenderer& fr,
+                                                           const Eigen::Vector3d& eye,
+                                                           bool cache) const {
+  if (cache) return fr.prepare({layers.still, layers.still_version, &layers.moving}, eye);
+  return fr.prepare(scene, eye);
+}
+
 SceneMirror::Rebuilt SceneMirror::rebuild(const std::map<scene::NodeId, scene::Node>& nodes,
                                           scene::Scene& scene, scene_assets::AssetCache& cache,
                                           std::set<std::string>& failed_assets,

@@ -70,6 +70,9 @@ struct RenderScene {
   Expected<projector_render::FrameInfo> draw(projector_render::FrameRenderer& fr,
                                              const Eigen::Vector3d& eye,
                                              std::span<const ActorMesh> masks, bool cache) const;
+  // The scene alone, ahead of its masks (FrameRenderer::prepare; late latching).
+  Expected<projector_render::FrameInfo> prepare(projector_render::FrameRenderer& fr,
+                                                const Eigen::Vector3d& eye, bool cache) const;
 };
 
 }  // namespace studio::projector

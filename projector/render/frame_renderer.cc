@@ -77,7 +77,7 @@ struct FrameRenderer::Impl {
   std::vector<std::string> mask_ids;
   scene::ActorMesh scratch;
   std::vector<std::uint8_t> rgba;
-  std::optional<StaticLayer> layer;  // scene_cache enabled
+  std::optional<StaticLayer> layer;         // scene_cache enabled
   std::optional<Eigen::Vector3d> last_eye;  // of the previous layered frame
 
   Expected<FrameInfo> render(const scene::Scene& still, std::uint64_t version,
@@ -203,6 +203,23 @@ Expected<int> FrameRenderer::render(const scene::Scene& scene, const Eigen::Vect
 Expected<FrameInfo> FrameRenderer::render(const LayeredScene& scene, const Eigen::Vector3d& eye,
                                           std::span<const projector::ActorMesh> masks) {
   return impl_->render(scene.still, scene.still_version, scene.moving, eye, masks, true);
+}
+
+Expected<FrameInfo> FrameRenderer::prepare(const LayeredScene& scene, const Eigen::Vector3d& eye) {
+  auto info = impl_->render(scene.still, scene.still_version, scene.moving, eye, {}, true);
+  glFlush();  // llvmpipe starts rasterising now, not at the frame's glFinish
+  return info;
+}
+
+Expected<FrameInfo> FrameRenderer::prepare(const scene::Scene& scene, const Eigen::Vector3d& eye) {
+  auto info = impl_->render(scene, 0, nullptr, eye, {}, false);
+  glFlush();
+  return info;
+}
+
+int FrameRenderer::draw_masks(std::span<const projector::ActorMesh> masks) {
+  impl_->target.bind();
+  return impl_->draw_masks(masks);
 }
 
 Expected<FrameInfo> FrameRenderer::Impl::render(const scene::Scene& still, std::uint64_t version,

@@ -387,3 +387,63 @@ TEST(FrameRenderer, TwoPassWarpOverTheScreenOnlyKeepsTheFrame) {
     EXPECT_GT(a.blackout.area(), 1000);
   }
 }
+
+// Late latching (FrameRenderer::prepare + draw_masks): the scene drawn ahead and the masks put
+// over it later give the frame render() gives, in both forms, value for value, with the scene
+// cache's layered path too. Control: the mask is in the frame.
+TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
+  (void)context();
+  const Projector p = projector::testing::studio_projectors()[0];
+  auto view = projector::ProjectorView::create(p).value();
+  auto d = scene_config::read_scene_file(std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml");
+  ASSERT_TRUE(d) << d.error().message;
+  scene_assets::AssetCache cache;
+  auto scene = scene_assets::build_scene(*d, cache, 0);
+  ASSERT_TRUE(scene) << scene.error().message;
+  projector::ActorMesh mask;
+  for (int k = 0; k < 8; ++k)
+    mask.vertices.push_back(
+        Eigen::Vector3f(k & 1 ? 0.3f : -0.3f, k & 2 ? 1.8f : 0.0f, k & 4 ? -0.4f : -0.8f));
+  const std::array<std::uint32_t, 3> tris[] = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5},
+                                               {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6},
+                                               {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
+  mask.triangles.assign(std::begin(tris), std::end(tris));
+  const std::vector<projector::ActorMesh> masks{mask};
+  const scene::Scene empty(scene->options());
+  for (const Form form : {Form::single_pass, Form::two_pass}) {
+    FrameRendererOptions fo;
+    fo.form = form;
+    auto fr = FrameRenderer::create(view, fo);
+    ASSERT_TRUE(fr) << fr.error().message;
+    for (const auto& [path, a] : cache.all()) ASSERT_TRUE(fr->renderer().upload(*a));
+    for (const bool layered : {false, true}) {
+      const Eigen::Vector3d eye(0.1, 1.65, 1.2);
+      const LayeredScene layers{*scene, 7, &empty};
+      Readback want, got;
+      if (layered)
+        ASSERT_TRUE(fr->render(layers, eye, masks));
+      else
+        ASSERT_TRUE(fr->render(*scene, eye, masks));
+      fr->finish();
+      fr->read(want, true);
+      if (layered)
+        ASSERT_TRUE(fr->prepare(layers, eye));
+      else
+        ASSERT_TRUE(fr->prepare(*scene, eye));
+      EXPECT_EQ(fr->draw_masks(masks), 1);
+      fr->finish();
+      fr->read(got, true);
+      const cv::Mat a(fr->height(), fr->width(), CV_8UC4, want.rgba.data()),
+          b(fr->height(), fr->width(), CV_8UC4, got.rgba.data());
+      cv::Mat diff;
+      cv::absdiff(a, b, diff);
+      const int differ = cv::countNonZero(diff.reshape(1));
+      std::printf("%s%s: %d values differ, blackout %lld px\n",
+                  form == Form::single_pass ? "single pass" : "two pass",
+                  layered ? ", layered" : "", differ, static_cast<long long>(got.blackout.area()));
+      EXPECT_EQ(differ, 0);
+      EXPECT_EQ(got.blackout, want.blackout);
+      EXPECT_GT(got.blackout.area(), 1000);
+    }
+  }
+}

@@ -19,11 +19,13 @@ Expected<void> MarginOptions::validate() const {
 }
 
 Expected<Margin> security_margin(const MarginOptions& options, double latency_s,
-                                 double head_speed_mps, const MeshMotion* motion) {
+                                 double head_speed_mps, const MeshMotion* motion,
+                                 double velocity_age_s) {
   if (auto v = options.validate(); !v) return std::unexpected(v.error());
   if (!(latency_s >= 0) || !std::isfinite(latency_s)) return fail("margin: latency must be >= 0");
   if (!(head_speed_mps >= 0) || !std::isfinite(head_speed_mps))
     return fail("margin: head speed must be >= 0");
+  if (!std::isfinite(velocity_age_s)) return fail("margin: velocity age must be finite");
   Margin m;
   m.floor_m = options.floor_m;
   m.latency_s = latency_s;
@@ -39,7 +41,8 @@ Expected<Margin> security_margin(const MarginOptions& options, double latency_s,
             : motion->robust_acceleration_mps2.value_or(*motion->max_acceleration_mps2);
     m.acceleration_bounded = a > options.max_acceleration_mps2;
     m.acceleration_mps2 = std::min(a, options.max_acceleration_mps2);
-    m.motion_m = 0.5 * m.acceleration_mps2 * latency_s * (latency_s + motion->dt_s) +
+    m.velocity_age_s = velocity_age_s >= 0 ? velocity_age_s : 0.5 * motion->dt_s;
+    m.motion_m = 0.5 * m.acceleration_mps2 * latency_s * (latency_s + 2 * m.velocity_age_s) +
                  options.velocity_uncertainty_mps * latency_s;
   } else {
     m.motion_m = m.speed_mps * latency_s;

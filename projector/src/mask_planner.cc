@@ -66,8 +66,76 @@ Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t 
   a.mesh = std::move(mesh);
   a.base = std::move(**base);
   a.frame = frame;
-  last_cost_ = {motion_s, simplify_s};
+  a.pending = false;
+  a.latched.clear();
+  last_cost_ = {motion_s, simplify_s, 0, 0};
   return {};
+}
+
+Expected<void> MaskPlanner::latch_mesh(const std::string& actor_id, std::uint64_t frame,
+                                       ActorMesh mesh) {
+  if (auto ok = mesh.validate(); !ok) return fail("actor " + actor_id + ": " + ok.error().message);
+  auto it = actors_.find(actor_id);
+  if (it == actors_.end())
+    it =
+        actors_.emplace(actor_id, Actor{{}, {}, 0, MotionTracker(options_.motion), {}, 0, 0}).first;
+  Actor& a = it->second;
+  if (!a.mesh.vertices.empty() && mesh.capture_ns <= a.mesh.capture_ns)
+    return fail("actor " + actor_id + ": mesh capture time not after the previous mesh's");
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  auto base = simplify_for_mask(mesh, options_.grow);
+  if (!base) return fail("actor " + actor_id + ": " + base.error().message);
+  const auto t1 = Clock::now();
+  // A mesh latched over one never fitted (two latches without fit_pending between them): that
+  // one is skipped by the tracker; the next fit is against the last mesh fitted.
+  a.latched.clear();
+  a.latched_age_s = 0;
+  if (a.field && a.field_motion &&
+      (mesh.capture_ns - a.field->capture_ns()) * 1e-9 <= options_.motion.max_dt_s) {
+    if (auto v = a.field->at(base->mesh)) {
+      a.latched = std::move(*v);
+      a.latched_age_s =
+          (mesh.capture_ns - a.field->capture_ns()) * 1e-9 + 0.5 * a.field_motion->dt_s;
+    }
+  }
+  a.motion.reset();  // this mesh's own motion: after fit_pending()
+  a.mesh = std::move(mesh);
+  a.base = std::move(*base);
+  a.frame = frame;
+  a.pending = true;
+  last_cost_ = {0, std::chrono::duration<double>(t1 - t0).count(),
+                std::chrono::duration<double>(Clock::now() - t1).count(), 0};
+  return {};
+}
+
+int MaskPlanner::fit_pending() {
+  using Clock = std::chrono::steady_clock;
+  int fitted = 0;
+  double motion_s = 0, field_s = 0;
+  for (auto& [id, a] : actors_) {
+    if (!a.pending) continue;
+    a.pending = false;
+    ++fitted;
+    const auto t0 = Clock::now();
+    auto m = a.tracker.update(a.mesh);
+    const auto t1 = Clock::now();
+    motion_s += std::chrono::duration<double>(t1 - t0).count();
+    a.field.reset();
+    a.field_motion.reset();
+    if (!m || !*m) continue;  // refused or no estimate (first mesh, gap): not predicted
+    a.motion = std::move(**m);
+    a.known_speed_mps = a.motion->max_speed_mps;
+    a.latched.clear();  // the mesh's own motion from now on
+    if (auto f = VelocityField::create(a.mesh, *a.motion, options_.motion.region_size_m)) {
+      a.field = std::move(*f);
+      a.field_motion = a.motion;
+    }
+    field_s += std::chrono::duration<double>(Clock::now() - t1).count();
+  }
+  last_cost_.motion_s = motion_s;
+  last_cost_.field_s = field_s;
+  return fitted;
 }
 
 void MaskPlanner::remove(const std::string& actor_id) { actors_.erase(actor_id); }
@@ -99,9 +167,11 @@ Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
     const double L =
         overruns_.empty() ? std::max(age, options_.initial_latency_s) : age + overrun_s();
     // No estimate for this mesh: the last known speed stands in (the head's when faster).
-    const double speed =
-        a.motion ? a.head_speed_mps : std::max(a.head_speed_mps, a.known_speed_mps);
-    auto m = security_margin(options_.margin, L, speed, a.motion ? &*a.motion : nullptr);
+    // Latched (not fitted yet): the previous fit's motion, its velocity older by latched_age_s.
+    const bool latched = !a.motion && !a.latched.empty() && a.field_motion;
+    const MeshMotion* motion = a.motion ? &*a.motion : latched ? &*a.field_motion : nullptr;
+    const double speed = motion ? a.head_speed_mps : std::max(a.head_speed_mps, a.known_speed_mps);
+    auto m = security_margin(options_.margin, L, speed, motion, latched ? a.latched_age_s : -1);
     if (!m) return std::unexpected(m.error());
     predicted.push_back(m->predicted);
     if (first || m->margin_m > out.margin.margin_m) out.margin = *m;
@@ -122,9 +192,11 @@ Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
     // Each actor moved forward when its own margin relies on the prediction; the margin drawn
     // is the largest, which covers every actor's own. The simplified mesh keeps the mesh's
     // vertices, so the motion (per vertex of the mesh) moves it as it would the mesh.
-    if (predicted[k++] && a.motion) {
+    const bool latched = !a.motion && !a.latched.empty() && a.field_motion;
+    if (predicted[k++] && (a.motion || latched)) {
       const double horizon = std::clamp((display_ns - a.mesh.capture_ns) * 1e-9, 0.0, 1.0);
-      auto p = predict(a.base.mesh, *a.motion, horizon);
+      auto p = a.motion ? predict(a.base.mesh, *a.motion, horizon)
+                        : predict_by_velocities(a.base.mesh, a.latched, horizon);
       if (p) {
         moved = {std::move(*p), a.base.error_m};
         base = &moved;

@@ -28,6 +28,14 @@
 //   transitions (0.4 s smoothstep blends between poses: accelerations up to ~15 m/s^2, hence the
 //   default bound). The worst case makes the margin a function of latency alone: at the issue's
 //   40 ms it is 0.5 * 15 * 0.04 * 0.08 + 0.05 * 0.04 + floor = 36 mm; at 150 ms it is capped.
+//   Late latching (projector/mask_planner.h latch_mesh()): a mesh drawn before its own motion
+//   is fitted is moved forward by the PREVIOUS fit's velocities (projector/velocity_field.h),
+//   which stand for an instant further back. In general, with the velocity standing for the
+//   instant `age` before the mesh's capture (velocity_age_s; the mean over a fit's two captures
+//   dt apart stands for dt/2 before the later one), the error at t + L is
+//   (v(t) - v(t - age)) L + a L^2 / 2 = a L (L + 2 age) / 2; the fresh fit's age = dt/2 gives the
+//   formula above, the previous fit's age = (t - t_prev) + dt_prev / 2 (about 1.5 mesh
+//   intervals: at 25 Hz and L = 30 ms, 15 * 0.03 * 0.15 / 2 = 34 mm instead of 16 mm).
 //   Prediction is used only when the motion has an acceleration estimate (the third mesh on) and
 //   agrees with the head tracker (the head is not faster than the fastest region by more than
 //   head_disagreement_mps); otherwise the no-prediction term applies.
@@ -58,17 +66,21 @@ struct Margin {
   double floor_m = 0;
   double motion_m = 0;  // the motion term before clamping
   double latency_s = 0;
-  double speed_mps = 0;          // v (no-prediction term)
-  double acceleration_mps2 = 0;  // a (prediction term), after the bound
+  double speed_mps = 0;               // v (no-prediction term)
+  double acceleration_mps2 = 0;       // a (prediction term), after the bound
+  double velocity_age_s = 0;          // the prediction's velocity: this long before the capture
   bool acceleration_bounded = false;  // the estimate was above max_acceleration_mps2
-  bool predicted = false;        // the mesh is to be moved forward by latency_s
+  bool predicted = false;             // the mesh is to be moved forward by latency_s
   bool capped = false;
 };
 
 // latency_s: L; head_speed_mps: |head velocity| of the actor (0 if unknown); motion: the latest
-// mesh motion (nullptr if unknown). Errors: invalid options, negative or non-finite inputs.
+// mesh motion (nullptr if unknown); velocity_age_s: how long before the mesh's capture the
+// prediction's velocity stands for (above; negative: motion->dt_s / 2, the mesh's own fit).
+// Errors: invalid options, negative or non-finite inputs.
 Expected<Margin> security_margin(const MarginOptions& options, double latency_s,
-                                 double head_speed_mps, const MeshMotion* motion);
+                                 double head_speed_mps, const MeshMotion* motion,
+                                 double velocity_age_s = -1);
 
 // A sliding window of measured latencies (seconds) and its quantile.
 class LatencyWindow {

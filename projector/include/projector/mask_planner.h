@@ -21,6 +21,18 @@
 // (MaskPlannerOptions::parallel_mesh_work) — and times both (last_mesh_cost());
 // plan() per frame only moves the simplified mesh forward and grows it.
 //
+// Late latching (issues 15/20: the mesh off the long path; the projector node's default,
+// ProjectorNodeOptions::late_latch): latch_mesh() takes a new mesh with only what its first
+// frame needs — the simplification and, per vertex the mask uses, the velocity of the PREVIOUS
+// fit looked up in its field (projector/velocity_field.h, O(1) per vertex) — and leaves its own
+// motion fit pending; fit_pending(), called after that frame, fits it against the previous mesh
+// (MotionTracker, as set_mesh) and builds the field the next mesh's latch reads. Frames planned
+// before the fit move the mesh by the latched velocities and their margin counts the velocity's
+// age (mask_margin.h: (capture - previous capture) + previous dt / 2 instead of dt / 2); frames
+// after the fit use the mesh's own motion, as set_mesh's. A latched mesh whose field is older
+// than MotionOptions::max_dt_s (or with no field yet) is not predicted: the no-prediction margin
+// with the actor's last known speed, as a mesh after a gap.
+//
 // A mesh without a motion estimate (the first after a gap longer than MotionOptions::max_dt_s,
 // e.g. the hull stalled) is not taken as still: its no-prediction margin uses the actor's last
 // known speed (the fastest region of its last estimate) when that exceeds its head's.
@@ -38,6 +50,7 @@
 #include "projector/mask_geometry.h"
 #include "projector/mask_margin.h"
 #include "projector/motion.h"
+#include "projector/velocity_field.h"
 
 namespace studio::projector {
 
@@ -66,8 +79,10 @@ struct MaskPlan {
 // Wall time of set_mesh()'s two stages, seconds (steady clock); in parallel, motion_s is the
 // whole set_mesh's wait (the motion fit, then the join of the simplification).
 struct MeshCost {
-  double motion_s = 0;    // MotionTracker::update
+  double motion_s = 0;    // MotionTracker::update (latch_mesh: 0; fit_pending: its fits)
   double simplify_s = 0;  // simplify_for_mask
+  double latch_s = 0;     // latch_mesh: the velocities looked up in the previous fit's field
+  double field_s = 0;     // fit_pending: the velocity field built from the fit
 };
 
 class MaskPlanner {
@@ -77,6 +92,14 @@ class MaskPlanner {
   // The latest mesh of an actor (frame: its studio frame). Errors: invalid mesh, capture time not
   // after the actor's previous mesh. The motion is estimated against that previous mesh.
   Expected<void> set_mesh(const std::string& actor_id, std::uint64_t frame, ActorMesh mesh);
+  // Late latching (above): the mesh simplified and given the previous fit's velocities; its
+  // own motion fit left for fit_pending(). Errors: those of set_mesh().
+  Expected<void> latch_mesh(const std::string& actor_id, std::uint64_t frame, ActorMesh mesh);
+  // Fits the motion of every latched mesh not fitted yet (MotionTracker::update against the
+  // actor's previous mesh) and builds its velocity field. Returns the meshes tried (the first
+  // mesh of an actor gives no motion yet); the cost
+  // lands in last_mesh_cost().motion_s / field_s. A failed fit leaves the mesh unpredicted.
+  int fit_pending();
   void remove(const std::string& actor_id);
   void set_head_speed(const std::string& actor_id, double speed_mps);
   // Replaces the margin options for the next plans (a margin sweep: floor = cap = the margin
@@ -104,6 +127,14 @@ class MaskPlanner {
     std::optional<MeshMotion> motion;
     double head_speed_mps = 0;
     double known_speed_mps = 0;  // the fastest region of the last motion estimated (kept)
+    // Late latching: the mesh awaits its fit; the field of the last fit and that fit's motion
+    // (for the margin's acceleration and speed); the velocities latched for the mesh (empty:
+    // none, not predicted until fitted).
+    bool pending = false;
+    std::optional<VelocityField> field;
+    std::optional<MeshMotion> field_motion;
+    std::vector<Eigen::Vector3f> latched;
+    double latched_age_s = 0;  // the latched velocity's age at the mesh's capture
   };
   MaskPlannerOptions options_;
   std::map<std::string, Actor> actors_;

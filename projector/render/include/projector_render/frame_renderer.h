@@ -121,6 +121,17 @@ class FrameRenderer {
   // then the masks. Errors: those of render().
   Expected<FrameInfo> render(const LayeredScene& scene, const Eigen::Vector3d& eye,
                              std::span<const projector::ActorMesh> masks);
+  // Late latching (the projector node's default, ProjectorNodeOptions::late_latch): the frame's
+  // scene drawn AHEAD, before its masks are known — render() without masks, flushed so that
+  // llvmpipe rasterises it while the caller waits for the next mesh — then draw_masks() puts the
+  // masks over it (no depth test: the scene's depth plays no part) and finish() completes the
+  // frame: prepare + draw_masks + finish gives the very frame render + finish gives. Errors:
+  // those of render() (nothing is drawn then).
+  Expected<FrameInfo> prepare(const LayeredScene& scene, const Eigen::Vector3d& eye);
+  Expected<FrameInfo> prepare(const scene::Scene& scene, const Eigen::Vector3d& eye);
+  // Every mask mesh black over the frame prepared (or rendered) last; returns the masks drawn
+  // (an invalid mask is skipped).
+  int draw_masks(std::span<const projector::ActorMesh> masks);
   // The largest eye move (metres, any direction, first order) from `eye` under which the cached
   // static layer stays usable (StaticShiftBound::allowed_move_m over the heights it shows); 0
   // when nothing is cached or the cache is disabled.
