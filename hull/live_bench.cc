@@ -8,6 +8,7 @@
 // two threads (latency, at the cost of a thread hand-off).
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <ctime>
 
 #include "hull/crossing_refine.h"
@@ -65,7 +66,9 @@ double thread_cpu_ms() {
 }
 
 // Args: refine (0 plain, 1 exact crossings); refine threads; 1 = the mesh skips its normals when
-// the crossings recompute them (the node's way), 0 = computed twice (before).
+// the crossings recompute them (the node's way), 0 = computed twice (before); threads of the
+// segment marching cubes (the node gives it its `threads`). Wall time per stage as *_wall_ms: what
+// a split buys in latency.
 void BM_LiveFrame(benchmark::State& state) {
   const LiveStudio& s = LiveStudio::get();
   const bool refine = state.range(0) != 0;
@@ -74,23 +77,36 @@ void BM_LiveFrame(benchmark::State& state) {
   cut.threads = 1;
   CutOptions refine_options = cut;
   refine_options.threads = int(state.range(1));
-  double ms[4] = {0, 0, 0, 0};
+  const int mesh_threads = int(state.range(3));
+  double ms[4] = {0, 0, 0, 0}, wall[3] = {0, 0, 0};
+  using Wall = std::chrono::steady_clock;
+  const auto since = [](Wall::time_point& t) {
+    const auto now = Wall::now();
+    const double d = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+    return d;
+  };
   std::size_t frame = 0, triangles = 0;
   for (auto _ : state) {
     const std::vector<View> views = s.views(frame++ % s.frames.size());
     double t = thread_cpu_ms();
+    auto w = Wall::now();
     auto hull = visual_hull(live_grid(), views, cut);
     const std::vector<SegmentSet> actors = connected_components(*hull, 0.01);
     double now = thread_cpu_ms();
     ms[0] += now - t, t = now;
+    wall[0] += since(w);
     for (const SegmentSet& actor : actors) {
-      Mesh mesh = segment_marching_cubes(actor, {.normals = !refine || !skip_normals});
+      Mesh mesh = segment_marching_cubes(
+          actor, {.normals = !refine || !skip_normals, .threads = mesh_threads});
       now = thread_cpu_ms();
       ms[1] += now - t, t = now;
+      wall[1] += since(w);
       if (refine) {
         if (!refine_crossings(mesh, actor, views, refine_options)) state.SkipWithError("refine");
         now = thread_cpu_ms();
         ms[2] += now - t, t = now;
+        wall[2] += since(w);
       }
       triangles += mesh.triangles.size();
       benchmark::DoNotOptimize(mesh);
@@ -101,13 +117,17 @@ void BM_LiveFrame(benchmark::State& state) {
   state.counters["mesh_ms"] = ms[1] / n;
   state.counters["refine_ms"] = ms[2] / n;  // main thread only when split
   state.counters["cpu_ms"] = (ms[0] + ms[1] + ms[2]) / n;
+  state.counters["mesh_wall_ms"] = wall[1] / n;
+  state.counters["refine_wall_ms"] = wall[2] / n;
+  state.counters["wall_ms"] = (wall[0] + wall[1] + wall[2]) / n;
   state.counters["triangles"] = double(triangles) / n;
 }
 BENCHMARK(BM_LiveFrame)
-    ->Args({0, 1, 0})
-    ->Args({1, 1, 0})
-    ->Args({1, 1, 1})
-    ->Args({1, 2, 1})
+    ->Args({0, 1, 0, 1})
+    ->Args({1, 1, 0, 1})
+    ->Args({1, 1, 1, 1})
+    ->Args({1, 2, 1, 1})
+    ->Args({1, 2, 1, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

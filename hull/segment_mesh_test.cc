@@ -89,11 +89,66 @@ TEST(SegmentMesh, HullOfAnActorIsWatertightWithTheSegmentVolume) {
   }
 }
 
+// The live hull meshes on two threads (MeshOptions::threads): the same vertices, triangles and
+// order as one thread, on the actor's hull (both axes) and on random sets with several segments
+// per column and gaps, where the two halves share a lattice row of vertices.
+TEST(SegmentMesh, TwoThreadsGiveTheSameMesh) {
+  const auto expect_same = [](const SegmentSet& set) {
+    const Mesh one = segment_marching_cubes(set, {.threads = 1});
+    const Mesh two = segment_marching_cubes(set, {.threads = 2});
+    ASSERT_FALSE(one.empty());
+    ASSERT_EQ(one.vertices.size(), two.vertices.size());
+    ASSERT_EQ(one.triangles.size(), two.triangles.size());
+    for (std::size_t k = 0; k < one.vertices.size(); ++k)
+      ASSERT_EQ(one.vertices[k], two.vertices[k]) << "vertex " << k;
+    for (std::size_t k = 0; k < one.triangles.size(); ++k)
+      ASSERT_EQ(one.triangles[k], two.triangles[k]) << "triangle " << k;
+    ASSERT_EQ(one.normals.size(), two.normals.size());
+    for (std::size_t k = 0; k < one.normals.size(); ++k) ASSERT_EQ(one.normals[k], two.normals[k]);
+    EXPECT_TRUE(check_topology(two).watertight());
+  };
+  const testing::Scene scene = testing::actor();
+  auto cams = support::camera_ring(8, 704, 576, 4.0, 1.6, {0, 1, 0}, 600);
+  std::vector<RunMask> masks;
+  std::vector<View> views;
+  for (const Camera& c : cams) masks.push_back(testing::render_mask(c, scene));
+  for (std::size_t k = 0; k < cams.size(); ++k) views.push_back({&cams[k], &masks[k]});
+  for (Axis axis : {Axis::y, Axis::x}) {
+    GridSpec g;
+    g.box_min = {-1, 0, -1};
+    g.box_max = {1, 2, 1};
+    g.axis = axis;
+    g.cells_u = g.cells_v = 160;
+    auto hull = visual_hull(g, views);
+    ASSERT_TRUE(hull);
+    expect_same(*hull);
+  }
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> U(0, 1);
+  for (int rows : {16, 17, 40}) {
+    GridSpec g;
+    g.cells_u = 23;
+    g.cells_v = rows;
+    std::vector<std::vector<Interval>> cols(g.columns());
+    for (auto& c : cols) {
+      float t = 0;
+      while (true) {
+        const float lo = t + 0.3f * U(rng), hi = lo + 0.3f * U(rng) + 0.01f;
+        if (hi > 1) break;
+        if (U(rng) < 0.7f) c.push_back({lo, hi});
+        t = hi + 0.01f;
+      }
+    }
+    expect_same(SegmentSet::from_columns(g, cols));
+  }
+}
+
 TEST(SegmentMesh, SphereMeshVolumeMatchesSphereHull) {
   testing::Scene s;
   s.ellipsoids.push_back({Eigen::Vector3d(0, 1, 0), Eigen::Vector3d::Constant(0.5)});
   auto cams = support::camera_ring(12, 640, 480, 5.0, 1.0, {0, 1, 0}, 700);
-  cams.push_back(support::look_at_camera("top", {0, 6, 0}, {0, 1, 0}, Eigen::Vector3d::UnitZ(), 640, 480, 700));
+  cams.push_back(support::look_at_camera("top", {0, 6, 0}, {0, 1, 0}, Eigen::Vector3d::UnitZ(), 640,
+                                         480, 700));
   std::vector<RunMask> masks;
   std::vector<View> views;
   for (const Camera& c : cams) masks.push_back(testing::render_mask(c, s));

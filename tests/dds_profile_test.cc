@@ -90,6 +90,56 @@ TEST_F(DdsProfileTest, StudioProfileRoutesMasksThroughTheirPartitionBetweenProce
   EXPECT_EQ(calib.find("239.255.42.1"), std::string::npos) << calib;
 }
 
+// The loopback profile (tests, the single-machine demo) sends data to the matched readers only:
+// a peer with a mask reader announces (SPDP) its unicast data locator and no default multicast
+// one, so a writer on this host never multicasts masks (or meshes) to every process of the
+// studio; discovery still multicasts (the peer and this process find each other without a peer
+// list). Negative control: the same profile with multicast data allowed (as before session 10)
+// announces the default group 239.255.0.1, which every writer would then send to.
+TEST_F(DdsProfileTest, LoopbackProfileSendsDataOnlyToItsReaders) {
+  const std::string loopback =
+      slurp(std::filesystem::path(STUDIO_SOURCE_DIR) / "deploy/dds/loopback.xml");
+  // The peer's trace after a writer here matched its mask reader.
+  const auto peer_trace = [&](const std::string& xml, const std::string& name) {
+    std::string x = xml;
+    replace(x, "</Domain>",
+            "<Tracing><Verbosity>finest</Verbosity><OutputFile>${STUDIO_TRACE}</OutputFile></"
+            "Tracing></Domain>");
+    const auto profile = dir_ / (name + ".xml");
+    std::ofstream(profile) << x;
+    const auto trace = dir_ / (name + ".trace");
+    Env env = dds_.env();
+    env[0].second = "file://" + profile.string();
+    env.push_back({"STUDIO_TRACE", trace.string()});
+    Process peer = Process::start({.name = "peer-" + name,
+                                   .binary = built_binary("tests/wire_peer"),
+                                   .args = {"echo"},
+                                   .env = env,
+                                   .dir = dir_})
+                       .value();
+    EXPECT_TRUE(peer.wait_ready(15s)) << peer.log();
+    auto p = wire::Participant::create(dds_.domain_id, dds_.config_uri).value();
+    auto topic = wire::Topic<studio_AlphaMask>::create(p).value();
+    auto writer = wire::Writer<studio_AlphaMask>::create(p, topic).value();
+    EXPECT_TRUE(writer.wait_for_readers(1, 10s)) << name;
+    EXPECT_EQ(peer.stop(), 0);
+    return slurp(trace);
+  };
+  ASSERT_NE(dds_.config_uri.find("deploy/dds/loopback.xml"), std::string::npos);
+  const std::string unicast = peer_trace(loopback, "loopback");
+  ASSERT_NE(unicast.find("DCPSSubscription/SubscriptionBuiltinTopicData:{topic_name=\"studio/"
+                         "camera/mask\""),
+            std::string::npos)
+      << "no mask reader in the peer's trace";
+  EXPECT_NE(unicast.find("default_unicast_locator={udp/127.0.0.1:"), std::string::npos);
+  EXPECT_EQ(unicast.find("default_multicast_locator="), std::string::npos);
+  std::string multicast_data = loopback;
+  replace(multicast_data, "<AllowMulticast>spdp</AllowMulticast>",
+          "<AllowMulticast>true</AllowMulticast>");
+  const std::string control = peer_trace(multicast_data, "multicast-data");
+  EXPECT_NE(control.find("default_multicast_locator={udp/239.255.0.1:"), std::string::npos);
+}
+
 TEST_F(DdsProfileTest, LoopbackProfileSelectsOnlyLoWithMulticast) {
   const auto trace = dir_ / "peer.trace";
   Env env = dds_.env();

@@ -26,6 +26,7 @@ CameraWorker::CameraWorker(CameraSetup setup, const CaptureIo& io)
       tracked_(setup.tracked),
       report_tracker_(setup.report_tracker),
       lens_table_(std::move(setup.lens_table)),
+      modelled_readout_ns_(setup.modelled_readout_ns),
       image_rate_(io.options.image_rate),
       image_raw_(io.options.image_raw) {
   if (report_tracker_) {
@@ -82,6 +83,11 @@ void CameraWorker::on_source_error(const Error& error) {
 }
 
 void CameraWorker::on_frame(Frame& frame, Clock::time_point now) {
+  // capture_ns -> here: the modelled read-out, then whatever came on top (capture_stages.h).
+  const int64_t grabbed_ns = realtime_ns();
+  io_.stages.add(CaptureStages::readout_model, double(modelled_readout_ns_) * 1e-6);
+  io_.stages.add(CaptureStages::grab_late,
+                 double(grabbed_ns - frame.capture_ns - modelled_readout_ns_) * 1e-6);
   source_failed_ = false;
   io_.frames_captured.add();
   bool send = false, raw = false;
@@ -101,7 +107,9 @@ void CameraWorker::on_frame(Frame& frame, Clock::time_point now) {
   // Key (unless keying runs elsewhere: masks: false) → the image into the ring, before its mask
   // goes out (moved, not copied, unless this frame's image is also published) → mask codec →
   // AlphaMask.
+  const auto key_start = Clock::now();
   const bool keyed = io_.options.publish_masks && key(frame);
+  if (keyed) io_.stages.add(CaptureStages::key, Clock::now() - key_start);
   if (send) {
     ring_.push(frame.frame, frame.capture_ns, frame.image);
   } else {
@@ -150,10 +158,18 @@ bool CameraWorker::key(const Frame& frame) {
 }
 
 void CameraWorker::publish_mask(const Frame& frame) {
+  const auto t0 = Clock::now();
   encode_mask(mask_, io_.options.coding, mask_bytes_);
   from_core(id_, frame.frame, frame.capture_ns, mask_bytes_, mask_.width(), mask_.height(),
             mask_sample_);
-  if (io_.masks.write(*mask_sample_)) io_.loop.completed(frame.frame, frame.capture_ns);
+  const auto t1 = Clock::now();
+  const bool written = bool(io_.masks.write(*mask_sample_));
+  const int64_t written_ns = realtime_ns();
+  io_.stages.add(CaptureStages::code, t1 - t0);
+  io_.stages.add(CaptureStages::write, Clock::now() - t1);
+  if (!written) return;
+  io_.stages.add(CaptureStages::capture_to_mask, double(written_ns - frame.capture_ns) * 1e-6);
+  io_.loop.completed(frame.frame, frame.capture_ns);
 }
 
 void CameraWorker::send_image(const Frame& frame, bool raw) {

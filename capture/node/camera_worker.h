@@ -19,6 +19,7 @@
 #include "capture/recorder.h"
 #include "capture/take_schedule.h"
 #include "capture_node.h"
+#include "capture_stages.h"
 #include "image_ring.h"
 #include "wire/capture_convert.h"
 #include "keyer/config/kept_plates.h"
@@ -48,6 +49,7 @@ struct CaptureIo {
   runtime::Counter& frames_unkeyed;      // difference key without a clean plate yet
   runtime::Counter& plates_captured;     // KeyerPlate requests completed
   runtime::Counter& plate_saves_failed;  // completed plates that could not be kept in plate_dir
+  CaptureStages& stages;                 // where a frame's time goes (capture_stages.h)
 };
 
 class CameraWorker {
@@ -123,6 +125,7 @@ class CameraWorker {
   TrackedSource* tracked_ = nullptr;
   bool report_tracker_ = false;
   std::optional<LensTableOptions> lens_table_;
+  int64_t modelled_readout_ns_ = 0;
   ImageRing ring_{25};
   // Grab thread only.
   wire::Owned<studio_CameraCalibration> calibration_sample_;

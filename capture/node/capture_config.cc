@@ -274,6 +274,7 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
     so.readout_ns = c.sim.readout_us >= 0 ? int64_t(readout_us * 1000)
                                           : std::min(int64_t(readout_us * 1000), clock.period_ns);
     setup.calibration = so.camera;
+    setup.modelled_readout_ns = so.readout_ns;
     src = SimFrameSource::create(so);
   } else if (c.type == "files") {
     FileSourceOptions fo = c.files;

@@ -26,6 +26,7 @@ class CaptureNode : public runtime::Node {
       : options_(std::move(options)),
         kept_plates_(options_.plate_dir),
         loop_(context, kLog),
+        stages_(context.metrics),
         io_{.options = options_,
             .kept_plates = kept_plates_,
             .loop = loop_,
@@ -41,7 +42,8 @@ class CaptureNode : public runtime::Node {
             .frames_dropped = loop_.counter("frames_dropped"),
             .frames_unkeyed = loop_.counter("frames_unkeyed"),
             .plates_captured = loop_.counter("plates_captured"),
-            .plate_saves_failed = loop_.counter("plate_saves_failed")} {
+            .plate_saves_failed = loop_.counter("plate_saves_failed"),
+            .stages = stages_} {
     loop_.count_as_input(io_.frames_captured);
     loop_.input<studio_CameraControl>(
         {.received = "controls_in",
@@ -160,6 +162,7 @@ class CaptureNode : public runtime::Node {
   runtime::Input<studio_CaptureCommand>* commands_ = nullptr;
   std::unique_ptr<ImageRequests> image_requests_;
   runtime::ServiceLoop loop_;  // stopped (destroyed) before the workers: declared after them
+  CaptureStages stages_;
   CaptureIo io_;
 };
 

@@ -45,6 +45,9 @@ struct CameraSetup {
   TrackedSource* tracked = nullptr;  // `source` itself when the camera is Free-D tracked
   bool report_tracker = false;       // this camera counts its listener's packets
   std::optional<LensTableOptions> lens_table;  // a fixed camera's zoom/focus -> intrinsics
+  // What the camera model adds between the exposure instant and delivery (a simulated camera's
+  // read-out: physics, reported apart from our cost, capture_stages.h); 0 for real cameras.
+  int64_t modelled_readout_ns = 0;
 };
 
 struct CaptureNodeOptions {

@@ -251,6 +251,44 @@ TEST_F(CaptureNodeTest, PublishesMasksImagesStateAndAppliesControl) {
   EXPECT_EQ(p.stop(), 0) << p.log();
 }
 
+// The status says where a frame's time goes before its mask is on the wire
+// (capture_stages.h): the simulated camera's read-out model apart (physics: exactly the
+// configured read-out), what came on top of it, the key, the codec and the write, and the whole
+// capture -> mask, which holds the read-out and the key (a camera with a 6 ms read-out).
+TEST_F(CaptureNodeTest, StatusSaysWhereAFramesTimeGoes) {
+  auto status = reader<studio_ServiceStatus>();
+  const std::string config =
+      "clock: {fps: 25}\ntakes_dir: takes\nstatus_period: 0.2\ncameras:\n"
+      "  - id: cam0\n    source: {type: sim, ring: 6, index: 0, width: 176, height: 144, "
+      "readout_us: 6000}\n";
+  auto& p =
+      spawn("capture", "capture/studio-capture", {"--config", write_config("cap.yaml", config)});
+  ASSERT_TRUE(p.wait_ready(30s)) << p.log();
+  std::map<std::string, double> g;
+  uint64_t masks = 0;
+  const auto until = std::chrono::steady_clock::now() + 20s;
+  while (std::chrono::steady_clock::now() < until && masks < 10) {
+    for (auto& s : status.take()) {
+      if (!s.meta.valid_data || std::string(s.data->service) != "capture") continue;
+      for (const auto& c : wire::view(s.data->counters)) g[c.name] = c.value;
+      masks = uint64_t(g["masks_published"]);
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  ASSERT_GE(masks, 10u) << p.log();
+  for (const char* name : {"stage_readout_model_ms", "stage_grab_late_ms", "stage_key_ms",
+                           "stage_code_ms", "stage_write_ms", "capture_to_mask_ms"})
+    EXPECT_TRUE(g.contains(name)) << name;
+  EXPECT_DOUBLE_EQ(g["stage_readout_model_ms"], 6.0);
+  EXPECT_GE(g["stage_grab_late_ms"], 0.0);  // never delivered before the read-out
+  EXPECT_GT(g["stage_key_ms"], 0.0);
+  EXPECT_GE(g["stage_code_ms"], 0.0);
+  EXPECT_GT(g["stage_write_ms"], 0.0);
+  EXPECT_GE(g["capture_to_mask_ms"], 6.0 + g["stage_key_ms"] * 0.5);
+  EXPECT_LT(g["capture_to_mask_ms"], 1000.0);
+  EXPECT_EQ(p.stop(), 0) << p.log();
+}
+
 // With the difference key the node publishes no mask until a clean plate is captured on command
 // (CameraControl KeyerPlate N: the next N frames); a bad count is an error in CameraState. A node
 // that does not key (masks: false) leaves KeyerPlate to the keyer node: no error there. With

@@ -174,12 +174,16 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
     return std::optional<Frame>();
   };
   // An untracked camera's picture depends on f alone: render it while waiting for its instant,
-  // so that it is ready at capture_ns instead of one render later (kept if the wait runs out).
-  // It starts half a period before the instant, not at once: after the previous frame's keying
-  // in every capture server on the machine (all run at one real-time priority, where a render
-  // started early would hold up another server's keying, hence its mask).
+  // so that it is ready when the frame is due instead of one render later (kept if the wait runs
+  // out). It starts half a period before the frame is due (capture_ns + the read-out), not at
+  // once: after the previous frame's keying in every capture server on the machine (all run at
+  // one real-time priority, where a render started early would hold up another server's keying,
+  // hence its mask), and after the previous frame's hull, so that the renders of every camera on
+  // the machine (a simulation cost: a real camera renders nothing) do not hold up the
+  // subscribers of its mesh below the capture servers' priority (issue 20).
+  const int64_t render_at = capture_ns - half + std::min(options_.readout_ns, half);
   if (options_.paced && !pose_ && !(ahead_ && ahead_->frame == f)) {
-    if (!wait_until(capture_ns - half, deadline)) return ran_out();
+    if (!wait_until(render_at, deadline)) return ran_out();
     ahead_.emplace();
     ahead_->frame = f;
     studio_.render(0, int64_t(f), &ahead_->image, nullptr);

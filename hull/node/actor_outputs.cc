@@ -59,8 +59,10 @@ void ActorOutputs::actor(const SegmentSet& set, const std::string& actor_id, Fra
   m->frame = frame.frame;
   m->capture_ns = frame.capture_ns;
   m->source_frame = frame.frame;
-  // With exact crossings the normals come after the vertices moved (refine_crossings).
-  Mesh mesh = segment_marching_cubes(set, {.normals = !options_.refine});
+  // With exact crossings the normals come after the vertices moved (refine_crossings). On the
+  // node's threads, as the cut and the crossings.
+  Mesh mesh =
+      segment_marching_cubes(set, {.normals = !options_.refine, .threads = options_.threads});
   lap(d.mesh);
   if (options_.refine) {
     // Only fails on a mask of the wrong size, which the frame's cut already rejected.

@@ -134,7 +134,9 @@ class HullNode : public runtime::Node {
     const auto now = SteadyClock::now();
     assembler_.add(s.camera_id, s.frame, s.capture_ns, std::move(*mask), now);
     // The frame's newest mask so far: when it was handled, and its transport (hull_stages.h).
-    Arrival& a = arrivals_[s.frame];
+    auto [it, first] = arrivals_.try_emplace(s.frame);
+    Arrival& a = it->second;
+    if (first) a.first = now;
     a.handled = now;
     a.delivery_ms =
         meta.source_timestamp ? double(realtime_ns() - meta.source_timestamp) * 1e-6 : -1;
@@ -163,6 +165,7 @@ class HullNode : public runtime::Node {
         stages_.add(HullStages::mask_delivery, it->second.delivery_ms);
         stages_.add(HullStages::capture_to_mask, it->second.written_ms);
       }
+      stages_.add(HullStages::assembly, it->second.handled - it->second.first);
       stages_.add(HullStages::queue, t - it->second.handled);
     }
     arrivals_.erase(arrivals_.begin(), arrivals_.upper_bound(frame.frame));
@@ -217,11 +220,12 @@ class HullNode : public runtime::Node {
   runtime::Counter* stale_ = nullptr;
   runtime::Counter* invalid_ = nullptr;
   struct Arrival {
-    SteadyClock::time_point handled;
-    double delivery_ms = -1;  // -1: no source timestamp
-    double written_ms = -1;   // capture_ns -> written
+    SteadyClock::time_point first;    // the frame's first mask handled
+    SteadyClock::time_point handled;  // its newest
+    double delivery_ms = -1;          // -1: no source timestamp
+    double written_ms = -1;           // capture_ns -> written
   };
-  std::map<uint64_t, Arrival> arrivals_;  // frame -> its newest mask (loop thread)
+  std::map<uint64_t, Arrival> arrivals_;  // frame -> its first and newest mask (loop thread)
   HullStages stages_;
   runtime::ServiceLoop loop_;  // last: stopped before the state above goes
 };

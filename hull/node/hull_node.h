@@ -18,8 +18,9 @@
 //   min_views: 2              visibility policy (hull/silhouette_cut.h): a point is actor iff
 //                             inside every silhouette that sees it and seen by >= min_views
 //                             cameras (0..64; the offline CLI's default, kDefaultMinViews)
-//   threads: 2                threads of the cut and of the exact crossings (columns and
-//                             crossing vertices are independent)
+//   threads: 2                threads of the cut, the segment marching cubes and the exact
+//                             crossings (columns, halves of the cell rows and crossing vertices
+//                             are independent)
 //   mesh: true                publish studio/actor/mesh (segment marching cubes)
 //   refine: true              exact crossings on the mesh (hull/crossing_refine.h): vertices
 //                             between an inside and an outside column move to where the hull

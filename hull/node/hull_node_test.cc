@@ -224,9 +224,10 @@ void HullNodeTest::masks_in_segments_and_mesh_out(bool refine) {
     std::this_thread::sleep_for(50ms);
   }
   for (const char* name :
-       {"capture_to_mask_ms", "stage_mask_delivery_ms", "stage_queue_ms", "stage_cut_ms",
-        "stage_mesh_ms", "stage_refine_ms", "stage_publish_ms", "mask_to_mesh_ms"})
+       {"capture_to_mask_ms", "stage_mask_delivery_ms", "stage_assembly_ms", "stage_queue_ms",
+        "stage_cut_ms", "stage_mesh_ms", "stage_refine_ms", "stage_publish_ms", "mask_to_mesh_ms"})
     EXPECT_TRUE(g.contains(name)) << name;
+  EXPECT_GE(g["stage_assembly_ms"], 0);
   EXPECT_GT(g["stage_cut_ms"], 0);
   EXPECT_GT(g["stage_mesh_ms"], 0);
   EXPECT_EQ(g["stage_refine_ms"] > 0, refine);

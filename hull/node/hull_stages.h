@@ -8,6 +8,8 @@
 //   stage_mask_delivery_ms  the frame's last mask: written by its capture server
 //                           (source_timestamp) -> handed to the hull's handler (DDS transport,
 //                           the loop's wake-up; CLOCK_REALTIME, same host)
+//   stage_assembly_ms       the frame's first mask handled -> its last (the assembly's wait for
+//                           the slowest capture server)
 //   stage_queue_ms          last mask handled -> the frame's cut starts (other frames or work
 //                           ahead of it on the loop thread; for a frame cut at its deadline
 //                           without every mask, also the wait for the missing ones)
@@ -31,6 +33,7 @@ class HullStages {
   enum Stage {
     capture_to_mask,
     mask_delivery,
+    assembly,
     queue,
     cut,
     mesh,
@@ -42,8 +45,9 @@ class HullStages {
 
   explicit HullStages(runtime::Metrics& metrics) {
     static constexpr const char* kNames[kCount] = {
-        "capture_to_mask_ms", "stage_mask_delivery_ms", "stage_queue_ms",   "stage_cut_ms",
-        "stage_mesh_ms",      "stage_refine_ms",        "stage_publish_ms", "mask_to_mesh_ms"};
+        "capture_to_mask_ms", "stage_mask_delivery_ms", "stage_assembly_ms",
+        "stage_queue_ms",     "stage_cut_ms",           "stage_mesh_ms",
+        "stage_refine_ms",    "stage_publish_ms",       "mask_to_mesh_ms"};
     for (int i = 0; i < kCount; ++i) gauges_[i] = &metrics.gauge(kNames[i]);
   }
   // One measurement of a stage, milliseconds.

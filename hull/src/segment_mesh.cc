@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <latch>
+#include <thread>
 #include <unordered_map>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -71,7 +73,8 @@ struct Scratch {
   std::vector<uint32_t> offset, fill, count;
   std::vector<uint8_t> occupied;
   std::vector<float> heights;
-  std::vector<int32_t> vertex_of;
+  std::vector<int32_t> vertex_of, vertex_of2;  // per slot, the first and second half's vertex
+  std::vector<uint32_t> slots, remap;          // the second half's vertices: slot, final index
 };
 
 }  // namespace
@@ -211,162 +214,228 @@ Mesh segment_marching_cubes(const SegmentSet& set, const MeshOptions& options) {
     }
   std::vector<uint32_t>& count = scratch.count;
   count.assign(lines, 0);
-  for (std::size_t l = 0; l < lines; ++l) {
-    float* b = heights.data() + offset[l];
-    float* e = heights.data() + offset[l + 1];
-    if (b == e) continue;
-    if (e - b <= 24) {  // a handful of end points: insertion sort
-      for (float* p = b + 1; p < e; ++p) {
-        const float x = *p;
-        float* q = p;
-        for (; q > b && q[-1] > x; --q) *q = q[-1];
-        *q = x;
+  // Each line's heights sorted and deduplicated (lines are independent).
+  const auto sort_lines = [&](std::size_t first, std::size_t last) {
+    for (std::size_t l = first; l < last; ++l) {
+      float* b = heights.data() + offset[l];
+      float* e = heights.data() + offset[l + 1];
+      if (b == e) continue;
+      if (e - b <= 24) {  // a handful of end points: insertion sort
+        for (float* p = b + 1; p < e; ++p) {
+          const float x = *p;
+          float* q = p;
+          for (; q > b && q[-1] > x; --q) *q = q[-1];
+          *q = x;
+        }
+      } else {
+        std::sort(b, e);
       }
-    } else {
-      std::sort(b, e);
+      count[l] = uint32_t(std::unique(b, e) - b);
     }
-    count[l] = uint32_t(std::unique(b, e) - b);
-  }
-  std::vector<int32_t>& vertex_of = scratch.vertex_of;
-  vertex_of.assign(heights.size(), -1);
-
-  Mesh mesh;
-  mesh.vertices.reserve(heights.size());  // untouched reserve costs address space only
-  mesh.triangles.reserve(2 * heights.size());
+  };
   const double du = g.du(), dv = g.dv();
   const int ua = g.u(), va = g.v(), aa = g.a();
-  // The vertex at heights[slot] of line l (created on first use).
-  const auto vertex_at = [&](std::size_t l, std::size_t slot) -> uint32_t {
-    int32_t& id = vertex_of[slot];
-    if (id < 0) {
-      const float t = heights[slot];
-      id = int32_t(mesh.vertices.size());
-      const int x2 = int(l % std::size_t(L.X)), y2 = int(l / std::size_t(L.X));
-      Eigen::Vector3d p;
-      p[ua] = g.box_min[ua] + (x2 * 0.5 - 0.5 + i0) * du;
-      p[va] = g.box_min[va] + (y2 * 0.5 - 0.5 + j0) * dv;
-      p[aa] = t;
-      mesh.vertices.push_back(p.cast<float>());
-    }
-    return uint32_t(id);
-  };
 
   // Per cell: lattice lines of corners, mid-edges and centre (doubled offsets from c0).
   static constexpr int kCorner[4][2] = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
   static constexpr int kMid[4][2] = {{1, 0}, {2, 1}, {1, 2}, {0, 1}};
-  for (int cj = -1; cj < nv; ++cj) {
-    const uint8_t* occ0 = occupied.data() + std::size_t(cj + 1) * ow;
-    const uint8_t* occ1 = occ0 + ow;
-    for (int ci = -1; ci < nu; ++ci) {
-      if (!(occ0[ci + 1] | occ0[ci + 2] | occ1[ci + 1] | occ1[ci + 2])) continue;
-      const std::span<const Interval> cols[4] = {column(ci, cj), column(ci + 1, cj),
-                                                 column(ci + 1, cj + 1), column(ci, cj + 1)};
-      if (cols[0].empty() && cols[1].empty() && cols[2].empty() && cols[3].empty()) continue;
-      const int x0 = 2 * ci + 2, y0 = 2 * cj + 2;
-      // The cell's nine lattice lines: corners 0-3, mid-edges 4-7 (m_k = 4 + k), centre 8.
-      std::size_t line[9];
-      for (int k = 0; k < 4; ++k) {
-        line[k] = L.line(x0 + kCorner[k][0], y0 + kCorner[k][1]);
-        line[4 + k] = L.line(x0 + kMid[k][0], y0 + kMid[k][1]);
+  // The cells of rows [cj_begin, cj_end) into `mesh`; vertex_of[slot] is the vertex made for
+  // heights[slot] (-1: none yet); `slots`, when given, receives the slot of every new vertex.
+  const auto mesh_rows = [&](int cj_begin, int cj_end, Mesh& mesh, int32_t* vertex_of,
+                             std::vector<uint32_t>* slots) {
+    // The vertex at heights[slot] of line l (created on first use).
+    const auto vertex_at = [&](std::size_t l, std::size_t slot) -> uint32_t {
+      int32_t& id = vertex_of[slot];
+      if (id < 0) {
+        const float t = heights[slot];
+        id = int32_t(mesh.vertices.size());
+        const int x2 = int(l % std::size_t(L.X)), y2 = int(l / std::size_t(L.X));
+        Eigen::Vector3d p;
+        p[ua] = g.box_min[ua] + (x2 * 0.5 - 0.5 + i0) * du;
+        p[va] = g.box_min[va] + (y2 * 0.5 - 0.5 + j0) * dv;
+        p[aa] = t;
+        mesh.vertices.push_back(p.cast<float>());
+        if (slots) slots->push_back(uint32_t(slot));
       }
-      line[8] = L.line(x0 + 1, y0 + 1);
-      // The centre line holds exactly the end points of the cell's four columns: the events.
-      const float* events = heights.data() + offset[line[8]];
-      const uint32_t n_events = count[line[8]];
-      // Per line a cursor into its sorted heights; events come in increasing order, so every
-      // lookup at the current event moves a cursor forward (no search). Mid-edge and centre
-      // lines hold every event of the cell, a corner line the end points of its column.
-      std::size_t cursor[9], end[9];
-      for (int k = 0; k < 9; ++k) cursor[k] = offset[line[k]], end[k] = cursor[k] + count[line[k]];
-      const auto slot_at = [&](int k, float t) -> std::size_t {
-        std::size_t& c = cursor[k];
-        while (c < end[k] && heights[c] < t) ++c;
-        return c;
-      };
-      // Internal piece edges q = 0..3: T_q | D_q, line pair (m_q, m_{q-1});
-      // q = 4..7: D_{q-4} | D_{q-3}, line pair (m_{q-4}, o); first line when the first piece
-      // (T_q or D_{q-4}) is inside.
-      const auto edge_line = [](int q, int side) -> int {
-        if (q < 4) return side == 0 ? 4 + q : 4 + ((q + 3) & 3);
-        return side == 0 ? 4 + (q - 4) : 8;
-      };
-      std::size_t wall_start[8][2];
-      const auto emit_wall = [&](int q, int dir, float e) {
-        const int la = edge_line(q, dir > 0 ? 0 : 1), lb = edge_line(q, dir > 0 ? 1 : 0);
-        const std::size_t sa = wall_start[q][dir > 0 ? 0 : 1], sb = wall_start[q][dir > 0 ? 1 : 0];
-        const std::size_t ea = slot_at(la, e), eb = slot_at(lb, e);
-        // Zipper between the two vertical sides (every height of each line in [start, e]),
-        // counter-clockwise seen from outside: polygon a0 -> b0 -> ... -> b_top -> a_top -> a0.
-        const std::size_t la_line = line[la], lb_line = line[lb];
-        std::size_t i = sa, k = sb;
-        uint32_t va = vertex_at(la_line, i), vb = vertex_at(lb_line, k);
-        while (i < ea || k < eb) {
-          if (i >= ea || (k < eb && heights[k + 1] <= heights[i + 1])) {
-            const uint32_t vn = vertex_at(lb_line, ++k);
-            mesh.triangles.push_back({va, vb, vn});
-            vb = vn;
-          } else {
-            const uint32_t vn = vertex_at(la_line, ++i);
-            mesh.triangles.push_back({va, vb, vn});
-            va = vn;
-          }
-        }
-      };
-      const auto emit_piece = [&](int piece, float t, bool up) {
-        uint32_t v[3];
-        if (piece < 4) {
-          const int k = piece;
-          v[0] = vertex_at(line[4 + ((k + 3) & 3)], slot_at(4 + ((k + 3) & 3), t));
-          v[1] = vertex_at(line[k], slot_at(k, t));
-          v[2] = vertex_at(line[4 + k], slot_at(4 + k, t));
-        } else {
-          const int k = piece - 4;
-          v[0] = vertex_at(line[8], slot_at(8, t));
-          v[1] = vertex_at(line[4 + ((k + 3) & 3)], slot_at(4 + ((k + 3) & 3), t));
-          v[2] = vertex_at(line[4 + k], slot_at(4 + k, t));
-        }
-        if (up) {
-          mesh.triangles.push_back({v[0], v[1], v[2]});
-        } else {
-          mesh.triangles.push_back({v[0], v[2], v[1]});
-        }
-      };
-
-      unsigned config = 0;
-      std::size_t pos[4] = {0, 0, 0, 0};
-      bool inside[4] = {false, false, false, false};
-      for (uint32_t ev = 0; ev < n_events; ++ev) {
-        const float e = events[ev];
-        unsigned next = config;
+      return uint32_t(id);
+    };
+    for (int cj = cj_begin; cj < cj_end; ++cj) {
+      const uint8_t* occ0 = occupied.data() + std::size_t(cj + 1) * ow;
+      const uint8_t* occ1 = occ0 + ow;
+      for (int ci = -1; ci < nu; ++ci) {
+        if (!(occ0[ci + 1] | occ0[ci + 2] | occ1[ci + 1] | occ1[ci + 2])) continue;
+        const std::span<const Interval> cols[4] = {column(ci, cj), column(ci + 1, cj),
+                                                   column(ci + 1, cj + 1), column(ci, cj + 1)};
+        if (cols[0].empty() && cols[1].empty() && cols[2].empty() && cols[3].empty()) continue;
+        const int x0 = 2 * ci + 2, y0 = 2 * cj + 2;
+        // The cell's nine lattice lines: corners 0-3, mid-edges 4-7 (m_k = 4 + k), centre 8.
+        std::size_t line[9];
         for (int k = 0; k < 4; ++k) {
-          const auto& c = cols[k];
-          if (pos[k] >= c.size()) continue;
-          const float edge = inside[k] ? c[pos[k]].hi : c[pos[k]].lo;
-          if (edge == e) {
-            if (inside[k]) ++pos[k];
-            inside[k] = !inside[k];
-            next ^= 1u << k;
+          line[k] = L.line(x0 + kCorner[k][0], y0 + kCorner[k][1]);
+          line[4 + k] = L.line(x0 + kMid[k][0], y0 + kMid[k][1]);
+        }
+        line[8] = L.line(x0 + 1, y0 + 1);
+        // The centre line holds exactly the end points of the cell's four columns: the events.
+        const float* events = heights.data() + offset[line[8]];
+        const uint32_t n_events = count[line[8]];
+        // Per line a cursor into its sorted heights; events come in increasing order, so every
+        // lookup at the current event moves a cursor forward (no search). Mid-edge and centre
+        // lines hold every event of the cell, a corner line the end points of its column.
+        std::size_t cursor[9], end[9];
+        for (int k = 0; k < 9; ++k)
+          cursor[k] = offset[line[k]], end[k] = cursor[k] + count[line[k]];
+        const auto slot_at = [&](int k, float t) -> std::size_t {
+          std::size_t& c = cursor[k];
+          while (c < end[k] && heights[c] < t) ++c;
+          return c;
+        };
+        // Internal piece edges q = 0..3: T_q | D_q, line pair (m_q, m_{q-1});
+        // q = 4..7: D_{q-4} | D_{q-3}, line pair (m_{q-4}, o); first line when the first piece
+        // (T_q or D_{q-4}) is inside.
+        const auto edge_line = [](int q, int side) -> int {
+          if (q < 4) return side == 0 ? 4 + q : 4 + ((q + 3) & 3);
+          return side == 0 ? 4 + (q - 4) : 8;
+        };
+        std::size_t wall_start[8][2];
+        const auto emit_wall = [&](int q, int dir, float e) {
+          const int la = edge_line(q, dir > 0 ? 0 : 1), lb = edge_line(q, dir > 0 ? 1 : 0);
+          const std::size_t sa = wall_start[q][dir > 0 ? 0 : 1],
+                            sb = wall_start[q][dir > 0 ? 1 : 0];
+          const std::size_t ea = slot_at(la, e), eb = slot_at(lb, e);
+          // Zipper between the two vertical sides (every height of each line in [start, e]),
+          // counter-clockwise seen from outside: polygon a0 -> b0 -> ... -> b_top -> a_top -> a0.
+          const std::size_t la_line = line[la], lb_line = line[lb];
+          std::size_t i = sa, k = sb;
+          uint32_t va = vertex_at(la_line, i), vb = vertex_at(lb_line, k);
+          while (i < ea || k < eb) {
+            if (i >= ea || (k < eb && heights[k + 1] <= heights[i + 1])) {
+              const uint32_t vn = vertex_at(lb_line, ++k);
+              mesh.triangles.push_back({va, vb, vn});
+              vb = vn;
+            } else {
+              const uint32_t vn = vertex_at(la_line, ++i);
+              mesh.triangles.push_back({va, vb, vn});
+              va = vn;
+            }
           }
-        }
-        const uint8_t before = kTables.pieces[config], after = kTables.pieces[next];
-        for (unsigned change = before ^ after; change != 0; change &= change - 1) {
-          const int p = __builtin_ctz(change);
-          emit_piece(p, e, (before >> p) & 1);
-        }
-        const int8_t* dir0 = kTables.dir[config];
-        const int8_t* dir1 = kTables.dir[next];
-        for (unsigned walls = kTables.dir_change[config][next]; walls != 0; walls &= walls - 1) {
-          const int q = __builtin_ctz(walls);
-          const int d0 = dir0[q], d1 = dir1[q];
-          if (d0 != 0) emit_wall(q, d0, e);
-          if (d1 != 0) {
-            wall_start[q][0] = slot_at(edge_line(q, 0), e);
-            wall_start[q][1] = slot_at(edge_line(q, 1), e);
+        };
+        const auto emit_piece = [&](int piece, float t, bool up) {
+          uint32_t v[3];
+          if (piece < 4) {
+            const int k = piece;
+            v[0] = vertex_at(line[4 + ((k + 3) & 3)], slot_at(4 + ((k + 3) & 3), t));
+            v[1] = vertex_at(line[k], slot_at(k, t));
+            v[2] = vertex_at(line[4 + k], slot_at(4 + k, t));
+          } else {
+            const int k = piece - 4;
+            v[0] = vertex_at(line[8], slot_at(8, t));
+            v[1] = vertex_at(line[4 + ((k + 3) & 3)], slot_at(4 + ((k + 3) & 3), t));
+            v[2] = vertex_at(line[4 + k], slot_at(4 + k, t));
           }
+          if (up) {
+            mesh.triangles.push_back({v[0], v[1], v[2]});
+          } else {
+            mesh.triangles.push_back({v[0], v[2], v[1]});
+          }
+        };
+
+        unsigned config = 0;
+        std::size_t pos[4] = {0, 0, 0, 0};
+        bool inside[4] = {false, false, false, false};
+        for (uint32_t ev = 0; ev < n_events; ++ev) {
+          const float e = events[ev];
+          unsigned next = config;
+          for (int k = 0; k < 4; ++k) {
+            const auto& c = cols[k];
+            if (pos[k] >= c.size()) continue;
+            const float edge = inside[k] ? c[pos[k]].hi : c[pos[k]].lo;
+            if (edge == e) {
+              if (inside[k]) ++pos[k];
+              inside[k] = !inside[k];
+              next ^= 1u << k;
+            }
+          }
+          const uint8_t before = kTables.pieces[config], after = kTables.pieces[next];
+          for (unsigned change = before ^ after; change != 0; change &= change - 1) {
+            const int p = __builtin_ctz(change);
+            emit_piece(p, e, (before >> p) & 1);
+          }
+          const int8_t* dir0 = kTables.dir[config];
+          const int8_t* dir1 = kTables.dir[next];
+          for (unsigned walls = kTables.dir_change[config][next]; walls != 0; walls &= walls - 1) {
+            const int q = __builtin_ctz(walls);
+            const int d0 = dir0[q], d1 = dir1[q];
+            if (d0 != 0) emit_wall(q, d0, e);
+            if (d1 != 0) {
+              wall_start[q][0] = slot_at(edge_line(q, 0), e);
+              wall_start[q][1] = slot_at(edge_line(q, 1), e);
+            }
+          }
+          config = next;
         }
-        config = next;
       }
     }
+  };
+
+  std::vector<int32_t>& vertex_of = scratch.vertex_of;
+  Mesh mesh;
+  mesh.vertices.reserve(heights.size());  // untouched reserve costs address space only
+  mesh.triangles.reserve(2 * heights.size());
+  // Rows of cells -1 .. nv-1. Two threads: split where half the occupied columns are behind;
+  // each thread sorts the lines its rows need and meshes its rows. Lattice row 2 * split + 2 is
+  // the one both halves touch: the first sorts it, the second waits for that. The second half's
+  // vertices on it are matched to the first half's by slot, the rest appended in the second
+  // half's order of first use: the order one thread makes them in, so the mesh is the same for
+  // any thread count.
+  int split = nv;
+  if (options.threads >= 2 && nv >= 16) {
+    std::size_t total = 0;
+    for (uint8_t o : occupied) total += o;
+    std::size_t behind = 0;
+    for (int j = 0; j < nv && split == nv; ++j) {
+      for (int i = 0; i < nu; ++i) behind += occupied[std::size_t(i + 1) + std::size_t(j + 1) * ow];
+      if (2 * behind >= total) split = j + 1;
+    }
+    if (split >= nv - 1) split = nv;
+  }
+  if (split == nv) {
+    sort_lines(0, lines);
+    vertex_of.assign(heights.size(), -1);
+    mesh_rows(-1, nv, mesh, vertex_of.data(), nullptr);
+  } else {
+    const std::size_t shared_end = std::size_t(2 * split + 3) * std::size_t(L.X);  // y2 <= 2s+2
+    std::vector<int32_t>& vertex_of2 = scratch.vertex_of2;
+    Mesh upper;
+    std::vector<uint32_t>& slots = scratch.slots;
+    slots.clear();
+    {
+      std::latch shared_sorted(1);
+      std::jthread worker([&] {
+        sort_lines(shared_end, lines);
+        vertex_of2.assign(heights.size(), -1);
+        shared_sorted.wait();
+        mesh_rows(split, nv, upper, vertex_of2.data(), &slots);
+      });
+      sort_lines(0, shared_end);
+      shared_sorted.count_down();
+      vertex_of.assign(heights.size(), -1);
+      mesh_rows(-1, split, mesh, vertex_of.data(), nullptr);
+    }
+    std::vector<uint32_t>& remap = scratch.remap;
+    remap.resize(upper.vertices.size());
+    for (std::size_t k = 0; k < upper.vertices.size(); ++k) {
+      const int32_t shared = vertex_of[slots[k]];
+      if (shared >= 0) {
+        remap[k] = uint32_t(shared);
+      } else {
+        remap[k] = uint32_t(mesh.vertices.size());
+        mesh.vertices.push_back(upper.vertices[k]);
+      }
+    }
+    const std::size_t first = mesh.triangles.size();
+    mesh.triangles.insert(mesh.triangles.end(), upper.triangles.begin(), upper.triangles.end());
+    for (std::size_t t = first; t < mesh.triangles.size(); ++t)
+      for (uint32_t& v : mesh.triangles[t]) v = remap[v];
   }
 
   if (options.normals) compute_normals(mesh);

@@ -25,10 +25,11 @@
 // `drop_every` loses frames like a camera dropping packets (they count in stats().drops), and
 // `stamp` writes the frame number into the corner (sim/frame_stamp.h) after the features.
 // Brightness is applied through a 256-entry table (saturating), blur as two separable box passes.
-// Paced and untracked, the picture of the next frame is rendered in the half period before its
-// exposure instant (it depends on the frame number alone) and delivered at that instant: the
-// image is ready at capture_ns, not one render (2-5 ms of CPU at 704x576) after it, and the
-// render does not compete with the previous frame's keying. Never delivered early.
+// Paced and untracked, the picture of the next frame is rendered in the half period before it is
+// due (capture_ns + readout_ns, the read-out capped at half a period; it depends on the frame
+// number alone) and delivered then: the image is ready when due, not one render (2-5 ms of CPU at
+// 704x576) after it, and the render competes neither with the previous frame's keying nor with
+// the hull's work on it. Never delivered early.
 // `readout_ns` models what a real camera adds between the exposure instant and the frame reaching
 // the host (the rest of the exposure, sensor read-out, link transfer): the frame is delivered no
 // earlier than capture_ns + readout_ns. 0 (the library default) is an ideal camera; the capture

@@ -37,6 +37,9 @@ struct MeshOptions {
   // Vertex normals (compute_normals). A caller that moves the vertices afterwards and recomputes
   // them (refine_crossings) skips this pass: mesh.normals is then empty.
   bool normals = true;
+  // 2: the cells are split into two halves of rows meshed on two threads (the live hull's
+  // latency); the mesh is identical for any value (same vertices, triangles and order).
+  int threads = 1;
 };
 
 // Cost follows the occupied part of the grid (the bounding rectangle of the non-empty columns).
