@@ -220,10 +220,10 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
         cov, f.images.back(), truth_mask);
     const auto oracle_blend =
         TextureBlend::create(testing::true_mesh(f.truth.body), views, to).value();
-    c.oracle = testing::score_held_out(
-        testing::blend_over(testing::truth_surface(f.truth.body, held, ss), held, ss,
-                            oracle_blend, plate, &cov, &unseen),
-        cov, f.images.back(), truth_mask);
+    c.oracle =
+        testing::score_held_out(testing::blend_over(testing::truth_surface(f.truth.body, held, ss),
+                                                    held, ss, oracle_blend, plate, &cov, &unseen),
+                                cov, f.images.back(), truth_mask);
     for (const auto& [what, sc] : std::vector<std::pair<const char*, testing::HeldOutScore>>{
              {"refined, per sub-pixel", c.per_pixel}, {"TRUE surface (oracle)", c.oracle}})
       std::printf(

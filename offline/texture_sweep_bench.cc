@@ -153,11 +153,13 @@ int main(int argc, char** argv) {
       {
         const auto h = testing::surface_distance(p.hull_mesh, p.f.truth.body);
         const auto r = testing::surface_distance(p.refined_mesh, p.f.truth.body);
-        std::printf("  %-9s f%-3lld s%llu surface mean / p95 hull %.2f / %.2f refined %.2f / %.2f (%+.1f %% / %+.1f %%)\n",
-                    sim::motion_name(poses[i].motion), (long long)poses[i].frame,
-                    (unsigned long long)poses[i].seed, 1e3 * h.both.mean, 1e3 * h.both.p95,
-                    1e3 * r.both.mean, 1e3 * r.both.p95, 100 * (r.both.mean / h.both.mean - 1),
-                    100 * (r.both.p95 / h.both.p95 - 1));
+        std::printf(
+            "  %-9s f%-3lld s%llu surface mean / p95 hull %.2f / %.2f refined %.2f / %.2f (%+.1f "
+            "%% / %+.1f %%)\n",
+            sim::motion_name(poses[i].motion), (long long)poses[i].frame,
+            (unsigned long long)poses[i].seed, 1e3 * h.both.mean, 1e3 * h.both.p95,
+            1e3 * r.both.mean, 1e3 * r.both.p95, 100 * (r.both.mean / h.both.mean - 1),
+            100 * (r.both.p95 / h.both.p95 - 1));
       }
       const Camera& cam = p.f.cameras.back();
       const Image<Rgb8>& truth = p.f.images.back();

@@ -413,9 +413,8 @@ int run_refined(int argc, char** argv) {
                   a.threshold, a.ncc, carve.patch_half, a.max_depth, int(key.mode));
     settings += buf;
     if (a.surface >= 0) {  // (absent when off: files made without it keep their fingerprint)
-      std::snprintf(buf, sizeof buf, " surface %d photo %d inside_hull %d rim_band %.9g",
-                    a.surface, a.surface_photo, int(surface.inside_hull),
-                    surface.rim_band_cells);
+      std::snprintf(buf, sizeof buf, " surface %d photo %d inside_hull %d rim_band %.9g", a.surface,
+                    a.surface_photo, int(surface.inside_hull), surface.rim_band_cells);
       settings += buf;
     }
     if (!a.keyer_file.empty()) {

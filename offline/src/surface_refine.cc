@@ -309,7 +309,8 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
         // near its middle.
         std::unordered_map<uint64_t, std::pair<float, float>> extent;
         const auto key = [](const Facet& f) {
-          return (uint64_t(f.camera) << 40) ^ (uint64_t(uint32_t(f.py)) << 20) ^ uint64_t(uint32_t(f.px));
+          return (uint64_t(f.camera) << 40) ^ (uint64_t(uint32_t(f.py)) << 20) ^
+                 uint64_t(uint32_t(f.px));
         };
         for (std::size_t n = 0; n < nv; ++n) {
           if (!anchored[n]) continue;
@@ -322,7 +323,8 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
         for (std::size_t n = 0; n < nv; ++n) {
           if (!anchored[n]) continue;
           const auto& [lo, hi] = extent.at(key(facet[n]));
-          anchored[n] = std::abs(facet[n].depth - 0.5f * (lo + hi)) <= float(o.rim_band_cells * cell);
+          anchored[n] =
+              std::abs(facet[n].depth - 0.5f * (lo + hi)) <= float(o.rim_band_cells * cell);
         }
       }
     }

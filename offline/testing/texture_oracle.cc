@@ -32,8 +32,7 @@ hull::Mesh true_mesh(const sim::ActorBody& body, int segments) {
   return m;
 }
 
-std::vector<SurfaceSample> truth_surface(const sim::ActorBody& body, const Camera& camera,
-                                         int ss) {
+std::vector<SurfaceSample> truth_surface(const sim::ActorBody& body, const Camera& camera, int ss) {
   const Camera fine = fine_camera(camera, ss);
   std::vector<SurfaceSample> out(std::size_t(fine.width) * fine.height);
   // Only the projected bounds of the body are cast.
