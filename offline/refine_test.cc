@@ -27,6 +27,7 @@
 #include "offline/surface_refine.h"
 #include "offline/texture.h"
 #include "sim/cameras.h"
+#include "testing/texture_oracle.h"
 #include "testing/truth.h"
 
 namespace studio::offline {
@@ -82,6 +83,10 @@ struct Case {
   double psnr_full_hull = 0, psnr_full_refined = 0;   // union of the silhouettes
   double psnr_carved = 0, psnr_full_carved = 0;
   double photo_target_error = 0, photo_stay_error = 0;  // metres (mean |target - truth|, |truth|)
+  // The held-out view's error split (testing/texture_oracle.h), union PSNR: the refined mesh's
+  // blend evaluated per sub-pixel (an atlas of unlimited resolution), and the same blend on the
+  // TRUE surface with true visibility (no geometry error: what the texturing alone costs).
+  testing::HeldOutScore per_pixel, oracle;
   std::size_t carved = 0;
 };
 
@@ -149,6 +154,16 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
   for (const hull::Mesh* m : std::vector<const hull::Mesh*>{&hull_mesh, &carved_mesh, &mesh}) {
     const auto colours = vertex_colours(*m, views, to).value();
     const Image<Rgb8> rendered = testing::render_coloured(*m, colours, f.cameras.back());
+    {
+      // Interior pixels whose centre no triangle covers (left black by the unfiltered render).
+      std::size_t holes = 0;
+      for (int y = 0; y < actor.height(); ++y)
+        for (int x = 0; x < actor.width(); ++x) {
+          const Rgb8 q = rendered.view().row(y)[x];
+          holes += actor.view().row(y)[x] && q.r == 0 && q.g == 0 && q.b == 0;
+        }
+      std::printf("  interior px the unfiltered render leaves black: %zu\n", holes);
+    }
     (m == &mesh          ? c.psnr_refined
      : m == &carved_mesh ? c.psnr_carved
                          : c.psnr_hull) = testing::psnr(rendered, f.images.back(), actor);
@@ -192,6 +207,32 @@ const Case& evaluate(sim::Motion motion, int64_t frame) {
           px[0], 100 * se[0] / total, px[1], 100 * se[1] / total, px[2], 100 * se[2] / total,
           short_px);
     }
+  }
+  {
+    const Camera& held = f.cameras.back();
+    const Image<Rgb8>& plate = studio.background(int(f.cameras.size()) - 1);
+    constexpr int ss = 4;
+    Mask cov;
+    std::size_t unseen = 0;
+    const auto blend = TextureBlend::create(mesh, views, to).value();
+    c.per_pixel = testing::score_held_out(
+        testing::blend_over(testing::mesh_surface(mesh, held, ss), held, ss, blend, plate, &cov),
+        cov, f.images.back(), truth_mask);
+    const auto oracle_blend =
+        TextureBlend::create(testing::true_mesh(f.truth.body), views, to).value();
+    c.oracle =
+        testing::score_held_out(testing::blend_over(testing::truth_surface(f.truth.body, held, ss),
+                                                    held, ss, oracle_blend, plate, &cov, &unseen),
+                                cov, f.images.back(), truth_mask);
+    for (const auto& [what, sc] : std::vector<std::pair<const char*, testing::HeldOutScore>>{
+             {"refined, per sub-pixel", c.per_pixel}, {"TRUE surface (oracle)", c.oracle}})
+      std::printf(
+          "  %s blend: union %.2f dB, interior %.2f dB; squared error interior %.0f %%, border "
+          "%.0f %%, outside the true mask %.0f %% (%zu px)\n",
+          what, sc.union_db, sc.interior_db, 100 * sc.share_interior, 100 * sc.share_border,
+          100 * sc.share_outside, sc.outside_px);
+    std::printf("  oracle: %zu of the true surface's sub-pixels seen by no camera (filled)\n",
+                unseen);
   }
   std::printf("%s frame %lld, %d^2 columns: carved %zu of %zu voxels in %d iterations\n",
               sim::motion_name(motion), (long long)frame, kGrid, carved.carved, carved.voxels,
@@ -272,9 +313,10 @@ TEST(SurfaceRefine, CloserToTheTruthThanCarvingAndTheHull) {
       "hull (carving alone %.1f %% / %.1f %%)\n",
       100 * mean_gain, 100 * p95_gain, 100 * (1 - carved_mean / hull_mean),
       100 * (1 - carved_p95 / hull_p95));
-  // Measured 18 % / 23 % (docs/offline.md); the 30 % is not reached.
-  EXPECT_GE(mean_gain, 0.16);
-  EXPECT_GE(p95_gain, 0.21);
+  // Measured 20.8 % / 26.1 % with the facet middles anchored (18.9 / 23.6 % with every facet
+  // vertex anchored; docs/offline.md); the 30 % is not reached.
+  EXPECT_GE(mean_gain, 0.19);
+  EXPECT_GE(p95_gain, 0.24);
 }
 
 // Poses the surface stage's settings (steps, anchors, the hull constraint) were not chosen on:
@@ -329,9 +371,10 @@ TEST(SurfaceRefine, ValidationPosesNotTunedOn) {
   std::printf(
       "validation poses: carved + surface mean %.1f %% lower, p95 %.1f %% lower than the hull\n",
       100 * mean_gain, 100 * p95_gain);
-  // Measured 18.8 % / 22.5 % (docs/offline.md; the 30 % is not reached).
-  EXPECT_GE(mean_gain, 0.16);
-  EXPECT_GE(p95_gain, 0.20);
+  // Measured 21.5 % / 25.6 % with the facet middles anchored (18.8 % / 22.5 % before;
+  // docs/offline.md; the 30 % is not reached).
+  EXPECT_GE(mean_gain, 0.19);
+  EXPECT_GE(p95_gain, 0.23);
 }
 
 TEST(Texture, HeldOutViewPsnr) {
@@ -348,6 +391,17 @@ TEST(Texture, HeldOutViewPsnr) {
     EXPECT_GE(c.psnr_full_carved, c.psnr_full_hull - 0.25) << sim::motion_name(motion);
     EXPECT_GE(c.psnr_full_refined, c.psnr_full_carved + 0.5) << sim::motion_name(motion);
     EXPECT_GE(c.psnr_refined, 27.5) << sim::motion_name(motion);
+    // Geometry against texturing (the oracle): the same blend on the TRUE surface, with true
+    // visibility, reaches the 28 dB over the union of silhouettes (measured 31.2 / 30.5
+    // dB); on the refined mesh it stays ~6 dB lower (25.6 / 24.2 dB) whether the colour is per
+    // vertex or per sub-pixel (an atlas would not close it: within 0.3 dB). What limits the
+    // held-out view is the shape: half of the union's squared error is mesh outside the true
+    // silhouette. (In this test, not its own: each ctest process re-evaluates the poses.)
+    EXPECT_GE(c.oracle.union_db, 29.5) << sim::motion_name(motion);
+    EXPECT_GE(c.oracle.interior_db, 32.0) << sim::motion_name(motion);
+    // Per-vertex colour is within half a dB of the blend evaluated at every rendered point.
+    EXPECT_GE(c.psnr_full_refined, c.per_pixel.union_db - 0.5) << sim::motion_name(motion);
+    EXPECT_LT(c.psnr_full_refined, c.oracle.union_db) << sim::motion_name(motion);
   }
 }
 

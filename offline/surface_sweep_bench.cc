@@ -111,6 +111,8 @@ int main(int argc, char** argv) {
         o.shape_lambda = v;
       else if (k == "rim")
         o.rim_cos = v;
+      else if (k == "band")
+        o.rim_band_cells = v;
       else if (k == "anchor")
         o.anchor_rims = v != 0;
       else if (k == "hull")

@@ -65,11 +65,12 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
                     colours alone
   --max-depth C     carving stops C cells below the hull (default 12)
   --surface S|off   surface stage on the mesh (after carving with --refine): S Laplacian steps
-                    with the silhouette rims anchored, each move kept inside the visual hull,
-                    moving the hull's bulges between the silhouette cones inwards (10
-                    recommended: -19 % mean / -24 % p95 surface distance vs the hull with
-                    --refine on the two concave test poses, -18 % / -23 % on five other poses
-                    not tuned on; union PSNR +1 dB); default off
+                    with the silhouette rims (the middle of each facet) anchored, each move
+                    kept inside the visual hull, moving the hull's bulges between the
+                    silhouette cones inwards (10 recommended: -21 % mean / -26 % p95 surface
+                    distance vs the hull with --refine on the two concave test poses; 30:
+                    -23 % / -28 %, also on five other poses not tuned on, at 3x the stage's
+                    cost; union PSNR +1.2-1.6 dB); default off
   --surface-photo N photo-consistency iterations of the surface stage before the steps (patch
                     search along the normals; default 0: measured no gain, docs/offline.md)
   --plan N          print the take's frames split into N contiguous shards, one A:B per line
@@ -412,8 +413,8 @@ int run_refined(int argc, char** argv) {
                   a.threshold, a.ncc, carve.patch_half, a.max_depth, int(key.mode));
     settings += buf;
     if (a.surface >= 0) {  // (absent when off: files made without it keep their fingerprint)
-      std::snprintf(buf, sizeof buf, " surface %d photo %d inside_hull %d", a.surface,
-                    a.surface_photo, int(surface.inside_hull));
+      std::snprintf(buf, sizeof buf, " surface %d photo %d inside_hull %d rim_band %.9g", a.surface,
+                    a.surface_photo, int(surface.inside_hull), surface.rim_band_cells);
       settings += buf;
     }
     if (!a.keyer_file.empty()) {

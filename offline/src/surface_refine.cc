@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "offline/view_sampling.h"
@@ -49,6 +50,8 @@ Expected<void> SurfaceRefineOptions::validate() const {
       !(rim_cos >= 0 && rim_cos <= 1))
     return fail(
         "surface refine: shape_steps must be 0..1000, shape_lambda in (0, 1], rim_cos in [0, 1]");
+  if (!(rim_band_cells >= 0 && rim_band_cells <= 64))
+    return fail("surface refine: rim_band_cells must be in [0, 64]");
   if (shape_order != 1 && shape_order != 2)
     return fail("surface refine: shape_order must be 1 or 2");
   if (shape_order == 2 && shape_lambda > 0.25)
@@ -270,6 +273,13 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
   if (o.shape_steps > 0) {
     smooth_normals();
     std::vector<uint8_t> anchored(nv, 0);
+    // The facet that anchored a vertex: camera, contour pixel, depth along the camera's axis.
+    struct Facet {
+      uint32_t camera = 0;
+      int32_t px = 0, py = 0;
+      float depth = 0;
+    };
+    std::vector<Facet> facet(o.rim_band_cells > 0 ? nv : 0);
     if (o.anchor_rims) {
       parallel_for(nv, o.threads, [&](std::size_t a, std::size_t b) {
         for (std::size_t n = a; n < b; ++n) {
@@ -284,10 +294,39 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
             int inside = 0;
             for (int dy = -1; dy <= 1; ++dy)
               for (int dx = -1; dx <= 1; ++dx) inside += views[c].mask->contains(px + dx, py + dy);
-            if (inside > 0 && inside < 9) anchored[n] = 1;
+            if (inside > 0 && inside < 9) {
+              anchored[n] = 1;
+              if (o.rim_band_cells > 0) {
+                facet[n] = {uint32_t(c), int32_t(px), int32_t(py),
+                            float((cams[c].R * x + cams[c].t).z())};
+              }
+            }
           }
         }
       });
+      if (o.rim_band_cells > 0) {
+        // The extent of each (camera, contour pixel) facet strip along its ray; keep the anchors
+        // near its middle.
+        std::unordered_map<uint64_t, std::pair<float, float>> extent;
+        const auto key = [](const Facet& f) {
+          return (uint64_t(f.camera) << 40) ^ (uint64_t(uint32_t(f.py)) << 20) ^
+                 uint64_t(uint32_t(f.px));
+        };
+        for (std::size_t n = 0; n < nv; ++n) {
+          if (!anchored[n]) continue;
+          auto [it, fresh] = extent.try_emplace(key(facet[n]), facet[n].depth, facet[n].depth);
+          if (!fresh) {
+            it->second.first = std::min(it->second.first, facet[n].depth);
+            it->second.second = std::max(it->second.second, facet[n].depth);
+          }
+        }
+        for (std::size_t n = 0; n < nv; ++n) {
+          if (!anchored[n]) continue;
+          const auto& [lo, hi] = extent.at(key(facet[n]));
+          anchored[n] =
+              std::abs(facet[n].depth - 0.5f * (lo + hi)) <= float(o.rim_band_cells * cell);
+        }
+      }
     }
     // For inside_hull: the cameras (bit c) whose silhouette contains x's projection (nearest
     // pixel), and whether x is inside all of the silhouettes `bits` (stops at the first miss).

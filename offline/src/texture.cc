@@ -1,6 +1,8 @@
 #include "offline/texture.h"
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <thread>
 
 #include "offline/view_sampling.h"
@@ -31,34 +33,73 @@ Expected<void> TextureOptions::validate() const {
   return {};
 }
 
-Expected<std::vector<Eigen::Vector3f>> vertex_colours(const hull::Mesh& mesh,
-                                                      std::span<const ColourView> views,
-                                                      const TextureOptions& options) {
+struct TextureBlend::Impl {
+  TextureOptions options;
+  std::vector<SampledView> cams;
+  std::vector<DepthBuffer> buffers;
+};
+
+TextureBlend::TextureBlend(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+TextureBlend::TextureBlend(TextureBlend&&) noexcept = default;
+TextureBlend& TextureBlend::operator=(TextureBlend&&) noexcept = default;
+TextureBlend::~TextureBlend() = default;
+
+Expected<TextureBlend> TextureBlend::create(const hull::Mesh& occluder,
+                                            std::span<const ColourView> views,
+                                            const TextureOptions& options) {
   if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
   auto sampled = prepare_views(views, options.edge_margin_px);
   if (!sampled) return std::unexpected(sampled.error());
-  const std::vector<SampledView>& cams = *sampled;
-  const std::size_t nv = mesh.vertices.size();
-  std::vector<Eigen::Vector3d> sum(nv, Eigen::Vector3d::Zero());
-  std::vector<double> weight(nv, 0);
-  std::vector<DepthBuffer> buffers(cams.size());
-  {
-    std::vector<std::jthread> pool;
-    const int workers = std::max(1, std::min<int>(options.threads, int(cams.size())));
-    for (int w = 0; w < workers; ++w) {
-      run_on(pool, workers, [&, w] {
-        for (std::size_t c = std::size_t(w); c < cams.size(); c += std::size_t(workers)) {
-          buffers[c].reset(cams[c]);
-          for (const auto& t : mesh.triangles) {
-            buffers[c].triangle(cams[c], mesh.vertices[t[0]].cast<double>(),
-                                mesh.vertices[t[1]].cast<double>(),
-                                mesh.vertices[t[2]].cast<double>());
-          }
+  auto impl = std::make_unique<Impl>();
+  impl->options = options;
+  impl->cams = std::move(*sampled);
+  const std::vector<SampledView>& cams = impl->cams;
+  std::vector<DepthBuffer>& buffers = impl->buffers;
+  buffers.resize(cams.size());
+  std::vector<std::jthread> pool;
+  const int workers = std::max(1, std::min<int>(options.threads, int(cams.size())));
+  for (int w = 0; w < workers; ++w) {
+    run_on(pool, workers, [&, w] {
+      for (std::size_t c = std::size_t(w); c < cams.size(); c += std::size_t(workers)) {
+        buffers[c].reset(cams[c]);
+        for (const auto& t : occluder.triangles) {
+          buffers[c].triangle(cams[c], occluder.vertices[t[0]].cast<double>(),
+                              occluder.vertices[t[1]].cast<double>(),
+                              occluder.vertices[t[2]].cast<double>());
         }
-      });
-    }
+      }
+    });
   }
-  // Vertices in parallel; each sums its cameras in camera order (deterministic).
+  pool.clear();  // joins
+  return TextureBlend(std::move(impl));
+}
+
+std::optional<Eigen::Vector3f> TextureBlend::colour(const Eigen::Vector3d& x,
+                                                    const Eigen::Vector3d& n) const {
+  const Impl& b = *impl_;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double weight = 0;
+  // Cameras in order (deterministic sums).
+  for (std::size_t c = 0; c < b.cams.size(); ++c) {
+    auto o = observe(b.cams[c], b.buffers[c], x, n, b.options.min_cos, b.options.depth_tolerance);
+    if (!o) continue;
+    const double w = std::pow(double(o->cos), b.options.sharpness);
+    sum += w * o->colour.cast<double>();
+    weight += w;
+  }
+  if (!(weight > 0)) return std::nullopt;
+  return (sum / weight).cast<float>();
+}
+
+Expected<std::vector<Eigen::Vector3f>> vertex_colours(const hull::Mesh& mesh,
+                                                      std::span<const ColourView> views,
+                                                      const TextureOptions& options) {
+  auto blend = TextureBlend::create(mesh, views, options);
+  if (!blend) return std::unexpected(blend.error());
+  const std::size_t nv = mesh.vertices.size();
+  std::vector<Eigen::Vector3f> colour(nv, Eigen::Vector3f::Zero());
+  std::vector<uint8_t> known(nv, 0);
+  // Vertices in parallel (each its own entry: independent of the thread count).
   {
     std::vector<std::jthread> pool;
     const int workers = std::max(1, options.threads);
@@ -67,27 +108,14 @@ Expected<std::vector<Eigen::Vector3f>> vertex_colours(const hull::Mesh& mesh,
       run_on(pool, workers, [&, w] {
         const std::size_t a = std::min(nv, std::size_t(w) * chunk), b = std::min(nv, a + chunk);
         for (std::size_t n = a; n < b; ++n) {
-          const Eigen::Vector3d x = mesh.vertices[n].cast<double>();
           const Eigen::Vector3d normal = mesh.normals[n].cast<double>();
           if (normal.squaredNorm() < 0.5) continue;
-          for (std::size_t c = 0; c < cams.size(); ++c) {
-            auto o =
-                observe(cams[c], buffers[c], x, normal, options.min_cos, options.depth_tolerance);
-            if (!o) continue;
-            const double w8 = std::pow(double(o->cos), options.sharpness);
-            sum[n] += w8 * o->colour.cast<double>();
-            weight[n] += w8;
+          if (auto c = blend->colour(mesh.vertices[n].cast<double>(), normal)) {
+            colour[n] = *c;
+            known[n] = 1;
           }
         }
       });
-    }
-  }
-  std::vector<Eigen::Vector3f> colour(nv, Eigen::Vector3f::Zero());
-  std::vector<uint8_t> known(nv, 0);
-  for (std::size_t n = 0; n < nv; ++n) {
-    if (weight[n] > 0) {
-      colour[n] = (sum[n] / weight[n]).cast<float>();
-      known[n] = 1;
     }
   }
   // Fill the unseen vertices from their neighbours, ring by ring (Jacobi steps: deterministic).

@@ -70,6 +70,15 @@ struct SurfaceRefineOptions {
   double shape_lambda = 0.5;
   bool anchor_rims = true;
   double rim_cos = 0.08;  // a rim vertex: |cos(normal, view)| below this, on the contour (1 px)
+  // > 0: of a camera's facet (the hull's surface on the cone of one contour pixel: every vertex
+  // there passes the rim test), only the vertices within rim_band_cells of the middle of its
+  // extent along the pixel's ray stay anchored. The true surface touches the cone somewhere on
+  // the strip, the facet lies outside it elsewhere (a convex cross-section seen by cameras 45
+  // degrees apart is circumscribed by a polygon touching it near each side's middle); the rest
+  // of the facet is free to move in. 0: every facet vertex is anchored (sessions 8-9). Measured
+  // (docs/offline.md, session 10): -18.9 / -23.6 % -> -20.8 / -26.1 % mean / p95 vs the hull on
+  // the train pair with 10 steps.
+  double rim_band_cells = 1;
   // Each step's move is kept inside the visual hull: a vertex whose projection is inside a
   // camera's silhouette (nearest pixel) stays inside it (the move is halved up to 3 times, else
   // the vertex stays). Laplacian steps move concave creases outwards (the hull's fold between an
