@@ -17,6 +17,7 @@ struct FrameMetrics {
         mesh_errors(loop.counter("mesh_motion_errors")),
         from_cache(loop.counter("frames_from_cache")),
         rerendered(loop.counter("scene_rerendered")),
+        fits_deferred(loop.counter("motion_fits_deferred")),
         moving_nodes(loop.metrics().gauge("scene_moving_nodes")),
         cache_move_mm(loop.metrics().gauge("scene_cache_move_mm")),
         cpu_per_frame_ms(loop.metrics().gauge("cpu_per_frame_ms")),
@@ -28,7 +29,7 @@ struct FrameMetrics {
     loop.count_as_output(rendered);
   }
   runtime::Counter &rendered, &eye_rejected, &head_stale, &scene_left_out, &assets_failed,
-      &superseded, &mesh_errors, &from_cache, &rerendered;
+      &superseded, &mesh_errors, &from_cache, &rerendered, &fits_deferred;
   runtime::Gauge &moving_nodes, &cache_move_mm, &cpu_per_frame_ms, &margin_mm, &latency_p_ms,
       &render_ms, &overrun_p_ms, &mesh_triangles;
 };

@@ -244,6 +244,7 @@ class ProjectorNode : public runtime::Node {
     const auto period = std::chrono::duration_cast<SteadyClock::duration>(
         std::chrono::duration<double>(1.0 / options_.rate));
     auto next = SteadyClock::now();
+    bool fit_deferred = false;  // the last frame's meshes were not fitted (late latching)
     // A frame when a new mesh arrives (at once: the mesh's motion-to-photon latency is its
     // transport + motion estimate + one render), else one period after the last frame (the
     // scene and the eye move without meshes too).
@@ -260,9 +261,24 @@ class ProjectorNode : public runtime::Node {
       render_one(*fr, state, out.window ? &*out.window : nullptr);
       if (options_.late_latch) {
         prepare_ahead(*fr, state, seconds(next - SteadyClock::now()));
-        const auto t = SteadyClock::now();
-        if (planner_.fit_pending() > 0)
-          stages_.add(FrameStages::motion, seconds(SteadyClock::now() - t));
+        // A newer mesh already waiting (the thread is behind): its frame goes first and this
+        // mesh's fit is dropped; the next fit is against the last mesh fitted, over two mesh
+        // intervals (MaskPlanner::latch_mesh), and the margin counts the velocities' age. Never
+        // two in a row, so the velocities are at most one interval older than otherwise.
+        bool waiting = false;
+        {
+          std::lock_guard lock(mutex_);
+          waiting = inbox_.has_meshes();
+        }
+        if (waiting && !fit_deferred) {
+          fit_deferred = true;
+          m_.fits_deferred.add();
+        } else {
+          fit_deferred = false;
+          const auto t = SteadyClock::now();
+          if (planner_.fit_pending() > 0)
+            stages_.add(FrameStages::motion, seconds(SteadyClock::now() - t));
+        }
       }
     }
   }
