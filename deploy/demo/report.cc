@@ -445,12 +445,13 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
                           : latency_limit.starts_with("capture_to_mask")  ? "capture"
                                                                           : "hull";
       latency_limit += inside_line(c, owner);
-      // The simulated cameras render their image after the frame's instant (capture_ns), all at
-      // once: that CPU is in this stage, where a real camera hands over a finished image.
+      // The simulated cameras render each picture ahead, in the half period before it is due,
+      // and deliver it at capture_ns + the modelled read-out (capture/sim_source.h): this stage
+      // holds that read-out (a real camera's exposure rest and transfer), then the keying.
       if (latency_limit.starts_with("capture_to_mask")) {
         latency_limit +=
-            ": for the simulated cameras this includes rendering each image after "
-            "the frame instant (all cameras at once on the shared cores), then keying";
+            ": for the simulated cameras this includes the modelled camera read-out "
+            "(the rest of the exposure and the link transfer), then keying";
         // As written by the capture servers, before any subscriber's own wake-up delay.
         for (const ServiceSeen& s : c.services)
           if (auto g = s.counters.find("capture_to_mask_ms");

@@ -2,7 +2,7 @@
 // Closed test meshes for the projector's mask tests (header-only): a UV sphere in any rotation, a
 // watertight box, their union, and whether one mesh covers another (every vertex and face
 // centre of the other inside it by winding number, computed independently of the library).
-// The same shapes as projector/mask_test.cc's.
+// Used by projector/mask_test.cc and velocity_field_test.cc.
 
 #include <Eigen/Geometry>
 #include <array>
