@@ -93,7 +93,9 @@ TEST(MaskPlanner, LatchedMeshUsesThePreviousFitUntilItsOwnIsFitted) {
       ASSERT_TRUE(first);
       EXPECT_FALSE(first->margin.predicted);
     }
-    if (k < 3) EXPECT_EQ(late.fit_pending(), 1);
+    if (k < 3) {
+      EXPECT_EQ(late.fit_pending(), 1);
+    }
   }
   auto latched = late.plan(display);
   auto fitted = eager.plan(display);

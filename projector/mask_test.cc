@@ -22,8 +22,8 @@ namespace {
 constexpr int64_t kFrameNs = 40'000'000;  // 25 fps
 
 // The test shapes and the independent coverage check (projector/testing/shapes.h).
-using testing::Coverage;
 using testing::box;
+using testing::Coverage;
 using testing::coverage;
 using testing::merge;
 using testing::random_rotation;
@@ -33,7 +33,7 @@ using testing::winding;
 // ---- margin formula ---------------------------------------------------------------------------
 
 TEST(MaskMargin, ComponentsFollowTheFormula) {
-  MarginOptions o;  // floor 10 mm, cap 200 mm, sigma_v 0.05 m/s
+  MarginOptions o;                    // floor 10 mm, cap 200 mm, sigma_v 0.05 m/s
   o.worst_case_acceleration = false;  // the estimate's formula (the default is checked below)
   // No motion known: floor + head speed x latency.
   auto m = security_margin(o, 0.08, 1.0, nullptr);

@@ -332,8 +332,6 @@ class ProjectorNode : public runtime::Node {
     return drawn;
   }
 
-
-
   void render_one(projector_render::FrameRenderer& fr, Frame& st, WindowOutput* window) {
     const bool late = options_.late_latch;
     if (late && !st.prepared) prepare_ahead(fr, st, 0);  // the first frame, on the path

@@ -24,16 +24,23 @@ MaskPlanner::MaskPlanner(MaskPlannerOptions options)
       latencies_(options_.latency_window, options_.latency_quantile),
       overruns_(options_.latency_window, options_.latency_quantile) {}
 
-Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t frame,
-                                     ActorMesh mesh) {
+Expected<MaskPlanner::Actor*> MaskPlanner::accept(const std::string& actor_id,
+                                                  const ActorMesh& mesh) {
   if (auto ok = mesh.validate(); !ok) return fail("actor " + actor_id + ": " + ok.error().message);
   auto it = actors_.find(actor_id);
   if (it == actors_.end())
-    it =
-        actors_.emplace(actor_id, Actor{{}, {}, 0, MotionTracker(options_.motion), {}, 0, 0}).first;
+    it = actors_.emplace(actor_id, Actor(MotionTracker(options_.motion))).first;
   Actor& a = it->second;
   if (!a.mesh.vertices.empty() && mesh.capture_ns <= a.mesh.capture_ns)
     return fail("actor " + actor_id + ": mesh capture time not after the previous mesh's");
+  return &a;
+}
+
+Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t frame,
+                                     ActorMesh mesh) {
+  auto accepted = accept(actor_id, mesh);
+  if (!accepted) return std::unexpected(accepted.error());
+  Actor& a = **accepted;
   using Clock = std::chrono::steady_clock;
   // The two per-mesh stages read the mesh only and share nothing else: with parallel_mesh_work
   // the simplification runs on a thread of its own while this one fits the motion, so a mesh
@@ -74,14 +81,9 @@ Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t 
 
 Expected<void> MaskPlanner::latch_mesh(const std::string& actor_id, std::uint64_t frame,
                                        ActorMesh mesh) {
-  if (auto ok = mesh.validate(); !ok) return fail("actor " + actor_id + ": " + ok.error().message);
-  auto it = actors_.find(actor_id);
-  if (it == actors_.end())
-    it =
-        actors_.emplace(actor_id, Actor{{}, {}, 0, MotionTracker(options_.motion), {}, 0, 0}).first;
-  Actor& a = it->second;
-  if (!a.mesh.vertices.empty() && mesh.capture_ns <= a.mesh.capture_ns)
-    return fail("actor " + actor_id + ": mesh capture time not after the previous mesh's");
+  auto accepted = accept(actor_id, mesh);
+  if (!accepted) return std::unexpected(accepted.error());
+  Actor& a = **accepted;
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   auto base = simplify_for_mask(mesh, options_.grow);

@@ -43,6 +43,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -120,6 +121,7 @@ class MaskPlanner {
 
  private:
   struct Actor {
+    explicit Actor(MotionTracker t) : tracker(std::move(t)) {}
     ActorMesh mesh;
     MaskBase base;  // mesh, simplified for the mask (same vertices)
     std::uint64_t frame = 0;
@@ -136,6 +138,9 @@ class MaskPlanner {
     std::vector<Eigen::Vector3f> latched;
     double latched_age_s = 0;  // the latched velocity's age at the mesh's capture
   };
+  // The actor a new mesh is for (created on its first mesh), once the mesh is valid and captured
+  // after that actor's current one: the checks set_mesh() and latch_mesh() share.
+  Expected<Actor*> accept(const std::string& actor_id, const ActorMesh& mesh);
   MaskPlannerOptions options_;
   std::map<std::string, Actor> actors_;
   LatencyWindow latencies_;
