@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "testing/raster.h"
 #include "testing/truth.h"
 
 namespace studio::offline::testing {
@@ -60,49 +61,21 @@ std::vector<SurfaceSample> truth_surface(const sim::ActorBody& body, const Camer
 
 std::vector<SurfaceSample> mesh_surface(const hull::Mesh& mesh, const Camera& camera, int ss) {
   const Camera fine = fine_camera(camera, ss);
-  const int W = fine.width, H = fine.height;
-  std::vector<SurfaceSample> out(std::size_t(W) * H);
-  std::vector<float> zbuf(std::size_t(W) * H, std::numeric_limits<float>::infinity());
-  std::vector<Eigen::Vector2d> p(mesh.vertices.size());
-  std::vector<double> z(mesh.vertices.size());
-  std::vector<uint8_t> ok(mesh.vertices.size());
-  for (std::size_t n = 0; n < mesh.vertices.size(); ++n) {
-    const Eigen::Vector3d x = mesh.vertices[n].cast<double>();
-    z[n] = (fine.cam_from_world * x).z();
-    ok[n] = fine.project(x, &p[n]);
-  }
-  for (const auto& t : mesh.triangles) {
-    if (!ok[t[0]] || !ok[t[1]] || !ok[t[2]]) continue;
-    const Eigen::Vector2d a = p[t[0]], b = p[t[1]], c = p[t[2]];
-    const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-    if (std::abs(area) < 1e-12) continue;
-    const int x0 = std::max(0, int(std::ceil(std::min({a.x(), b.x(), c.x()}))));
-    const int x1 = std::min(W - 1, int(std::floor(std::max({a.x(), b.x(), c.x()}))));
-    const int y0 = std::max(0, int(std::ceil(std::min({a.y(), b.y(), c.y()}))));
-    const int y1 = std::min(H - 1, int(std::floor(std::max({a.y(), b.y(), c.y()}))));
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const Eigen::Vector2d q(x, y);
-        const double l0 = ((c - b).x() * (q - b).y() - (c - b).y() * (q - b).x()) / area;
-        const double l1 = ((a - c).x() * (q - c).y() - (a - c).y() * (q - c).x()) / area;
-        const double l2 = 1 - l0 - l1;
-        if (l0 < 0 || l1 < 0 || l2 < 0) continue;
-        const double w0 = l0 / z[t[0]], w1 = l1 / z[t[1]], w2 = l2 / z[t[2]], ws = w0 + w1 + w2;
-        const float depth = float(1 / ws);
-        float& zb = zbuf[std::size_t(y) * W + x];
-        if (depth >= zb) continue;
-        zb = depth;
-        SurfaceSample& s = out[std::size_t(y) * W + x];
-        s.x = (w0 * mesh.vertices[t[0]].cast<double>() + w1 * mesh.vertices[t[1]].cast<double>() +
-               w2 * mesh.vertices[t[2]].cast<double>()) /
-              ws;
-        const Eigen::Vector3d n = w0 * mesh.normals[t[0]].cast<double>() +
-                                  w1 * mesh.normals[t[1]].cast<double>() +
-                                  w2 * mesh.normals[t[2]].cast<double>();
-        s.n = n.squaredNorm() > 0 ? n.normalized() : Eigen::Vector3d::Zero();
-        s.hit = true;
-      }
-  }
+  std::vector<SurfaceSample> out(std::size_t(fine.width) * fine.height);
+  raster_fragments(mesh, fine,
+                   [&](int x, int y, const std::array<uint32_t, 3>& t, double w0, double w1,
+                       double w2, double ws) {
+                     SurfaceSample& s = out[std::size_t(y) * fine.width + x];
+                     s.x = (w0 * mesh.vertices[t[0]].cast<double>() +
+                            w1 * mesh.vertices[t[1]].cast<double>() +
+                            w2 * mesh.vertices[t[2]].cast<double>()) /
+                           ws;
+                     const Eigen::Vector3d n = w0 * mesh.normals[t[0]].cast<double>() +
+                                               w1 * mesh.normals[t[1]].cast<double>() +
+                                               w2 * mesh.normals[t[2]].cast<double>();
+                     s.n = n.squaredNorm() > 0 ? n.normalized() : Eigen::Vector3d::Zero();
+                     s.hit = true;
+                   });
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "keyer/keyer.h"
+#include "testing/raster.h"
 
 namespace studio::offline::testing {
 namespace {
@@ -239,47 +240,19 @@ Image<Rgb8> raster(const hull::Mesh& mesh, const std::vector<Eigen::Vector3f>& c
   const int W = camera.width, H = camera.height;
   Image<Rgb8> out(W, H);
   covered->assign(std::size_t(W) * H, 0);
-  std::vector<float> zbuf(std::size_t(W) * H, std::numeric_limits<float>::infinity());
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) out.view().row(y)[x] = background;
-  std::vector<Eigen::Vector2d> p(mesh.vertices.size());
-  std::vector<double> z(mesh.vertices.size());
-  std::vector<uint8_t> ok(mesh.vertices.size());
-  for (std::size_t n = 0; n < mesh.vertices.size(); ++n) {
-    const Eigen::Vector3d x = mesh.vertices[n].cast<double>();
-    z[n] = (camera.cam_from_world * x).z();
-    ok[n] = camera.project(x, &p[n]);
-  }
-  for (const auto& t : mesh.triangles) {
-    if (!ok[t[0]] || !ok[t[1]] || !ok[t[2]]) continue;
-    const Eigen::Vector2d a = p[t[0]], b = p[t[1]], c = p[t[2]];
-    const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-    if (std::abs(area) < 1e-12) continue;
-    const int x0 = std::max(0, int(std::ceil(std::min({a.x(), b.x(), c.x()}))));
-    const int x1 = std::min(W - 1, int(std::floor(std::max({a.x(), b.x(), c.x()}))));
-    const int y0 = std::max(0, int(std::ceil(std::min({a.y(), b.y(), c.y()}))));
-    const int y1 = std::min(H - 1, int(std::floor(std::max({a.y(), b.y(), c.y()}))));
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const Eigen::Vector2d q(x, y);
-        const double l0 = ((c - b).x() * (q - b).y() - (c - b).y() * (q - b).x()) / area;
-        const double l1 = ((a - c).x() * (q - c).y() - (a - c).y() * (q - c).x()) / area;
-        const double l2 = 1 - l0 - l1;
-        if (l0 < 0 || l1 < 0 || l2 < 0) continue;
-        // Perspective-correct interpolation (1/z).
-        const double w0 = l0 / z[t[0]], w1 = l1 / z[t[1]], w2 = l2 / z[t[2]], ws = w0 + w1 + w2;
-        const float depth = float(1 / ws);
-        float& zb = zbuf[std::size_t(y) * W + x];
-        if (depth >= zb) continue;
-        zb = depth;
+  raster_fragments(
+      mesh, camera,
+      [&](int x, int y, const std::array<uint32_t, 3>& t, double w0, double w1, double w2,
+          double ws) {
         (*covered)[std::size_t(y) * W + x] = 1;
         const Eigen::Vector3f col =
             (float(w0) * colours[t[0]] + float(w1) * colours[t[1]] + float(w2) * colours[t[2]]) /
             float(ws);
         auto q8 = [](float v) { return uint8_t(std::clamp(v + 0.5f, 0.0f, 255.0f)); };
         out.view().row(y)[x] = Rgb8{q8(col.x()), q8(col.y()), q8(col.z())};
-      }
-  }
+      });
   return out;
 }
 
