@@ -296,9 +296,9 @@ def write_markdown(r, path):
              "|---|---|---|---|---|---|---|---|")
     exits = r.get("services_exit_status") or {}
     for s in r.get("per_service") or []:
-        name = s["instance"] if s["service"] == "capture" else s["service"]
-        if s["service"] == "keyer":
-            name = s["instance"]
+        # demo.sh names capture servers, keyers and projectors by instance (cam0, keyer0, proj1),
+        # the single services by service (hull, tracker, scene, preview).
+        name = s["instance"] if s["service"] in ("capture", "keyer", "projector") else s["service"]
         L.append(f"| {s['service']}:{s['instance']} | {s['pid']} | {s['state']} | "
                  f"{fmt(s.get('rate_hz'))} | {fmt(s.get('delivered_hz'))} | {fmt(s.get('cpu_percent'))} | {fmt(s.get('rss_mb'))} | "
                  f"{exits.get(name, '?')} |")
