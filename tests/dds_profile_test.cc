@@ -1,5 +1,6 @@
 // The DDS profiles of deploy/dds: the production profile parses and carries masks through its
-// own multicast group (network partition) between two processes; both profiles are exercised on
+// own multicast group (network partition) between two processes, and every bulk topic's reader
+// announces its own group; both profiles are exercised on
 // the loopback interface only (the production interface line is swapped for lo).
 
 #include <gtest/gtest.h>
@@ -85,9 +86,24 @@ TEST_F(DdsProfileTest, StudioProfileRoutesMasksThroughTheirPartitionBetweenProce
   const std::string masks = subscription_of("studio/camera/mask");
   ASSERT_FALSE(masks.empty()) << "no mask reader in the peer's trace";
   EXPECT_NE(masks.find("multicast_locator={udp/239.255.42.1:"), std::string::npos) << masks;
-  const std::string calib = subscription_of("studio/camera/calibration");
-  ASSERT_FALSE(calib.empty());
-  EXPECT_EQ(calib.find("239.255.42.1"), std::string::npos) << calib;
+  // Every bulk topic's reader announces its partition's group (a host joins it only for its
+  // readers); the small topics stay on the default group.
+  const std::pair<const char*, const char*> bulk[] = {
+      {"studio/actor/mesh", "239.255.42.2"},        {"studio/actor/segments", "239.255.42.3"},
+      {"studio/camera/image", "239.255.42.4"},      {"studio/camera/image_reply", "239.255.42.4"},
+      {"studio/projector/frame", "239.255.42.5"},   {"studio/projector/mask", "239.255.42.5"}};
+  for (const auto& [topic, group] : bulk) {
+    const std::string sub = subscription_of(topic);
+    ASSERT_FALSE(sub.empty()) << "no " << topic << " reader in the peer's trace";
+    EXPECT_NE(sub.find(std::string("multicast_locator={udp/") + group + ":"), std::string::npos)
+        << topic << ": " << sub;
+  }
+  for (const char* topic : {"studio/camera/calibration", "studio/actor/head", "studio/scene/node",
+                            "studio/service/status"}) {
+    const std::string sub = subscription_of(topic);
+    ASSERT_FALSE(sub.empty()) << "no " << topic << " reader in the peer's trace";
+    EXPECT_EQ(sub.find("239.255.42."), std::string::npos) << topic << ": " << sub;
+  }
 }
 
 // The loopback profile (tests, the single-machine demo) sends data to the matched readers only:

@@ -7,7 +7,9 @@
 //    the bridge sees the masks of both capture hosts go to their own multicast group
 //    (239.255.42.1, the profile's network partition) once two processes read them (the hull and
 //    an operator's `studioctl topic hz`; for the hull alone Cyclone's cheaper path is one unicast
-//    copy), `studioctl status` on host 3 hears every
+//    copy), the hull's segments to theirs (239.255.42.3) once an operator on host 1 reads them
+//    beside the tracker, and nothing but discovery to the default group; `studioctl status` on
+//    host 3 hears every
 //    service of the three hosts and `studioctl topic hz` there measures the hull's segments;
 //    before the operator's set-up `studioctl doctor` on a host names each missing piece (no
 //    multicast route; socket buffers above net.core.rmem_max) and passes after it;
@@ -170,6 +172,16 @@ class MultiHost : public StudioTest {
     return rate;
   }
 
+  // Packets from src to dst on UDP port `port`, from tshark's lines.
+  static uint64_t packets_to_port(const std::string& log, const std::string& src,
+                                  const std::string& dst, int port) {
+    uint64_t n = 0;
+    std::stringstream s(log);
+    const std::string prefix = src + "\t" + dst + "\t" + std::to_string(port) + "\t";
+    for (std::string l; std::getline(s, l);) n += l.rfind(prefix, 0) == 0;
+    return n;
+  }
+
   std::string suffix_, hub_;
   uint64_t rmem_ = 0, wmem_ = 0;
   int runs_ = 0;
@@ -215,8 +227,23 @@ TEST_F(MultiHost, ProductionProfileMasksGoByMulticastAndTheHullRuns) {
       3, {"topic", "hz", "studio/camera/mask", "--json", "--count", "2", "--window", "2"});
   EXPECT_EQ(second.code, 0) << second.err;
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Bulk topics other than masks have their own groups too: an operator on host 1 watching the
+  // hull's segments (read on host 3 by the tracker) makes the hull multicast them, to the
+  // segments' group, not to the default group every participant of the domain joins.
+  auto seg = studioctl_on(
+      1, {"topic", "hz", "studio/actor/segments", "--json", "--count", "2", "--window", "2"});
+  EXPECT_EQ(seg.code, 0) << seg.err;
   tshark.stop();
   f = flows(tshark.log());
+  const Flow s3 = f[{"10.77.0.3", "239.255.42.3"}], d3 = f[{"10.77.0.3", "239.255.0.1"}];
+  EXPECT_GE(s3.packets, 50u) << "segments of host 3 on the segments' group";
+  // The default group carries discovery (SPDP on port 7400 + 250 domain, RTPS d0) and, on the
+  // data port one above (d2), only Cyclone's few built-in messages (participant liveliness: 3
+  // packets in this window); the segments went there (103 packets in this window) before they
+  // had their own group.
+  const uint64_t data_on_default =
+      packets_to_port(tshark.log(), "10.77.0.3", "239.255.0.1", 7400 + 250 * dds_.domain_id + 1);
+  EXPECT_LT(data_on_default, 20u) << "host 3 sent user data to the default multicast group";
   const Flow m1 = f[{"10.77.0.1", "239.255.42.1"}], m2 = f[{"10.77.0.2", "239.255.42.1"}];
   // Two cameras per host at 25 fps while the second reader listens (> 2 s): >= 50 each.
   EXPECT_GE(m1.packets, 50u) << "masks of host 1 on the mask group";
@@ -231,10 +258,14 @@ TEST_F(MultiHost, ProductionProfileMasksGoByMulticastAndTheHullRuns) {
       "MULTIHOST production profile: hull alone: %llu unicast packets host 1 -> host 3; with "
       "a second mask reader (%.1f s): masks to 239.255.42.1 from host 1: %llu packets %llu "
       "bytes, host 2: %llu packets %llu bytes; unicast bytes from the capture hosts to the hull "
-      "host in all %llu; hull segments on host 3 %.1f Hz\n",
+      "host in all %llu; hull segments on host 3 %.1f Hz; an operator on host 1 reading them: "
+      "segments to 239.255.42.3 from host 3: %llu packets %llu bytes, to the default group "
+      "239.255.0.1: %llu packets %llu bytes (%llu of them data)\n",
       (unsigned long long)single.packets, secs, (unsigned long long)m1.packets,
       (unsigned long long)m1.bytes, (unsigned long long)m2.packets, (unsigned long long)m2.bytes,
-      (unsigned long long)unicast_to_3, rate);
+      (unsigned long long)unicast_to_3, rate, (unsigned long long)s3.packets,
+      (unsigned long long)s3.bytes, (unsigned long long)d3.packets, (unsigned long long)d3.bytes,
+      (unsigned long long)data_on_default);
 }
 
 TEST_F(MultiHost, UnicastProfileWorksWithoutMulticast) {
