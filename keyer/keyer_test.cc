@@ -8,6 +8,7 @@
 #include "../src/key_kernels.h"
 #include "core/mask_codec.h"
 #include "keyer/reference_keyer.h"
+#include "support/avx_state.h"
 #include "support/masks.h"
 #include "test_frames.h"
 
@@ -53,6 +54,33 @@ TEST(KeyKernels, SimdMatchesScalarOnEveryWidth) {
     scalar.diff(row.data(), plate.data(), w, lo, b.data());
     ASSERT_TRUE(std::equal(a.begin(), a.begin() + (w + 63) / 64, b.begin())) << "width " << w;
   }
+}
+
+// The row kernels return with the AVX upper state clean (the caller's legacy-SSE code would
+// otherwise pay a merge penalty on every instruction: 1.8x the capture server's simulator, issue
+// 20). GCC 12 drops the vzeroupper it owes before a tail call into non-AVX code; the kernels
+// clear it themselves. Control: the state is seen dirty right after dirtying it.
+TEST(KeyKernels, ReturnWithTheAvxUpperStateClean) {
+#if defined(__x86_64__)
+  if (!studio::testing::xinuse_readable()) GTEST_SKIP() << "no AVX / XGETBV(1) on this CPU";
+  const auto& best = detail::best_kernels();
+  std::vector<uint8_t> row(3 * 704, 40), plate(3 * 704, 30);
+  std::vector<uint64_t> bits(11);
+  const auto p = detail::make_chroma_params(2, 0, 1, 20);
+  for (int w : {704, 700, 31}) {  // a tail after the 32-pixel blocks, and none but a tail
+    studio::testing::dirty_avx_upper();
+    ASSERT_NE(studio::testing::xinuse() & studio::testing::kAvxUpperState, 0u) << "control";
+    studio::testing::clean_avx_upper();
+    best.chroma(row.data(), w, p, bits.data());
+    EXPECT_EQ(studio::testing::xinuse() & studio::testing::kAvxUpperState, 0u)
+        << best.name << " chroma, width " << w;
+    best.diff(row.data(), plate.data(), w, 10, bits.data());
+    EXPECT_EQ(studio::testing::xinuse() & studio::testing::kAvxUpperState, 0u)
+        << best.name << " diff, width " << w;
+  }
+#else
+  GTEST_SKIP() << "x86-64 only";
+#endif
 }
 
 TEST(KeyKernels, BitsToRunsMatchesPixels) {
