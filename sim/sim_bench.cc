@@ -17,7 +17,10 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <ctime>
+#include <thread>
 #include <vector>
 
 #include "sim/cameras.h"
@@ -130,6 +133,156 @@ void BM_CameraFrameBySegment(benchmark::State& state) {
 }
 BENCHMARK(BM_CameraFrameBySegment)->ArgName("demo_frames")->Arg(0)->Arg(1)->Iterations(2)->Unit(
     benchmark::kMillisecond);
+
+// Cost by the studio clock's time (issue 20: why the demo's capture servers cost twice the other
+// cases here). In the `sequence` motion the actor walks 5 s of every 16 s loop round a 0.8 m
+// circle (5.59 s per lap) and does the turn, the raised hand and the crouch where the walk
+// stopped, a spot that moves back by 0.66 rad per loop: one turn of it takes 152.8 s. So the
+// distance from the actor to each ring camera, hence its size on the image, depends on the wall
+// clock over ~150 s, and a 30-60 s demo sees a part of that cycle. Each ring camera as its own
+// one-camera studio (a capture server), every 5th frame of 160 s of the clock from
+// $SIM_BENCH_CLOCK_FROM (unix seconds; default 1'795'000'000, 2026-11-18, a loop start), split
+// in 16 windows of 10 s. Counters: wNN = thread CPU ms per 6-camera frame in window NN, aNN =
+// mean actor pixels (true mask) per camera frame in it (thousands); mean / min / max over windows.
+void BM_CamerasOverClock(benchmark::State& state) {
+  int64_t from_s = 1'795'000'000;
+  if (const char* env = std::getenv("SIM_BENCH_CLOCK_FROM")) from_s = std::atoll(env);
+  std::vector<SimulatedStudio> studios;
+  for (const Camera& c : ring_cameras()) {
+    StudioOptions o;
+    o.threads = 1;
+    studios.push_back(SimulatedStudio::create({c}, o).value());
+  }
+  constexpr int kWindows = 16, kStep = 5;
+  constexpr int64_t kWindowFrames = 250;  // 10 s at 25 fps
+  double cpu[kWindows] = {}, area[kWindows] = {};
+  int64_t n[kWindows] = {};
+  for (auto _ : state) {
+    for (int w = 0; w < kWindows; ++w) {
+      for (int64_t k = 0; k < kWindowFrames; k += kStep) {
+        const int64_t f = from_s * 25 + w * kWindowFrames + k;
+        for (const SimulatedStudio& studio : studios) {
+          Image<Rgb8> image;
+          Mask mask;
+          const double t0 = thread_cpu();
+          studio.render(0, f, &image, &mask);
+          cpu[w] += thread_cpu() - t0;
+          long px = 0;
+          for (uint8_t m : mask.pixels()) px += m != 0;
+          area[w] += double(px);
+          benchmark::DoNotOptimize(image.data());
+        }
+        ++n[w];  // one 6-camera frame
+      }
+    }
+  }
+  double lo = 1e300, hi = 0, sum = 0;
+  for (int w = 0; w < kWindows; ++w) {
+    const double ms = 1e3 * cpu[w] / double(n[w]);
+    char name[8];
+    std::snprintf(name, sizeof name, "w%02d", w);
+    state.counters[name] = ms;
+    std::snprintf(name, sizeof name, "a%02d", w);
+    state.counters[name] = area[w] / double(n[w]) / double(studios.size()) / 1e3;
+    lo = std::min(lo, ms);
+    hi = std::max(hi, ms);
+    sum += ms;
+  }
+  state.counters["mean"] = sum / kWindows;
+  state.counters["min"] = lo;
+  state.counters["max"] = hi;
+}
+BENCHMARK(BM_CamerasOverClock)->Iterations(1)->Unit(benchmark::kSecond);
+
+// Does idling between frames make a render dearer? The six ring cameras (one-camera studios) of
+// the same 25 frames rendered back to back (`busy_ms`) and paced as in the demo: one 6-camera
+// round, then asleep until the next 40 ms tick (`paced_ms`), blocks alternating so that load hits
+// both alike; thread CPU ms per 6-camera frame and `paced_over_busy`.
+void BM_CamerasPacedVsBusy(benchmark::State& state) {
+  std::vector<SimulatedStudio> studios;
+  for (const Camera& c : ring_cameras()) {
+    StudioOptions o;
+    o.threads = 1;
+    studios.push_back(SimulatedStudio::create({c}, o).value());
+  }
+  const int64_t base = int64_t{1'795'000'000} * 25;
+  double cpu[2] = {};
+  int64_t n[2] = {};
+  auto round = [&](int64_t f, int mode) {
+    for (const SimulatedStudio& studio : studios) {
+      Image<Rgb8> image;
+      const double t0 = thread_cpu();
+      studio.render(0, f, &image, nullptr);
+      cpu[mode] += thread_cpu() - t0;
+      benchmark::DoNotOptimize(image.data());
+    }
+    ++n[mode];
+  };
+  for (auto _ : state) {
+    for (int block = 0; block < 8; ++block) {
+      for (int64_t k = 0; k < 25; ++k) round(base + block * 25 + k, 0);
+      auto tick = std::chrono::steady_clock::now();
+      for (int64_t k = 0; k < 25; ++k) {
+        round(base + block * 25 + k, 1);
+        tick += std::chrono::milliseconds(40);
+        std::this_thread::sleep_until(tick);
+      }
+    }
+  }
+  state.counters["busy_ms"] = 1e3 * cpu[0] / double(n[0]);
+  state.counters["paced_ms"] = 1e3 * cpu[1] / double(n[1]);
+  state.counters["paced_over_busy"] = (cpu[1] / double(n[1])) / (cpu[0] / double(n[0]));
+}
+BENCHMARK(BM_CamerasPacedVsBusy)->Iterations(1)->Unit(benchmark::kSecond);
+
+// A render right after code that leaves the AVX upper state dirty (256-bit AVX without
+// vzeroupper, as the capture server's in-process keyer did) against one right after a
+// vzeroupper, both on every frame (which goes first alternates), on the six ring cameras
+// (one-camera studios): thread CPU ms per camera frame and `dirty_over_clean`. The renderer
+// clears the state at its entry (sim/src/clean_upper.h), so the ratio is ~1; without that it
+// was ~2 on this machine (BENCHMARKS.md, "Simulated studio").
+__attribute__((noinline)) void set_avx_upper(bool dirty) {
+#if defined(__x86_64__)
+  if (!__builtin_cpu_supports("avx")) return;
+  if (dirty)
+    asm volatile("vpcmpeqd %%ymm15, %%ymm15, %%ymm15" ::: "xmm15");
+  else
+    asm volatile("vzeroupper" ::: "xmm0", "xmm1", "xmm2", "xmm3", "xmm4", "xmm5", "xmm6", "xmm7",
+                 "xmm8", "xmm9", "xmm10", "xmm11", "xmm12", "xmm13", "xmm14", "xmm15");
+#else
+  (void)dirty;
+#endif
+}
+void BM_RenderAfterDirtyUpper(benchmark::State& state) {
+  std::vector<SimulatedStudio> studios;
+  for (const Camera& c : ring_cameras()) {
+    StudioOptions o;
+    o.threads = 1;
+    studios.push_back(SimulatedStudio::create({c}, o).value());
+  }
+  const int64_t base = int64_t{1'795'000'000} * 25;
+  double cpu[2] = {};
+  int64_t n[2] = {}, frame = 0;
+  for (auto _ : state) {
+    for (const SimulatedStudio& studio : studios) {
+      for (int k = 0; k < 2; ++k) {
+        const int dirty = k ^ static_cast<int>(frame & 1);  // which goes first alternates
+        Image<Rgb8> image;
+        set_avx_upper(dirty != 0);
+        const double t0 = thread_cpu();
+        studio.render(0, base + frame, &image, nullptr);
+        cpu[dirty] += thread_cpu() - t0;
+        ++n[dirty];
+        benchmark::DoNotOptimize(image.data());
+      }
+    }
+    ++frame;
+  }
+  state.counters["clean_ms"] = 1e3 * cpu[0] / double(n[0]);
+  state.counters["dirty_ms"] = 1e3 * cpu[1] / double(n[1]);
+  state.counters["dirty_over_clean"] = (cpu[1] / double(n[1])) / (cpu[0] / double(n[0]));
+}
+BENCHMARK(BM_RenderAfterDirtyUpper)->Unit(benchmark::kMillisecond)->MinTime(3);
 
 // The naive renderer: per pixel, the world ray against every part; single thread.
 void naive_frame(const SimulatedStudio& studio, int64_t frame, std::vector<Image<Rgb8>>* images,

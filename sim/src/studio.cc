@@ -14,6 +14,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "clean_upper.h"
 #include "projector_light_impl.h"
 #include "studio_impl.h"
 
@@ -487,12 +488,14 @@ FrameTruth SimulatedStudio::truth(int64_t frame) const {
 
 void SimulatedStudio::render(int camera, int64_t frame, Image<Rgb8>* image, Mask* true_mask,
                              Image<uint8_t>* true_matte) const {
+  detail::clean_avx_upper_state();  // clean_upper.h: legacy SSE at full speed
   impl_->render(camera, impl_->prepare(frame), image, true_mask, true_matte);
 }
 
 FrameTruth SimulatedStudio::render_all(int64_t frame, std::vector<Image<Rgb8>>* images,
                                        std::vector<Mask>* true_masks,
                                        std::vector<Image<uint8_t>>* true_mattes) const {
+  detail::clean_avx_upper_state();  // clean_upper.h (worker threads start clean)
   const detail::PreparedFrame f = impl_->prepare(frame);
   const int n = camera_count();
   if (images) images->resize(n);
