@@ -7,36 +7,18 @@
 
 #include <cstdint>
 
-#if defined(__x86_64__)
-#include <cpuid.h>
-#endif
-
 #include "sim/cameras.h"
 #include "sim/studio.h"
+#include "support/avx_state.h"
 
 namespace studio::sim {
 namespace {
 
 #if defined(__x86_64__)
-constexpr uint64_t kUpperState = (1u << 2) | (1u << 6);
-
-bool xinuse_readable() {
-  unsigned a, b, c, d;
-  if (!__get_cpuid(1, &a, &b, &c, &d) || !(c & bit_OSXSAVE) || !(c & bit_AVX)) return false;
-  if (!__get_cpuid_count(0xD, 1, &a, &b, &c, &d)) return false;
-  return (a & (1u << 2)) != 0;  // XGETBV with ECX = 1
-}
-
-__attribute__((noinline)) uint64_t xinuse() {
-  uint32_t lo, hi;
-  asm volatile("xgetbv" : "=a"(lo), "=d"(hi) : "c"(1));
-  return (uint64_t(hi) << 32) | lo;
-}
-
-// Leaves the YMM upper halves dirty, as a 256-bit AVX routine returning without vzeroupper does.
-__attribute__((noinline)) void dirty_upper() {
-  asm volatile("vpcmpeqd %%ymm15, %%ymm15, %%ymm15" ::: "xmm15");
-}
+using studio::testing::dirty_avx_upper;
+using studio::testing::kAvxUpperState;
+using studio::testing::xinuse;
+using studio::testing::xinuse_readable;
 #endif
 
 TEST(SimAvxState, RenderClearsDirtyUpperState) {
@@ -59,20 +41,20 @@ TEST(SimAvxState, RenderClearsDirtyUpperState) {
   Mask mask;
   studio->render(0, 5, &image, &mask);  // warm: first-call allocations, tables
 
-  dirty_upper();
+  dirty_avx_upper();
   const uint64_t before = xinuse();
-  EXPECT_NE(before & kUpperState, 0u) << "control: the state was not dirty (XINUSE " << before << ")";
-  dirty_upper();
+  EXPECT_NE(before & kAvxUpperState, 0u) << "control: the state was not dirty (XINUSE " << before << ")";
+  dirty_avx_upper();
   studio->render(0, 6, &image, &mask);
   const uint64_t after_render = xinuse();
-  EXPECT_EQ(after_render & kUpperState, 0u) << "render() ran with dirty upper state";
+  EXPECT_EQ(after_render & kAvxUpperState, 0u) << "render() ran with dirty upper state";
 
   std::vector<Image<Rgb8>> images;
   std::vector<Mask> masks;
-  dirty_upper();
+  dirty_avx_upper();
   studio->render_all(7, &images, &masks);
   const uint64_t after_all = xinuse();
-  EXPECT_EQ(after_all & kUpperState, 0u) << "render_all() ran with dirty upper state";
+  EXPECT_EQ(after_all & kAvxUpperState, 0u) << "render_all() ran with dirty upper state";
 #else
   GTEST_SKIP() << "x86-64 only";
 #endif

@@ -25,6 +25,7 @@
 
 #include "sim/cameras.h"
 #include "sim/studio.h"
+#include "support/avx_state.h"
 
 namespace studio::sim {
 namespace {
@@ -241,14 +242,13 @@ BENCHMARK(BM_CamerasPacedVsBusy)->Iterations(1)->Unit(benchmark::kSecond);
 // (one-camera studios): thread CPU ms per camera frame and `dirty_over_clean`. The renderer
 // clears the state at its entry (sim/src/clean_upper.h), so the ratio is ~1; without that it
 // was ~2 on this machine (BENCHMARKS.md, "Simulated studio").
-__attribute__((noinline)) void set_avx_upper(bool dirty) {
+void set_avx_upper(bool dirty) {
 #if defined(__x86_64__)
   if (!__builtin_cpu_supports("avx")) return;
   if (dirty)
-    asm volatile("vpcmpeqd %%ymm15, %%ymm15, %%ymm15" ::: "xmm15");
+    studio::testing::dirty_avx_upper();
   else
-    asm volatile("vzeroupper" ::: "xmm0", "xmm1", "xmm2", "xmm3", "xmm4", "xmm5", "xmm6", "xmm7",
-                 "xmm8", "xmm9", "xmm10", "xmm11", "xmm12", "xmm13", "xmm14", "xmm15");
+    studio::testing::clean_avx_upper();
 #else
   (void)dirty;
 #endif
