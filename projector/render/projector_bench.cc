@@ -44,6 +44,7 @@
 #include "scene_render/egl_context.h"
 #include "scene_render/render_target.h"
 #include "sim/actor.h"
+#include "testing/hull_meshes.h"
 #include "testing/projectors.h"
 
 using namespace studio;
@@ -266,6 +267,43 @@ void BM_SinglePassCached_720p(benchmark::State& s) { run(s, Work::single_pass_ca
 void BM_SinglePassCacheMiss_720p(benchmark::State& s) {
   run(s, Work::single_pass_cache_miss, true);
 }
+// The mask of a live-like hull mesh (the arm swing's, testing/hull_meshes.h, ~38k triangles)
+// simplified by GrowOptions max_triangles (arg 0) and cluster_factor (arg 1), as the late-latched
+// node draws it per frame at 720p: grown by 3 cm (+ the simplification's error), drawn over the
+// scene prepared ahead (outside the timing), finished and read back. Counters: triangles drawn,
+// the simplification's error (added to the margin) and the pixels blacked out.
+void BM_HullMask_720p(benchmark::State& state) {
+  Fixture& f = fixture();
+  static const projector::ActorMesh hull =
+      projector::testing::hull_meshes(sim::Motion::arm_swing, 60, 1).front();
+  auto view = projector::ProjectorView::create(at_720p(f.projector));
+  auto fr = FrameRenderer::create(*view, {});
+  if (!fr) {
+    state.SkipWithError(fr.error().message.c_str());
+    return;
+  }
+  for (const auto& [p, a] : f.cache.all()) (void)fr->renderer().upload(*a);
+  projector::GrowOptions o;
+  o.max_triangles = std::size_t(state.range(0));
+  o.cluster_factor = std::size_t(state.range(1));
+  const projector::MaskBase base = projector::simplify_for_mask(hull, o).value();
+  Readback rb;
+  std::vector<projector::ActorMesh> masks(1);
+  for (auto _ : state) {
+    state.PauseTiming();
+    if (!fr->prepare(f.scene, kEye)) state.SkipWithError("prepare failed");
+    glFinish();
+    state.ResumeTiming();
+    masks[0] = projector::grow_mask(base, 0.03, o).value();
+    fr->draw_masks(masks);
+    glFinish();
+    fr->read(rb);
+  }
+  state.counters["triangles_drawn"] = double(base.mesh.triangles.size());
+  state.counters["error_mm"] = base.error_m * 1e3;
+  state.counters["blackout_px"] = double(rb.blackout.area());
+}
+
 #define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(2.0)
 BENCHMARK(BM_Clear) OPTS;
 BENCHMARK(BM_GrowMask) OPTS;
@@ -284,6 +322,7 @@ BENCHMARK(BM_SinglePassReadback_720p) OPTS;
 BENCHMARK(BM_LateLatch_720p) OPTS;
 BENCHMARK(BM_SinglePassCached_720p) OPTS;
 BENCHMARK(BM_SinglePassCacheMiss_720p) OPTS;
+BENCHMARK(BM_HullMask_720p)->Args({3000, 4})->Args({12000, 1})->Args({8000, 1}) OPTS;
 }  // namespace
 
 BENCHMARK_MAIN();
