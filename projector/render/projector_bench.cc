@@ -27,6 +27,10 @@
 // after the mesh (scene + mask + finish + read-back). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
 // overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame),
 // from_cache (cached cases: the fraction of frames whose static layer came from the cache).
+// `TwoPass_720p` / `TwoPassHalfEye_720p`: the two pass at 1280x720 with the eye texture at its
+// suggested size and at half of it each side (FrameRendererOptions::eye_texture_scale 0.5: a
+// quarter of the scene's fragments; baseline `SinglePass_720p`). `HullMask_720p`: the mask of the
+// hull's own mesh per simplification setting (after BM_HullMask_720p below).
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -102,6 +106,7 @@ enum class Work {
   single_pass_cached,
   single_pass_cache_miss,
   two_pass_cached,
+  two_pass_half_eye,
   late_latch
 };
 
@@ -139,6 +144,7 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
   auto view = projector::ProjectorView::create(projector);
   FrameRendererOptions fo;
   const bool two_pass = work == Work::two_pass || work == Work::two_pass_full_warp ||
+                        work == Work::two_pass_half_eye ||
                         work == Work::two_pass_cached;
   const bool layered = work == Work::single_pass_cached || work == Work::single_pass_cache_miss ||
                        work == Work::two_pass_cached;
@@ -146,6 +152,7 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
   const double pixels = double(projector.camera.width) * projector.camera.height;
   fo.form = two_pass ? Form::two_pass : Form::single_pass;
   fo.warp_screen_only = work != Work::two_pass_full_warp;
+  if (work == Work::two_pass_half_eye) fo.eye_texture_size = view->suggested_texture_size() / 2;
   if (work == Work::single_pass_bilinear)
     fo.renderer.texture_filter = scene_render::RendererOptions::TextureFilter::bilinear;
   auto fr = FrameRenderer::create(*view, fo);
@@ -264,6 +271,8 @@ void BM_SinglePassReadback_720p(benchmark::State& s) {
 }
 void BM_LateLatch_720p(benchmark::State& s) { run(s, Work::late_latch, true); }
 void BM_SinglePassCached_720p(benchmark::State& s) { run(s, Work::single_pass_cached, true); }
+void BM_TwoPass_720p(benchmark::State& s) { run(s, Work::two_pass, true); }
+void BM_TwoPassHalfEye_720p(benchmark::State& s) { run(s, Work::two_pass_half_eye, true); }
 void BM_SinglePassCacheMiss_720p(benchmark::State& s) {
   run(s, Work::single_pass_cache_miss, true);
 }
@@ -322,6 +331,8 @@ BENCHMARK(BM_SinglePassReadback_720p) OPTS;
 BENCHMARK(BM_LateLatch_720p) OPTS;
 BENCHMARK(BM_SinglePassCached_720p) OPTS;
 BENCHMARK(BM_SinglePassCacheMiss_720p) OPTS;
+BENCHMARK(BM_TwoPass_720p) OPTS;
+BENCHMARK(BM_TwoPassHalfEye_720p) OPTS;
 BENCHMARK(BM_HullMask_720p)->Args({3000, 4})->Args({12000, 1})->Args({8000, 1}) OPTS;
 }  // namespace
 
