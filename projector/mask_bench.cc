@@ -10,11 +10,14 @@
 //                                  (set_mesh + plan), before and after
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <string>
 
 #include "projector/mask_geometry.h"
 #include "projector/mask_planner.h"
 #include "projector/motion.h"
+#include "projector/velocity_field.h"
+#include "testing/hull_meshes.h"
 #include "testing/swing_meshes.h"
 
 using namespace studio;
@@ -50,9 +53,11 @@ BENCHMARK(BM_FrameMask_SimplifyPerFrame)->Unit(benchmark::kMillisecond)->MinTime
 
 void BM_FrameMask_SimplifiedOnce(benchmark::State& state) {
   const auto base = projector::simplify_for_mask(swing_meshes()[2]).value();
+  std::vector<Eigen::Vector3f> velocities;  // the motion's, per vertex of the simplified mesh
+  for (uint32_t i : base.source) velocities.push_back(motion().velocity(i));
   for (auto _ : state) {
-    auto moved = projector::predict(base.mesh, motion(), 0.06);
-    auto grown = projector::grow_mask({std::move(*moved), base.error_m}, kMargin);
+    auto moved = projector::predict_by_velocities(base.mesh, velocities, 0.06);
+    auto grown = projector::grow_mask({std::move(*moved), base.error_m, {}}, kMargin);
     benchmark::DoNotOptimize(grown);
   }
   state.counters["triangles_drawn"] = double(base.mesh.triangles.size());
@@ -134,6 +139,47 @@ void BM_MeshAndFrame(benchmark::State& state) {
   state.SetLabel(old ? "old: simplify per frame" : "new: simplify per mesh");
 }
 BENCHMARK(BM_MeshAndFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(2);
+
+// The mask's simplification per mesh (simplify_for_mask) on the hull's own meshes of the arm
+// swing (testing/hull_meshes.h, ~35-40k triangles as live), by GrowOptions: args max_triangles,
+// cluster_factor (presimplify on). Counters: the triangles drawn, the error added to the margin
+// (error_mm, the mean over meshes) and the largest.
+void BM_SimplifyHull(benchmark::State& state) {
+  static const std::vector<projector::ActorMesh> meshes =
+      projector::testing::hull_meshes(sim::Motion::arm_swing, 50, 8);
+  projector::GrowOptions o;
+  o.max_triangles = std::size_t(state.range(0));
+  o.cluster_factor = std::size_t(state.range(1));
+  std::size_t k = 0;
+  double error = 0, worst = 0, drawn = 0, in = 0;
+  for (auto _ : state) {
+    const projector::ActorMesh& mesh = meshes[k++ % meshes.size()];
+    auto base = projector::simplify_for_mask(mesh, o);
+    if (!base) {
+      state.SkipWithError(base.error().message.c_str());
+      break;
+    }
+    error += base->error_m;
+    worst = std::max(worst, base->error_m);
+    drawn += double(base->mesh.triangles.size());
+    in += double(mesh.triangles.size());
+  }
+  const double n = double(std::max<std::size_t>(k, 1));
+  state.counters["error_mm"] = 1e3 * error / n;
+  state.counters["worst_error_mm"] = 1e3 * worst;
+  state.counters["triangles_drawn"] = drawn / n;
+  state.counters["triangles_in"] = in / n;
+}
+BENCHMARK(BM_SimplifyHull)
+    ->Args({3000, 4})
+    ->Args({3000, 2})
+    ->Args({3000, 1})
+    ->Args({6000, 1})
+    ->Args({8000, 1})
+    ->Args({12000, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1)
+    ->MeasureProcessCPUTime();
 
 }  // namespace
 

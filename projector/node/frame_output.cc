@@ -24,6 +24,7 @@ Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeO
   projector_render::FrameRendererOptions fo;
   fo.form = options.form;
   fo.eye_texture_size = {options.eye_texture[0], options.eye_texture[1]};
+  fo.eye_texture_scale = options.eye_texture_scale;
   fo.thumb_width = options.thumbnail[0];
   fo.thumb_height = options.thumbnail[1];
   fo.scene_cache = options.scene_cache;

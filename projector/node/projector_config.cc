@@ -18,6 +18,8 @@ Expected<void> ProjectorNodeOptions::validate() const {
   if (output == OutputKind::window && monitor.empty())
     return fail("monitor: a name (or primary) for output: window");
   if (frame_every < 0) return fail("frame_every: >= 0");
+  if (!(eye_texture_scale >= 0.1 && eye_texture_scale <= 1))
+    return fail("eye_texture_scale: 0.1..1");
   if (!(display_lag_s >= 0 && display_lag_s <= 1)) return fail("display_lag: 0..1 seconds");
   if (!(head_timeout_s > 0)) return fail("head_timeout: > 0 seconds");
   if (auto ok = scene_cache.validate(); !ok) return ok;
@@ -63,6 +65,10 @@ runtime::ServiceDefinition projector_service_definition() {
       "                            the xrandr output, e.g. HDMI-1) or primary; an unknown name\n"
       "                            fails at start listing the connected monitors\n"
       "    eye_texture: [0, 0]     two_pass eye texture size; 0 0 = one texel per projector pixel\n"
+      "                            on the screen, x eye_texture_scale\n"
+      "    eye_texture_scale: 1    two_pass, eye_texture 0 0: each side of the suggested size x\n"
+      "                            this (0.1..1; 0.5: the scene shaded on a quarter of the\n"
+      "                            texels, the warp magnifies 2x)\n"
       "    default_eye: [0, 1.7, 2]  eye (studio frame, m) until the actor's head arrives\n"
       "    display_lag: 0.016      seconds from a rendered frame to its light on the cloth (the\n"
       "                            projector's input lag): masks are predicted to that instant\n"
@@ -174,6 +180,7 @@ runtime::ServiceDefinition projector_service_definition() {
                          {{"headless", OutputKind::headless}, {"window", OutputKind::window}}),
         yaml::field("monitor", &ProjectorNodeOptions::monitor),
         yaml::field("eye_texture", &ProjectorNodeOptions::eye_texture).size(2),
+        yaml::field("eye_texture_scale", &ProjectorNodeOptions::eye_texture_scale).range(0.1, 1),
         yaml::field("default_eye", &ProjectorNodeOptions::default_eye).size(3),
         yaml::field("display_lag", &ProjectorNodeOptions::display_lag_s).range(0, 1),
         yaml::field("head_timeout", &ProjectorNodeOptions::head_timeout_s).min(0.01),

@@ -50,7 +50,8 @@ struct ProjectorNodeOptions {
   projector_render::Form form = projector_render::Form::single_pass;
   OutputKind output = OutputKind::headless;  // window: full screen on `monitor` (window_output.h)
   std::string monitor = "primary";
-  std::vector<int> eye_texture{0, 0};            // two pass: eye texture size, 0 0 = suggested
+  std::vector<int> eye_texture{0, 0};  // two pass: eye texture size, 0 0 = suggested
+  double eye_texture_scale = 1.0;      // two pass, eye_texture 0 0: the suggested size x this
   std::vector<double> default_eye{0, 1.7, 2.0};  // eye until a head pose arrives, studio frame
   // Render done -> the frame on the cloth (the projector's input lag and scan-out): the mask is
   // predicted to, and the margin covers, the display instant, not the render's end.

@@ -29,6 +29,8 @@ Expected<void> FrameRendererOptions::validate() const {
   if (eye_texture_size.x() < 0 || eye_texture_size.y() < 0 || eye_texture_size.x() > 8192 ||
       eye_texture_size.y() > 8192 || (eye_texture_size.x() == 0) != (eye_texture_size.y() == 0))
     return fail("eye_texture: both sides 1..8192, or both 0 (suggested size)");
+  if (!(eye_texture_scale >= 0.1 && eye_texture_scale <= 1))
+    return fail("eye_texture_scale: 0.1..1");
   if (thumb_width < 0 || thumb_height < 0 || thumb_width > 1024 || thumb_height > 1024 ||
       (thumb_width == 0) != (thumb_height == 0))
     return fail("thumbnail: both sides 1..1024, or both 0 (none)");
@@ -130,7 +132,13 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
   std::optional<scene_render::RenderTarget> eye_target;
   if (options.form == Form::two_pass) {
     Eigen::Vector2i size = options.eye_texture_size;
-    if (size.x() == 0) size = view.suggested_texture_size().cwiseMin(8192).cwiseMax(16);
+    if (size.x() == 0)
+      size = (view.suggested_texture_size().cast<double>() * options.eye_texture_scale)
+                 .array()
+                 .ceil()
+                 .cast<int>()
+                 .min(8192)
+                 .max(16);
     auto t = scene_render::RenderTarget::create(size.x(), size.y());
     if (!t) return std::unexpected(t.error());
     eye_target.emplace(std::move(*t));

@@ -188,10 +188,33 @@ TEST(FrameRenderer, TheActorSeesWhatAPlainPerspectiveRenderShows) {
 
   // Full render, and with the scene cache on: the static layer cached from an eye 0.36 mm away
   // (under the bound) and restored.
-  for (auto [form, cached] : {std::pair{Form::single_pass, false}, {Form::two_pass, false},
-                              {Form::single_pass, true}, {Form::two_pass, true}}) {
+  // Two pass also with the eye texture at half its suggested size (a quarter of the fragments),
+  // for this 1920x1080 projector and the same at 1280x720 (the demo's size: fewer texels still).
+  struct Case {
+    Form form;
+    bool cached;
+    double scale;
+    bool hd720;
+  };
+  for (auto [form, cached, scale, hd720] :
+       {Case{Form::single_pass, false, 1, false}, Case{Form::two_pass, false, 1, false},
+        Case{Form::single_pass, true, 1, false}, Case{Form::two_pass, true, 1, false},
+        Case{Form::two_pass, false, 0.5, false}, Case{Form::single_pass, false, 1, true},
+        Case{Form::two_pass, false, 0.5, true}}) {
     FrameRendererOptions fo;
     fo.form = form;
+    fo.eye_texture_scale = scale;
+    Projector q = p;
+    if (hd720) {  // the intrinsics scaled about the pixel-centre convention
+      const double k = 1280.0 / q.camera.width;
+      q.camera.width = 1280;
+      q.camera.height = 720;
+      q.camera.intrinsics.fx *= k;
+      q.camera.intrinsics.fy *= k;
+      q.camera.intrinsics.cx = (q.camera.intrinsics.cx + 0.5) * k - 0.5;
+      q.camera.intrinsics.cy = (q.camera.intrinsics.cy + 0.5) * k - 0.5;
+    }
+    const projector::ProjectorView view = projector::ProjectorView::create(q).value();
     auto fr = FrameRenderer::create(view, fo);
     ASSERT_TRUE(fr) << fr.error().message;
     for (const auto& [path, a] : cache.all()) ASSERT_TRUE(fr->renderer().upload(*a));
@@ -225,7 +248,7 @@ TEST(FrameRenderer, TheActorSeesWhatAPlainPerspectiveRenderShows) {
                      t = (*X - p.screen[0]).dot(e1) / e1.squaredNorm();
         if (s < 0.02 || s > 0.98 || t < 0.02 || t > 0.98) continue;  // the cloth, off its edges
         Eigen::Vector2d px;
-        if (!p.camera.project(*X, &px)) continue;
+        if (!q.camera.project(*X, &px)) continue;
         map_x.at<float>(y, x) = float(px.x());
         map_y.at<float>(y, x) = float(px.y());
         cloth.at<uchar>(y, x) = 255;
@@ -242,10 +265,10 @@ TEST(FrameRenderer, TheActorSeesWhatAPlainPerspectiveRenderShows) {
     const double mse =
         cv::mean(diff, cloth)[0] / 3 + cv::mean(diff, cloth)[1] / 3 + cv::mean(diff, cloth)[2] / 3;
     const double psnr = 10 * std::log10(255.0 * 255.0 / std::max(mse, 1e-12));
-    std::printf("%s%s: PSNR over the cloth %.1f dB (%d px)\n",
+    std::printf("%dx%d %s%s, eye texture x %.2f: PSNR over the cloth %.1f dB (%d px)\n",
+                q.camera.width, q.camera.height,
                 form == Form::single_pass ? "single pass" : "two pass",
-                cached ? ", from the scene cache" : "", psnr,
-                cv::countNonZero(cloth));
+                cached ? ", from the scene cache" : "", scale, psnr, cv::countNonZero(cloth));
     EXPECT_GE(psnr, 30.0);
   }
 }

@@ -27,6 +27,10 @@
 // after the mesh (scene + mask + finish + read-back). Counters: shaded_per_px (fragments past the depth test in one frame / pixels: the
 // overdraw llvmpipe shades; 1.0 = once per pixel), triangles (submitted in the last frame),
 // from_cache (cached cases: the fraction of frames whose static layer came from the cache).
+// `TwoPass_720p` / `TwoPassHalfEye_720p`: the two pass at 1280x720 with the eye texture at its
+// suggested size and at half of it each side (FrameRendererOptions::eye_texture_scale 0.5: a
+// quarter of the scene's fragments; baseline `SinglePass_720p`). `HullMask_720p`: the mask of the
+// hull's own mesh per simplification setting (after BM_HullMask_720p below).
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -44,6 +48,7 @@
 #include "scene_render/egl_context.h"
 #include "scene_render/render_target.h"
 #include "sim/actor.h"
+#include "testing/hull_meshes.h"
 #include "testing/projectors.h"
 
 using namespace studio;
@@ -101,6 +106,7 @@ enum class Work {
   single_pass_cached,
   single_pass_cache_miss,
   two_pass_cached,
+  two_pass_half_eye,
   late_latch
 };
 
@@ -138,6 +144,7 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
   auto view = projector::ProjectorView::create(projector);
   FrameRendererOptions fo;
   const bool two_pass = work == Work::two_pass || work == Work::two_pass_full_warp ||
+                        work == Work::two_pass_half_eye ||
                         work == Work::two_pass_cached;
   const bool layered = work == Work::single_pass_cached || work == Work::single_pass_cache_miss ||
                        work == Work::two_pass_cached;
@@ -145,6 +152,7 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
   const double pixels = double(projector.camera.width) * projector.camera.height;
   fo.form = two_pass ? Form::two_pass : Form::single_pass;
   fo.warp_screen_only = work != Work::two_pass_full_warp;
+  if (work == Work::two_pass_half_eye) fo.eye_texture_size = view->suggested_texture_size() / 2;
   if (work == Work::single_pass_bilinear)
     fo.renderer.texture_filter = scene_render::RendererOptions::TextureFilter::bilinear;
   auto fr = FrameRenderer::create(*view, fo);
@@ -263,9 +271,49 @@ void BM_SinglePassReadback_720p(benchmark::State& s) {
 }
 void BM_LateLatch_720p(benchmark::State& s) { run(s, Work::late_latch, true); }
 void BM_SinglePassCached_720p(benchmark::State& s) { run(s, Work::single_pass_cached, true); }
+void BM_TwoPass_720p(benchmark::State& s) { run(s, Work::two_pass, true); }
+void BM_TwoPassHalfEye_720p(benchmark::State& s) { run(s, Work::two_pass_half_eye, true); }
 void BM_SinglePassCacheMiss_720p(benchmark::State& s) {
   run(s, Work::single_pass_cache_miss, true);
 }
+// The mask of a live-like hull mesh (the arm swing's, testing/hull_meshes.h, ~38k triangles)
+// simplified by GrowOptions max_triangles (arg 0) and cluster_factor (arg 1), as the late-latched
+// node draws it per frame at 720p: grown by arg 2 mm (+ the simplification's error; 200: the
+// margin's cap, where a starved projector's margin sits), drawn over the
+// scene prepared ahead (outside the timing), finished and read back. Counters: triangles drawn,
+// the simplification's error (added to the margin) and the pixels blacked out.
+void BM_HullMask_720p(benchmark::State& state) {
+  Fixture& f = fixture();
+  static const projector::ActorMesh hull =
+      projector::testing::hull_meshes(sim::Motion::arm_swing, 60, 1).front();
+  auto view = projector::ProjectorView::create(at_720p(f.projector));
+  auto fr = FrameRenderer::create(*view, {});
+  if (!fr) {
+    state.SkipWithError(fr.error().message.c_str());
+    return;
+  }
+  for (const auto& [p, a] : f.cache.all()) (void)fr->renderer().upload(*a);
+  projector::GrowOptions o;
+  o.max_triangles = std::size_t(state.range(0));
+  o.cluster_factor = std::size_t(state.range(1));
+  const projector::MaskBase base = projector::simplify_for_mask(hull, o).value();
+  Readback rb;
+  std::vector<projector::ActorMesh> masks(1);
+  for (auto _ : state) {
+    state.PauseTiming();
+    if (!fr->prepare(f.scene, kEye)) state.SkipWithError("prepare failed");
+    glFinish();
+    state.ResumeTiming();
+    masks[0] = projector::grow_mask(base, 1e-3 * double(state.range(2)), o).value();
+    fr->draw_masks(masks);
+    glFinish();
+    fr->read(rb);
+  }
+  state.counters["triangles_drawn"] = double(base.mesh.triangles.size());
+  state.counters["error_mm"] = base.error_m * 1e3;
+  state.counters["blackout_px"] = double(rb.blackout.area());
+}
+
 #define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(2.0)
 BENCHMARK(BM_Clear) OPTS;
 BENCHMARK(BM_GrowMask) OPTS;
@@ -284,6 +332,14 @@ BENCHMARK(BM_SinglePassReadback_720p) OPTS;
 BENCHMARK(BM_LateLatch_720p) OPTS;
 BENCHMARK(BM_SinglePassCached_720p) OPTS;
 BENCHMARK(BM_SinglePassCacheMiss_720p) OPTS;
+BENCHMARK(BM_TwoPass_720p) OPTS;
+BENCHMARK(BM_TwoPassHalfEye_720p) OPTS;
+BENCHMARK(BM_HullMask_720p)
+    ->Args({3000, 4, 30})
+    ->Args({12000, 1, 30})
+    ->Args({8000, 1, 30})
+    ->Args({3000, 4, 100})
+    ->Args({3000, 4, 200}) OPTS;
 }  // namespace
 
 BENCHMARK_MAIN();

@@ -19,6 +19,15 @@ Expected<void> MaskPlannerOptions::validate() const {
   return {};
 }
 
+namespace {
+// The fitted motion's velocity at each vertex of the simplified mask mesh (its input vertex's).
+std::vector<Eigen::Vector3f> velocities_at(const MaskBase& base, const MeshMotion& motion) {
+  std::vector<Eigen::Vector3f> v(base.source.size());
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = motion.velocity(base.source[i]);
+  return v;
+}
+}  // namespace
+
 MaskPlanner::MaskPlanner(MaskPlannerOptions options)
     : options_(std::move(options)),
       latencies_(options_.latency_window, options_.latency_quantile),
@@ -72,6 +81,7 @@ Expected<void> MaskPlanner::set_mesh(const std::string& actor_id, std::uint64_t 
   if (a.motion) a.known_speed_mps = a.motion->max_speed_mps;
   a.mesh = std::move(mesh);
   a.base = std::move(**base);
+  a.fitted = a.motion ? velocities_at(a.base, *a.motion) : std::vector<Eigen::Vector3f>{};
   a.frame = frame;
   a.pending = false;
   a.latched.clear();
@@ -102,6 +112,7 @@ Expected<void> MaskPlanner::latch_mesh(const std::string& actor_id, std::uint64_
     }
   }
   a.motion.reset();  // this mesh's own motion: after fit_pending()
+  a.fitted.clear();
   a.mesh = std::move(mesh);
   a.base = std::move(*base);
   a.frame = frame;
@@ -127,6 +138,7 @@ int MaskPlanner::fit_pending() {
     a.field_motion.reset();
     if (!m || !*m) continue;  // refused or no estimate (first mesh, gap): not predicted
     a.motion = std::move(**m);
+    a.fitted = velocities_at(a.base, *a.motion);
     a.known_speed_mps = a.motion->max_speed_mps;
     a.latched.clear();  // the mesh's own motion from now on
     if (auto f = VelocityField::create(a.mesh, *a.motion, options_.motion.region_size_m)) {
@@ -192,15 +204,14 @@ Expected<MaskPlan> MaskPlanner::plan(std::int64_t display_ns) const {
     const MaskBase* base = &a.base;
     MaskBase moved;
     // Each actor moved forward when its own margin relies on the prediction; the margin drawn
-    // is the largest, which covers every actor's own. The simplified mesh keeps the mesh's
-    // vertices, so the motion (per vertex of the mesh) moves it as it would the mesh.
+    // is the largest, which covers every actor's own. The simplified mesh's vertices are the
+    // mesh's (MaskBase::source), so the motion moves them as it would the mesh.
     const bool latched = !a.motion && !a.latched.empty() && a.field_motion;
     if (predicted[k++] && (a.motion || latched)) {
       const double horizon = std::clamp((display_ns - a.mesh.capture_ns) * 1e-9, 0.0, 1.0);
-      auto p = a.motion ? predict(a.base.mesh, *a.motion, horizon)
-                        : predict_by_velocities(a.base.mesh, a.latched, horizon);
+      auto p = predict_by_velocities(a.base.mesh, a.motion ? a.fitted : a.latched, horizon);
       if (p) {
-        moved = {std::move(*p), a.base.error_m};
+        moved = {std::move(*p), a.base.error_m, {}};
         base = &moved;
       }
     }

@@ -16,6 +16,8 @@
 //   frame (conservative: the radius of the nearest part, applied everywhere).
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "core/camera.h"
 #include "core/error.h"
@@ -31,14 +33,20 @@ struct GrowOptions {
   std::size_t max_triangles = 3000;
   double max_error = 0.01;
   double error_safety = 1.5;
-  // A mesh of more than 4 x max_triangles is first clustered to about that many by
+  // A mesh of more than cluster_factor x max_triangles is first clustered to about that many by
   // meshoptimizer's sloppy simplifier (vertex clustering on a grid: the vertices kept are
   // original ones), then edge-collapsed to max_triangles; both stages' errors add up (x
-  // error_safety) in the push. On the demo's hull meshes (89k triangles, 25 frames): 7.9 instead
-  // of 32.6 ms CPU per mesh, error 2.6 instead of 1.7 cm, and silhouettes from 6 views at a
-  // 1 cm margin left 0 pixels of the mesh uncovered (the edge collapse alone: 15 of 4.4 M).
-  // false: the edge collapse alone on the whole mesh.
+  // error_safety) in the push. On the demo's hull meshes (89k triangles, 25 frames), clustered
+  // to 4 x: 7.9 instead of 32.6 ms CPU per mesh, error 2.6 instead of 1.7 cm, and silhouettes
+  // from 6 views at a 1 cm margin left 0 pixels of the mesh uncovered (the edge collapse alone:
+  // 15 of 4.4 M). false: the edge collapse alone on the whole mesh.
   bool presimplify = true;
+  // The clustering's target, x max_triangles (>= 1; 1: the edge collapse runs only when the
+  // clustering stopped above max_triangles). 2 was measured and not taken: 3.6 instead of 4.9 ms
+  // CPU per hull mesh (projector_mask_bench BM_SimplifyHull), but a fatter mask on the
+  // tessellated swing (test TwoStageSimplification...: 178-226 points 5 cm out inside it, not
+  // 148-152).
+  std::size_t cluster_factor = 4;
 };
 
 // Errors: invalid mesh, negative or non-finite margin. = grow_mask(simplify_for_mask(mesh)).
@@ -47,13 +55,14 @@ Expected<ActorMesh> grow_mesh(const ActorMesh& mesh, double margin_m,
 
 // The two halves of grow_mesh(), so a caller that grows one mesh for many frames (the projector:
 // a mesh per 40 ms, frames in between, each predicted to its own display instant) simplifies it
-// once. MaskBase::mesh keeps every vertex of the input (unused ones included: a motion estimated
-// per input vertex still applies, projector/motion.h predict()) and at most max_triangles
-// triangles; error_m is how far its surface may lie from the input's (the simplifier's error x
-// error_safety), which grow_mask() adds to the margin.
+// once. MaskBase::mesh holds at most max_triangles triangles and only the vertices they use
+// (input vertices, not moved; source[i] is vertex i's index in the input, so a motion estimated
+// per input vertex applies: velocities_at()); error_m is how far its surface may lie from the
+// input's (the simplifier's error x error_safety), which grow_mask() adds to the margin.
 struct MaskBase {
   ActorMesh mesh;
   double error_m = 0;
+  std::vector<uint32_t> source;  // per vertex of mesh: its index in the input mesh
 };
 // Errors: invalid mesh or options.
 Expected<MaskBase> simplify_for_mask(const ActorMesh& mesh, const GrowOptions& options = {});

@@ -123,10 +123,11 @@ class MaskPlanner {
   struct Actor {
     explicit Actor(MotionTracker t) : tracker(std::move(t)) {}
     ActorMesh mesh;
-    MaskBase base;  // mesh, simplified for the mask (same vertices)
+    MaskBase base;  // mesh, simplified for the mask (a subset of its vertices)
     std::uint64_t frame = 0;
     MotionTracker tracker;
     std::optional<MeshMotion> motion;
+    std::vector<Eigen::Vector3f> fitted;  // motion's velocity per vertex of base.mesh
     double head_speed_mps = 0;
     double known_speed_mps = 0;  // the fastest region of the last motion estimated (kept)
     // Late latching: the mesh awaits its fit; the field of the last fit and that fit's motion

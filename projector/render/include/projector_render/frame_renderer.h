@@ -41,8 +41,11 @@ enum class Form { single_pass, two_pass };
 
 struct FrameRendererOptions {
   Form form = Form::single_pass;
-  // Two-pass eye texture size; 0 x 0: ProjectorView::suggested_texture_size().
+  // Two-pass eye texture size; 0 x 0: ProjectorView::suggested_texture_size() x
+  // eye_texture_scale (each side; 1: one texel per projector pixel on the screen). The scene is
+  // shaded per texel: 0.5 shades a quarter of the fragments, the warp then magnifies 2x.
   Eigen::Vector2i eye_texture_size = Eigen::Vector2i::Zero();
+  double eye_texture_scale = 1.0;  // (0.1 .. 1]
   projector::OffAxisOptions off_axis;
   // The scene renderer's options; the projector samples textures at the nearest texel (within
   // 42 dB PSNR of bilinear on the default scene, a sixth less CPU per frame on llvmpipe).
