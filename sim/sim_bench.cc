@@ -100,6 +100,18 @@ void BM_CaptureCameraFastVsReference(benchmark::State& state) {
 }
 BENCHMARK(BM_CaptureCameraFastVsReference)->Unit(benchmark::kMillisecond)->MinTime(3);
 
+// The six ring cameras as six one-camera studios rendering on one thread each (a capture
+// server's work).
+std::vector<SimulatedStudio> one_camera_studios() {
+  std::vector<SimulatedStudio> studios;
+  for (const Camera& c : ring_cameras()) {
+    StudioOptions o;
+    o.threads = 1;
+    studios.push_back(SimulatedStudio::create({c}, o).value());
+  }
+  return studios;
+}
+
 // Cost by pose: each camera of the ring as its own one-camera studio (as a capture server has
 // it), frames every 3rd of one 16 s loop of the `sequence` motion, the thread CPU per camera
 // frame summed per segment (walk 0-5 s, turn 5-8, raise hand 8-12, crouch 12-16). Arg 0: frames
@@ -107,12 +119,7 @@ BENCHMARK(BM_CaptureCameraFastVsReference)->Unit(benchmark::kMillisecond)->MinTi
 // start), the studio clock's frame numbers in the demo. Counters: walk, turn, raise, crouch (ms).
 void BM_CameraFrameBySegment(benchmark::State& state) {
   const int64_t base = state.range(0) ? int64_t{1'795'000'000} * 25 : 0;
-  std::vector<SimulatedStudio> studios;
-  for (const Camera& c : ring_cameras()) {
-    StudioOptions o;
-    o.threads = 1;
-    studios.push_back(SimulatedStudio::create({c}, o).value());
-  }
+  const std::vector<SimulatedStudio> studios = one_camera_studios();
   double cpu[4] = {};
   int64_t n[4] = {};
   for (auto _ : state) {
@@ -148,12 +155,7 @@ BENCHMARK(BM_CameraFrameBySegment)->ArgName("demo_frames")->Arg(0)->Arg(1)->Iter
 void BM_CamerasOverClock(benchmark::State& state) {
   int64_t from_s = 1'795'000'000;
   if (const char* env = std::getenv("SIM_BENCH_CLOCK_FROM")) from_s = std::atoll(env);
-  std::vector<SimulatedStudio> studios;
-  for (const Camera& c : ring_cameras()) {
-    StudioOptions o;
-    o.threads = 1;
-    studios.push_back(SimulatedStudio::create({c}, o).value());
-  }
+  const std::vector<SimulatedStudio> studios = one_camera_studios();
   constexpr int kWindows = 16, kStep = 5;
   constexpr int64_t kWindowFrames = 250;  // 10 s at 25 fps
   double cpu[kWindows] = {}, area[kWindows] = {};
@@ -200,12 +202,7 @@ BENCHMARK(BM_CamerasOverClock)->Iterations(1)->Unit(benchmark::kSecond);
 // round, then asleep until the next 40 ms tick (`paced_ms`), blocks alternating so that load hits
 // both alike; thread CPU ms per 6-camera frame and `paced_over_busy`.
 void BM_CamerasPacedVsBusy(benchmark::State& state) {
-  std::vector<SimulatedStudio> studios;
-  for (const Camera& c : ring_cameras()) {
-    StudioOptions o;
-    o.threads = 1;
-    studios.push_back(SimulatedStudio::create({c}, o).value());
-  }
+  const std::vector<SimulatedStudio> studios = one_camera_studios();
   const int64_t base = int64_t{1'795'000'000} * 25;
   double cpu[2] = {};
   int64_t n[2] = {};
@@ -254,12 +251,7 @@ void set_avx_upper(bool dirty) {
 #endif
 }
 void BM_RenderAfterDirtyUpper(benchmark::State& state) {
-  std::vector<SimulatedStudio> studios;
-  for (const Camera& c : ring_cameras()) {
-    StudioOptions o;
-    o.threads = 1;
-    studios.push_back(SimulatedStudio::create({c}, o).value());
-  }
+  const std::vector<SimulatedStudio> studios = one_camera_studios();
   const int64_t base = int64_t{1'795'000'000} * 25;
   double cpu[2] = {};
   int64_t n[2] = {}, frame = 0;
