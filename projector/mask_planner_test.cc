@@ -130,6 +130,7 @@ TEST(MaskPlanner, LatchedMeshUsesThePreviousFitUntilItsOwnIsFitted) {
 TEST(MaskPlanner, StaleMeshIsCoveredForItsAge) {
   MaskPlannerOptions o;
   o.margin.prediction = false;
+  o.margin.worst_case_acceleration = false;  // v L alone: the age is what this checks
   o.margin.cap_m = 1.0;
   MaskPlanner planner(o);
   for (int k = 0; k < 3; ++k)
@@ -158,7 +159,8 @@ TEST(MaskPlanner, StaleMeshIsCoveredForItsAge) {
 }
 
 // After a gap (no motion estimate for the new mesh) the actor is not taken as still: the margin
-// covers its last known speed over the latency.
+// covers its last known speed over the latency, and (the default worst case) an acceleration
+// during it.
 TEST(MaskPlanner, MeshAfterAGapKeepsTheLastKnownSpeed) {
   MaskPlannerOptions o;
   o.margin.cap_m = 1.0;
@@ -171,7 +173,8 @@ TEST(MaskPlanner, MeshAfterAGapKeepsTheLastKnownSpeed) {
   ASSERT_TRUE(plan);
   EXPECT_FALSE(plan->margin.predicted);
   EXPECT_NEAR(plan->margin.speed_mps, 1.0, 0.1);
-  EXPECT_NEAR(plan->margin.margin_m, o.margin.floor_m + 0.1, 0.015);  // 1 m/s over 0.1 s
+  // 1 m/s over 0.1 s, and 15 m/s^2 over it: 0.1 + 0.075.
+  EXPECT_NEAR(plan->margin.margin_m, o.margin.floor_m + 0.1 + 0.5 * 15 * 0.01, 0.015);
 }
 
 TEST(MaskPlanner, RefusedMeshKeepsThePreviousAndLatencyComesFromShownFrames) {

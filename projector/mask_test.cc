@@ -98,6 +98,18 @@ TEST(MaskMargin, DefaultAssumesTheWorstCaseAccelerationWhateverTheEstimate) {
   EXPECT_EQ(m->acceleration_mps2, 15.0);
   EXPECT_NEAR(m->margin_m, 0.01 + 0.5 * 15 * 0.04 * 0.08 + 0.05 * 0.04, 1e-12);
   EXPECT_TRUE(security_margin(o, 0.15, 0.0, &still)->capped);
+  // Without prediction (no motion known: the first mesh, after a gap) the same worst case: an
+  // actor still at the capture may be moving at the display: v L + a L^2 / 2, not v L alone.
+  m = security_margin(o, 0.06, 0.0, nullptr);
+  ASSERT_TRUE(m);
+  EXPECT_FALSE(m->predicted);
+  EXPECT_NEAR(m->margin_m, 0.01 + 0.5 * 15 * 0.06 * 0.06, 1e-12);
+  m = security_margin(o, 0.06, 1.0, nullptr);
+  ASSERT_TRUE(m);
+  EXPECT_NEAR(m->margin_m, 0.01 + 1.0 * 0.06 + 0.5 * 15 * 0.06 * 0.06, 1e-12);
+  MarginOptions estimate = o;  // the estimate mode keeps v L
+  estimate.worst_case_acceleration = false;
+  EXPECT_NEAR(security_margin(estimate, 0.06, 1.0, nullptr)->margin_m, 0.01 + 0.06, 1e-12);
   // Control: with the estimate, the still actor gets the floor and the velocity term only.
   MarginOptions estimate = o;
   estimate.worst_case_acceleration = false;

@@ -45,7 +45,13 @@ Expected<Margin> security_margin(const MarginOptions& options, double latency_s,
     m.motion_m = 0.5 * m.acceleration_mps2 * latency_s * (latency_s + 2 * m.velocity_age_s) +
                  options.velocity_uncertainty_mps * latency_s;
   } else {
+    // The mask stays where the mesh was: v L; and, in the worst case, an actor that accelerates
+    // during the latency (at rest at the capture, moving at the display) adds a L^2 / 2.
     m.motion_m = m.speed_mps * latency_s;
+    if (options.worst_case_acceleration) {
+      m.acceleration_mps2 = options.max_acceleration_mps2;
+      m.motion_m += 0.5 * m.acceleration_mps2 * latency_s * latency_s;
+    }
   }
   m.margin_m = options.floor_m + m.motion_m;
   if (m.margin_m > options.cap_m) {

@@ -7,8 +7,11 @@
 // high quantile of a sliding window (LatencyWindow), so the margin covers the slow frames too.
 //
 // margin = clamp(floor + motion_term, floor, cap), with
-//   no prediction:    motion_term = v L
-//       v = max(|head velocity|, fastest mesh region) (projector/motion.h)
+//   no prediction:    motion_term = v L + a L^2 / 2
+//       v = max(|head velocity|, fastest mesh region) (projector/motion.h); a = the worst case
+//       max_acceleration_mps2 (the default, below: an actor may start moving during the latency;
+//       without it a fallback to this term, the first mesh, a mesh after a gap or one whose
+//       velocities are too old, covered an actor at rest only by the floor), 0 in estimate mode
 //   with prediction:  motion_term = a L (L + dt) / 2 + sigma_v L
 //       The mesh is moved forward by its regions' mean velocity over the last two captures
 //       (dt apart, the velocity at t - dt/2). For a region with constant acceleration a, the true
