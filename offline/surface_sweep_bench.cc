@@ -1,5 +1,8 @@
 // Development sweep (not a test): surface-stage variants on simulated poses, scored against the
 // truth. Usage: offline_surface_sweep "variant;variant;..." where a variant is key=value,...
+// (steps, lambda, rim, band, anchor, hull, order, fromhull, photo = photo-term iterations).
+// Environment: GRID (columns, 256), POSES (indices into the list below, e.g. 34),
+// COSTUME=patterned (the actor in sim's patterned costume instead of plain clothing).
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -70,6 +73,8 @@ int main(int argc, char** argv) {
     sim::StudioOptions so;
     so.actor.motion = poses[i].motion;
     so.actor.seed = poses[i].seed;
+    so.patterned_costume =
+        std::getenv("COSTUME") && std::string(std::getenv("COSTUME")) == "patterned";
     auto studio = sim::SimulatedStudio::create(sim::ring_cameras(ring), so).value();
     Prepared& p = prep[i];
     p.f = testing::render_frame(studio, poses[i].frame);
@@ -121,6 +126,8 @@ int main(int argc, char** argv) {
         o.shape_order = int(v);
       else if (k == "fromhull")
         from_hull = v != 0;
+      else if (k == "photo")
+        o.iterations = int(v);
       else {
         std::fprintf(stderr, "unknown key %s\n", k.c_str());
         return 1;

@@ -188,6 +188,74 @@ TEST(SimStudio, ShadowDarkensTheFloorNearTheFeetOnly) {
   EXPECT_LT(darker, 40000) << "a shadow, not a dark floor";
 }
 
+// The patterned costume (StudioOptions::patterned_costume) is on the clothing's surface: a surface
+// point seen by two cameras is darkened by the same factor in both (against the plain costume),
+// the clothing varies, the skin (head) keeps its colour, the true mask is the plain one's.
+TEST(SimStudio, PatternedCostumeIsTheSameOnTheSurfaceFromEveryCamera) {
+  StudioOptions plain;
+  plain.noise_sigma = 0;
+  plain.antialias = false;
+  StudioOptions patterned = plain;
+  patterned.patterned_costume = true;
+  const SimulatedStudio a = make(plain), b = make(patterned);
+  const int64_t frame = 30;
+  const FrameTruth truth = a.truth(frame);
+  const int n = a.camera_count();
+  std::vector<Image<Rgb8>> ia(n), ib(n);
+  std::vector<Mask> ma(n), mb(n);
+  for (int c = 0; c < n; ++c) {
+    a.render(c, frame, &ia[c], &ma[c]);
+    b.render(c, frame, &ib[c], &mb[c]);
+    EXPECT_TRUE(std::equal(ma[c].data(), ma[c].data() + std::size_t(ma[c].width()) * ma[c].height(),
+                           mb[c].data()))
+        << c;
+  }
+  // Displayed patterned / plain (green: the least spill and ring light), at a pixel.
+  auto ratio = [&](int c, int u, int v) { return double(ib[c](u, v).g) / double(ia[c](u, v).g); };
+  std::mt19937_64 rng(7);
+  int pairs = 0, skin = 0, skin_same = 0;
+  double worst = 0, lo = 1, hi = 0;
+  for (int tries = 0; tries < 200000 && pairs < 300; ++tries) {
+    const int c0 = int(rng() % n), c1 = (c0 + 1) % n;
+    const Camera& k0 = a.cameras()[c0];
+    const Camera& k1 = a.cameras()[c1];
+    const int u = int(rng() % k0.width), v = int(rng() % k0.height);
+    if (!interior(ma[c0], u, v, 255) || ia[c0](u, v).g < 40) continue;
+    const auto hit = truth.body.ray_hit(k0.centre_in_world(),
+                                        k0.pixel_ray_in_world(Eigen::Vector2d(u, v)));
+    if (!hit) continue;
+    const bool is_skin = truth.body.parts[hit->part].id == PartId::head;
+    if (is_skin) {
+      ++skin;
+      skin_same += ratio(c0, u, v) == 1.0;
+      continue;
+    }
+    Eigen::Vector2d px;
+    if (!k1.project(hit->point, &px)) continue;
+    const int u1 = int(std::lround(px.x())), v1 = int(std::lround(px.y()));
+    if (u1 < 2 || v1 < 2 || u1 >= k1.width - 2 || v1 >= k1.height - 2) continue;
+    if (!interior(ma[c1], u1, v1, 255) || ia[c1](u1, v1).g < 40) continue;
+    // Seen by both (nothing nearer on camera 1's ray), facing both: the same surface point up to
+    // half a pixel.
+    const auto hit1 = truth.body.ray_hit(k1.centre_in_world(),
+                                         k1.pixel_ray_in_world(Eigen::Vector2d(u1, v1)));
+    if (!hit1 || (hit1->point - hit->point).norm() > 0.004) continue;
+    const double r0 = ratio(c0, u, v), r1 = ratio(c1, u1, v1);
+    worst = std::max(worst, std::abs(r0 - r1));
+    lo = std::min(lo, r0), hi = std::max(hi, r0);
+    ++pairs;
+  }
+  std::printf("%d surface points seen by two cameras: patterned / plain %.2f .. %.2f, worst "
+              "difference between the cameras %.3f; head: %d of %d pixels unchanged\n",
+              pairs, lo, hi, worst, skin_same, skin);
+  ASSERT_GE(pairs, 100);
+  EXPECT_LT(worst, 0.08);           // the same surface point, the same factor
+  EXPECT_GT(hi - lo, 0.15);         // a pattern, not a uniform darkening
+  EXPECT_GT(lo, 0.6);               // within its range (0.6 .. 1, displayed: ^(1/2.2))
+  EXPECT_GT(skin, 0);
+  EXPECT_EQ(skin_same, skin);       // skin as before
+}
+
 TEST(SimStudio, SpillTintsActorEdgesBlue) {
   StudioOptions o;
   o.noise_sigma = 0;

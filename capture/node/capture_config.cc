@@ -39,7 +39,8 @@ const char kConfigHelp[] =
     "    - id: cam0\n"
     "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true,\n"
     "               frame_code: false, stamp: false, offset_us: 0, jitter_us: 0, drop_every: 0,\n"
-    "               readout_us: -1, motion: sequence, swing_peak_speed: 1.5}\n"
+    "               readout_us: -1, motion: sequence, swing_peak_speed: 1.5,\n"
+    "               costume: plain}\n"
     "                                    readout_us: exposure instant -> frame on the host (the\n"
     "                                    rest of the exposure, read-out, transfer); -1 (default):\n"
     "                                    a GigE camera's, half the exposure + 8 bits a pixel at\n"
@@ -51,6 +52,10 @@ const char kConfigHelp[] =
     "                                    stamp: frame number as a corner code in the pixels;\n"
     "                                    offset/jitter/drop_every: a real camera's imperfections\n"
     "                                    frame_code: the actor wears the frame number (preview tests)\n"
+    "                                    costume: plain (evenly coloured clothing) or patterned\n"
+    "                                    (a fixed pattern on the clothing's surface, the same from\n"
+    "                                    every camera: what photo-consistency needs to work on);\n"
+    "                                    every camera of a studio must give the same\n"
     "      source: {type: files, path: DIR, fps: 25, loop: false, paced: true}\n"
     "      source: {type: aravis, device: ID, pixel_format: BayerRG8, width: W, height: H,\n"
     "               fps: 25, trigger: free_run|software|line, line: Line0, buffers: 8,\n"
@@ -89,6 +94,7 @@ struct SimKeys {
   int ring = 6, index = 0, width = 704, height = 576;
   bool paced = true;
   bool frame_code = false;  // sim/frame_code.h
+  bool patterned_costume = false;  // sim::StudioOptions::patterned_costume
   bool stamp = false;
   double offset_us = 0, jitter_us = 0;
   double readout_us = -1;  // -1: a GigE camera's (see kUsage)
@@ -136,6 +142,14 @@ const yaml::Schema<SimKeys> kSim{
     yaml::field("height", &SimKeys::height).range(16, 8192),
     yaml::field("paced", &SimKeys::paced),
     yaml::field("frame_code", &SimKeys::frame_code),
+    yaml::field("costume", &SimKeys::patterned_costume,
+                [](const yaml::Node& n) -> Expected<bool> {
+                  auto s = n.as_string();
+                  if (!s) return std::unexpected(s.error());
+                  if (*s == "plain") return false;
+                  if (*s == "patterned") return true;
+                  return n.fail("costume: '" + *s + "' (expected plain or patterned)");
+                }),
     yaml::field("stamp", &SimKeys::stamp),
     yaml::field("offset_us", &SimKeys::offset_us).range(-5e5, 5e5),
     yaml::field("jitter_us", &SimKeys::jitter_us).range(0, 1e6),
@@ -256,6 +270,7 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
     SimSourceOptions so;
     so.paced = c.sim.paced;
     so.studio.frame_code = c.sim.frame_code;
+    so.studio.patterned_costume = c.sim.patterned_costume;
     so.studio.actor.motion = c.sim.motion;
     so.studio.actor.swing_peak_speed = c.sim.swing_peak_speed;
     so.stamp = c.sim.stamp;

@@ -126,6 +126,8 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
       {"cameras:\n  - id: a\n    source: {type: sim, motion: cartwheel}\n",
        "motion: unknown motion 'cartwheel' (expected idle, walk, turn, raise_hand, crouch, "
        "sequence or arm_swing)"},
+      {"cameras:\n  - id: a\n    source: {type: sim, costume: tartan}\n",
+       "costume: 'tartan' (expected plain or patterned)"},
       {"image: {rate: fast}\ncameras:\n  - id: a\n    source: {type: sim}\n", "image.rate"},
       {"cameras:\n  - id: a\n    source: {type: files, path: nowhere}\n", "nowhere"},
       {"clock: {fps: 25, period_ns: 40000000}\ncameras: []\n", "not both"},
@@ -142,6 +144,12 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
     EXPECT_NE(log.find(c.expect), std::string::npos) << c.yaml << log;
     EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
   }
+  // The positive control of a refused value: the same key with a known one starts.
+  auto& ok = spawn("capture", "capture/studio-capture",
+                   {"--config", write_config("costume.yaml",
+                                             "cameras:\n  - id: a\n    source: {type: sim, "
+                                             "width: 176, height: 144, costume: patterned}\n")});
+  EXPECT_TRUE(ok.wait_ready(30s)) << ok.log();
 }
 
 TEST_F(CaptureNodeTest, PublishesMasksImagesStateAndAppliesControl) {

@@ -32,6 +32,26 @@ struct CamPart {
   Rect rect;
   std::array<float, 3> albedo{};
   bool coded = false;  // wears the frame code (sim/frame_code.h): the torso
+  bool patterned = false;  // StudioOptions::patterned_costume, a clothing part
+  Eigen::Vector3d u_ref, w_ref;  // capsule: a world-fixed frame round its axis (camera frame)
+
+  // The costume's pattern at surface point p (camera frame), in [0.6, 1]: on a capsule, of the
+  // distance along its axis and the angle round it; on an ellipsoid, of the point on its unit
+  // sphere. Both in the part's own coordinates, so every camera sees the same pattern.
+  float pattern(const Eigen::Vector3d& p) const {
+    double v;
+    if (capsule) {
+      const Eigen::Vector3d q = p - a;
+      const double h = q.dot(e), th = std::atan2(q.dot(w_ref), q.dot(u_ref));
+      v = 0.8 + 0.12 * std::sin(2 * M_PI * h / 0.05) * std::cos(3 * th) +
+          0.08 * std::sin(2 * M_PI * h / 0.017 + 2 * th);
+    } else {
+      const Eigen::Vector3d q = M * (p - c);
+      v = 0.8 + 0.12 * std::sin(9 * q.x()) * std::sin(9 * q.y() + 1) +
+          0.08 * std::sin(23 * q.z() + 7 * q.x());
+    }
+    return static_cast<float>(v);
+  }
 
   // Ray parameter of the first hit of t * d (t > 0), or +inf.
   double hit(const Eigen::Vector3d& d) const {
@@ -100,8 +120,13 @@ struct CamPart {
   }
 };
 
+bool clothing(PartId id) {
+  return id != PartId::head && id != PartId::neck && id != PartId::hair && id != PartId::hand_l &&
+         id != PartId::hand_r;
+}
+
 std::vector<CamPart> to_camera(const CameraCache& cam, const ActorBody& body, int margin,
-                               bool frame_code = false) {
+                               bool frame_code = false, bool patterned = false) {
   std::vector<CamPart> out;
   out.reserve(body.parts.size());
   for (const Part& p : body.parts) {
@@ -121,6 +146,14 @@ std::vector<CamPart> to_camera(const CameraCache& cam, const ActorBody& body, in
       c.a2_r2 = c.a.squaredNorm() - c.r2;
       c.b2_r2 = c.b.squaredNorm() - c.r2;
       c.bound = c.r;
+      {  // a world-fixed direction across the axis, in the camera frame
+        const Eigen::Vector3d axis_w = cam.R.transpose() * c.e;
+        Eigen::Vector3d ref = std::abs(axis_w.x()) < 0.9 ? Eigen::Vector3d::UnitX()
+                                                         : Eigen::Vector3d::UnitZ();
+        ref = (ref - ref.dot(axis_w) * axis_w).normalized();
+        c.u_ref = cam.R * ref;
+        c.w_ref = c.e.cross(c.u_ref);
+      }
       lo = c.a.cwiseMin(c.b).array() - c.r;
       hi = c.a.cwiseMax(c.b).array() + c.r;
     } else {
@@ -142,6 +175,7 @@ std::vector<CamPart> to_camera(const CameraCache& cam, const ActorBody& body, in
     c.rect = cam.project_hull(corners, 8, margin);
     c.albedo = {p.albedo.r, p.albedo.g, p.albedo.b};
     c.coded = frame_code && p.id == PartId::torso;
+    c.patterned = patterned && clothing(p.id);
     out.push_back(c);
   }
   return out;
@@ -176,11 +210,17 @@ struct Shader {
     const float s = static_cast<float>(spill * (1 - ndv) * (1 - ndv));
     const float back[3] = {float(bg.r), float(bg.g), float(bg.b)};
     const std::array<float, 3>* albedo = &part.albedo;
+    bool banded = false;
     if (part.coded)
-      if (const int b = frame_code::band_of((part.M * (p - part.c)).y()); b >= 0) albedo = &code[b];
+      if (const int b = frame_code::band_of((part.M * (p - part.c)).y()); b >= 0) {
+        albedo = &code[b];
+        banded = true;
+      }
+    const float pattern = part.patterned && !banded ? part.pattern(p) : 1.0f;
     std::array<float, 3> out;
     for (int k = 0; k < 3; ++k) {
-      const float lin = static_cast<float>(exposure) * (*albedo)[k] * (light + ring_w * kRing[k]);
+      const float lin =
+          static_cast<float>(exposure) * pattern * (*albedo)[k] * (light + ring_w * kRing[k]);
       out[k] = kGamma(lin) * (1 - s) + back[k] * s;
     }
     return out;
@@ -347,7 +387,8 @@ void render_actor(const StudioOptions& options, const CameraCache& cam, const Pr
   const bool cull = !options.reference_renderer && cam.pinhole;
   apply_shadow(cam, frame.shadow, image, cull);
   const int width = cam.camera.width, height = cam.camera.height;
-  const std::vector<CamPart> parts = to_camera(cam, frame.truth.body, 1, options.frame_code);
+  const std::vector<CamPart> parts =
+      to_camera(cam, frame.truth.body, 1, options.frame_code, options.patterned_costume);
   // (touched_rect below repeats this rectangle arithmetic: keep the two in step.)
   Shader shader{cam.R * kKeyLight, cam.R * kFillLight, options.spill,
                 options.ring_light * options.projector_light.ring_level,
@@ -359,7 +400,7 @@ void render_actor(const StudioOptions& options, const CameraCache& cam, const Pr
   Rect U = union_rect(parts);
   std::vector<std::vector<CamPart>> blur;
   for (const ActorBody& b : frame.blur_bodies) {
-    blur.push_back(to_camera(cam, b, 1, options.frame_code));
+    blur.push_back(to_camera(cam, b, 1, options.frame_code, options.patterned_costume));
     U = U.united(union_rect(blur.back()));
   }
   if (U.empty()) return;

@@ -77,6 +77,11 @@ struct StudioOptions {
   ProjectorLight projector_light;
 
   bool frame_code = false;  // the actor wears the frame number (sim/frame_code.h)
+  // A patterned costume: the clothing parts' albedo (not the skin: head, neck, hands; nor hair)
+  // modulated by a fixed pattern on the part's own surface (stripes along each limb, checks
+  // round it, a finer weave), 0.6 .. 1.0 of the plain albedo, the same seen from every camera,
+  // hue kept (the key is unaffected). false: plainly coloured clothing (every figure so far).
+  bool patterned_costume = false;
 
   int threads = 2;  // render_all() threads over cameras
   // The renderer as it was before issue 20's cuts (every candidate part ray cast for every
