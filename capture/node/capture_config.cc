@@ -142,14 +142,8 @@ const yaml::Schema<SimKeys> kSim{
     yaml::field("height", &SimKeys::height).range(16, 8192),
     yaml::field("paced", &SimKeys::paced),
     yaml::field("frame_code", &SimKeys::frame_code),
-    yaml::field("costume", &SimKeys::patterned_costume,
-                [](const yaml::Node& n) -> Expected<bool> {
-                  auto s = n.as_string();
-                  if (!s) return std::unexpected(s.error());
-                  if (*s == "plain") return false;
-                  if (*s == "patterned") return true;
-                  return n.fail("costume: '" + *s + "' (expected plain or patterned)");
-                }),
+    yaml::enum_field("costume", &SimKeys::patterned_costume,
+                     {{"plain", false}, {"patterned", true}}),
     yaml::field("stamp", &SimKeys::stamp),
     yaml::field("offset_us", &SimKeys::offset_us).range(-5e5, 5e5),
     yaml::field("jitter_us", &SimKeys::jitter_us).range(0, 1e6),

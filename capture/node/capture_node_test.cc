@@ -127,7 +127,7 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
        "motion: unknown motion 'cartwheel' (expected idle, walk, turn, raise_hand, crouch, "
        "sequence or arm_swing)"},
       {"cameras:\n  - id: a\n    source: {type: sim, costume: tartan}\n",
-       "costume: 'tartan' (expected plain or patterned)"},
+       "expected one of plain, patterned, got 'tartan'"},
       {"image: {rate: fast}\ncameras:\n  - id: a\n    source: {type: sim}\n", "image.rate"},
       {"cameras:\n  - id: a\n    source: {type: files, path: nowhere}\n", "nowhere"},
       {"clock: {fps: 25, period_ns: 40000000}\ncameras: []\n", "not both"},

@@ -458,7 +458,8 @@ class Recorder {
 
   // Scores every queued projector frame: the true actor at display time against its blackout.
   void projector_loop() {
-    lower_to_scoring_priority();
+    const Scheduling own = idle_until_drained();
+    bool draining = false;
     while (true) {
       ProjectorJob job;
       const TruthScorer* truth = nullptr;
@@ -467,6 +468,10 @@ class Recorder {
         std::unique_lock lock(mutex_);
         wake_.wait(lock, [&] { return stopping_ || !projector_jobs_.empty(); });
         if (projector_jobs_.empty()) return;
+        if (stopping_ && !draining) {
+          draining = true;
+          scoring_scheduling(own);
+        }
         job = std::move(projector_jobs_.front());
         projector_jobs_.pop_front();
         truth = truth_.get();
@@ -506,13 +511,29 @@ class Recorder {
     }
   }
 
-  // Scoring (truth rendering) is the probe's heavy work and not latency-critical: when the
-  // probe runs real-time (deploy/demo.sh: SCHED_FIFO 45), its scoring threads drop to
-  // kScoringPriority, below every pipeline stage but above all time-sharing work and a
-  // real-time projector (deploy/demo.sh --projector-priority, 1..40), which would otherwise take
-  // the CPU they need (a starved scorer scores no frame: hull_iou null). Their load is bounded:
-  // score_rate_hz meshes, the frames the projector renders. A time-sharing probe keeps its
-  // scoring threads time-sharing.
+  // Scoring (truth rendering) is the probe's heavy work and not latency-critical, and the probe is
+  // the instrument, not the studio: during the window its scoring threads take only CPU that no
+  // service wants (SCHED_IDLE), so that the figures are the services', not the services' beside
+  // the probe's scoring (at SCHED_FIFO 41 the scorers preempted every time-sharing service, the
+  // projector included, ~4 CPU ms per 40 ms frame). What they have not scored by the window's end
+  // waits in the queues (projector frames up to projector_queue) and is scored in stop(), the
+  // threads back at their scheduling for it (scoring_scheduling): when the probe runs real-time
+  // (deploy/demo.sh: SCHED_FIFO 45), kScoringPriority, below every pipeline stage.
+  struct Scheduling {
+    int policy = SCHED_OTHER;
+    sched_param param{};
+  };
+  static Scheduling idle_until_drained() {
+    Scheduling own;
+    (void)pthread_getschedparam(pthread_self(), &own.policy, &own.param);
+    sched_param idle{};
+    (void)pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle);
+    return own;
+  }
+  static void scoring_scheduling(const Scheduling& own) {
+    (void)pthread_setschedparam(pthread_self(), own.policy, &own.param);
+    lower_to_scoring_priority();
+  }
   static void lower_to_scoring_priority() {
     int policy = SCHED_OTHER;
     sched_param param{};
@@ -523,7 +544,8 @@ class Recorder {
   }
 
   void score_loop() {
-    lower_to_scoring_priority();
+    const Scheduling own = idle_until_drained();
+    bool draining = false;
     while (true) {
       Job job;
       const TruthScorer* truth = nullptr;
@@ -531,6 +553,10 @@ class Recorder {
         std::unique_lock lock(mutex_);
         wake_.wait(lock, [&] { return stopping_ || !jobs_.empty(); });
         if (jobs_.empty()) return;  // stopping, and every queued job scored
+        if (stopping_ && !draining) {
+          draining = true;
+          scoring_scheduling(own);
+        }
         job = std::move(jobs_.front());
         jobs_.pop_front();
         truth = truth_.get();

@@ -51,7 +51,9 @@ struct ProbeOptions {
   std::string projector_png;         // a scored projector frame (thumbnail, blackout, true actor)
   std::string actor_view_png;        // that frame on the cloth from the true eye (optional)
   double display_lag_s = 0.016;      // projector frame rendered → on the cloth (sim's default)
-  std::size_t projector_queue = 64;  // frames waiting for scoring; beyond: counted unscored
+  // Frames waiting for scoring (scored when the CPU is otherwise idle, the rest after the window:
+  // probe.cc); beyond: counted unscored. 10 000: ~7 min of a 25 Hz projector, ~50 KB each.
+  std::size_t projector_queue = 10000;
   bool progress = true;
 
   Expected<void> validate() const;
