@@ -44,7 +44,7 @@ const char kConfigHelp[] =
     "                                    readout_us: exposure instant -> frame on the host (the\n"
     "                                    rest of the exposure, read-out, transfer); -1 (default):\n"
     "                                    a GigE camera's, half the exposure + 8 bits a pixel at\n"
-    "                                    1 Gbit/s (8.2 ms at 704x576); 0: an ideal camera"
+    "                                    1 Gbit/s (8.2 ms at 704x576); 0: an ideal camera\n"
     "                                    motion: the simulated actor's (idle, walk, turn,\n"
     "                                    raise_hand, crouch, sequence, arm_swing: the fast arm\n"
     "                                    swing, fingertips at swing_peak_speed m/s); every camera\n"
