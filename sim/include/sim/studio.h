@@ -79,8 +79,10 @@ struct StudioOptions {
   bool frame_code = false;  // the actor wears the frame number (sim/frame_code.h)
   // A patterned costume: the clothing parts' albedo (not the skin: head, neck, hands; nor hair)
   // modulated by a fixed pattern on the part's own surface (stripes along each limb, checks
-  // round it, a finer weave), 0.6 .. 1.0 of the plain albedo, the same seen from every camera,
-  // hue kept (the key is unaffected). false: plainly coloured clothing (every figure so far).
+  // round it, a finer weave), 0.6 .. 1.0 of the plain albedo, the same seen from every camera at
+  // an instant (round a limb it is laid from a world-fixed direction, so it does not follow the
+  // limb's twist over time), hue kept (the key is unaffected). false: plainly coloured clothing
+  // (every figure so far).
   bool patterned_costume = false;
 
   int threads = 2;  // render_all() threads over cameras
