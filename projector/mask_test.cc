@@ -107,13 +107,12 @@ TEST(MaskMargin, DefaultAssumesTheWorstCaseAccelerationWhateverTheEstimate) {
   m = security_margin(o, 0.06, 1.0, nullptr);
   ASSERT_TRUE(m);
   EXPECT_NEAR(m->margin_m, 0.01 + 1.0 * 0.06 + 0.5 * 15 * 0.06 * 0.06, 1e-12);
-  MarginOptions estimate = o;  // the estimate mode keeps v L
-  estimate.worst_case_acceleration = false;
-  EXPECT_NEAR(security_margin(estimate, 0.06, 1.0, nullptr)->margin_m, 0.01 + 0.06, 1e-12);
-  // Control: with the estimate, the still actor gets the floor and the velocity term only.
+  // Control: with the estimate, the still actor gets the floor and the velocity term only, and
+  // the no-prediction term is v L alone.
   MarginOptions estimate = o;
   estimate.worst_case_acceleration = false;
   EXPECT_NEAR(security_margin(estimate, 0.04, 0.0, &still)->margin_m, 0.01 + 0.05 * 0.04, 1e-12);
+  EXPECT_NEAR(security_margin(estimate, 0.06, 1.0, nullptr)->margin_m, 0.01 + 0.06, 1e-12);
 }
 
 TEST(MaskMargin, LatencyWindowTakesAHighQuantile) {
