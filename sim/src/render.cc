@@ -146,7 +146,7 @@ std::vector<CamPart> to_camera(const CameraCache& cam, const ActorBody& body, in
       c.a2_r2 = c.a.squaredNorm() - c.r2;
       c.b2_r2 = c.b.squaredNorm() - c.r2;
       c.bound = c.r;
-      {  // a world-fixed direction across the axis, in the camera frame
+      if (patterned && clothing(p.id)) {  // a world-fixed direction across the axis, camera frame
         const Eigen::Vector3d axis_w = cam.R.transpose() * c.e;
         Eigen::Vector3d ref = std::abs(axis_w.x()) < 0.9 ? Eigen::Vector3d::UnitX()
                                                          : Eigen::Vector3d::UnitZ();
