@@ -8,7 +8,11 @@ each offending test. Placeholders `<binary>_NOT_BUILT` (a gtest binary not built
 the ASan tree builds only the unit label's binaries) are counted, not checked: ctest fails them
 if they are run.
 
-usage: ctest_properties_check.py --build-dir DIR | --tests-json FILE
+With --sanitizer-exclude FILE (tests/sanitizer-exclude.txt: the release-only tests that
+`./studio test --asan` leaves out), every name in it must be a test of the list, so that a
+renamed test cannot silently run under ASan again, nor a stale line hide nothing.
+
+usage: ctest_properties_check.py (--build-dir DIR | --tests-json FILE) [--sanitizer-exclude FILE]
        ctest_properties_check.py --self-test
 exit 0 when every test passes the check, 1 otherwise, 2 on bad usage or unreadable input.
 """
@@ -42,8 +46,17 @@ def problems(doc):
     return out, placeholders
 
 
-def check(doc):
+def excluded_names(path):
+    """The test names of a sanitizer-exclude file: the first word of each line, # comments out."""
+    with open(path) as f:
+        return [line.split()[0] for line in f if line.strip() and not line.lstrip().startswith("#")]
+
+
+def check(doc, exclude=()):
     found, placeholders = problems(doc)
+    known = {t.get("name") for t in doc.get("tests", [])}
+    found += [(name, "in the sanitizer-exclude list but not a test") for name in exclude
+              if name not in known]
     n = len(doc.get("tests", []))
     for name, what in found:
         print(f"ctest_properties: {name}: {what}")
@@ -65,14 +78,22 @@ def self_test():
          "D.odd: unknown label"),
         ("placeholder ignored", [t("x_test_NOT_BUILT"), t("A.ok", TIMEOUT=1.0, LABELS=["gl"])], 0,
          "1 not-built placeholder"),
+        ("excluded test exists", [t("A.ok", TIMEOUT=1.0, LABELS=["unit"])], 0, None, "A.ok  heavy"),
+        ("excluded test unknown", [t("A.ok", TIMEOUT=1.0, LABELS=["unit"])], 1,
+         "A.gone: in the sanitizer-exclude list", "# comment\nA.ok  heavy\nA.gone  renamed"),
     ]
     failures = 0
-    for what, tests, want, text in cases:
-        with tempfile.NamedTemporaryFile("w", suffix=".json") as f:
+    for what, tests, want, text, *exclude in cases:
+        with tempfile.NamedTemporaryFile("w", suffix=".json") as f, \
+                tempfile.NamedTemporaryFile("w", suffix=".txt") as x:
             json.dump({"kind": "ctestInfo", "tests": tests}, f)
             f.flush()
-            r = subprocess.run([sys.executable, __file__, "--tests-json", f.name],
-                               capture_output=True, text=True)
+            args = [sys.executable, __file__, "--tests-json", f.name]
+            if exclude:
+                x.write(exclude[0] + "\n")
+                x.flush()
+                args += ["--sanitizer-exclude", x.name]
+            r = subprocess.run(args, capture_output=True, text=True)
         ok = r.returncode == want and (text is None or text in r.stdout)
         print(("ok   " if ok else "FAIL ") + what + ("" if ok else f": exit {r.returncode}\n{r.stdout}"))
         failures += not ok
@@ -85,6 +106,8 @@ def main():
     g.add_argument("--build-dir", help="a configured build tree (runs ctest --show-only=json-v1)")
     g.add_argument("--tests-json", help="a saved `ctest --show-only=json-v1` document")
     g.add_argument("--self-test", action="store_true", help="run the check on fixture documents")
+    ap.add_argument("--sanitizer-exclude", metavar="FILE",
+                    help="tests/sanitizer-exclude.txt: each name in it must be a test of the list")
     a = ap.parse_args()
     if a.self_test:
         return self_test()
@@ -96,10 +119,11 @@ def main():
             with open(a.tests_json) as f:
                 text = f.read()
         doc = json.loads(text)
+        exclude = excluded_names(a.sanitizer_exclude) if a.sanitizer_exclude else []
     except (OSError, subprocess.CalledProcessError, json.JSONDecodeError) as e:
         print(f"ctest_properties: cannot read the test list: {e}", file=sys.stderr)
         return 2
-    return check(doc)
+    return check(doc, exclude)
 
 
 if __name__ == "__main__":
