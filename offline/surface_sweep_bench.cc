@@ -2,7 +2,11 @@
 // truth. Usage: offline_surface_sweep "variant;variant;..." where a variant is key=value,...
 // (steps, lambda, rim, band, anchor, hull, order, fromhull, photo = photo-term iterations).
 // Environment: GRID (columns, 256), POSES (indices into the list below, e.g. 34),
-// COSTUME=patterned (the actor in sim's patterned costume instead of plain clothing).
+// COSTUME=patterned (the actor in sim's patterned costume instead of plain clothing),
+// LOW_RING=N (N more cameras on a second ring 0.9 m high looking at 1.0 m, between the main
+// ring's azimuths, the cyclorama's walls 6 m high instead of 4 so that they see cloth above the
+// actor: a larger studio's rig, e.g. 8 + overhead + 8 = 17 cameras), LOSS_PER_CAMERA=1 (the
+// hull's and the carved mesh's silhouette loss per camera: a mask wider than the actor shows).
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -75,7 +79,21 @@ int main(int argc, char** argv) {
     so.actor.seed = poses[i].seed;
     so.patterned_costume =
         std::getenv("COSTUME") && std::string(std::getenv("COSTUME")) == "patterned";
-    auto studio = sim::SimulatedStudio::create(sim::ring_cameras(ring), so).value();
+    std::vector<Camera> cams = sim::ring_cameras(ring);
+    if (const char* low = std::getenv("LOW_RING")) {
+      so.cyclorama_height = 6;  // a level view from 0.9 m sees above the 4 m walls
+      sim::RingOptions lo;
+      lo.count = std::atoi(low);
+      lo.overhead = false;
+      lo.height_m = 0.9;
+      lo.look_at_y = 1.0;
+      lo.first_azimuth_deg = 180.0 / lo.count;
+      for (Camera c : sim::ring_cameras(lo)) {
+        c.id = "low" + c.id.substr(3);
+        cams.push_back(c);
+      }
+    }
+    auto studio = sim::SimulatedStudio::create(cams, so).value();
     Prepared& p = prep[i];
     p.f = testing::render_frame(studio, poses[i].frame);
     p.views = p.f.views();
@@ -90,6 +108,13 @@ int main(int argc, char** argv) {
     p.carved_mesh = refined_mesh(carved.set, set, p.views, 2).value();
     p.hull = testing::surface_distance(p.hull_mesh, p.f.truth.body);
     p.carved = testing::surface_distance(p.carved_mesh, p.f.truth.body);
+    if (std::getenv("LOSS_PER_CAMERA")) {  // the hull's and the carved mesh's loss per camera
+      for (std::size_t c = 0; c < p.views.size(); ++c) {
+        const std::vector<ColourView> one = {p.views[c]};
+        std::printf("  %s: hull loss %.4f carved loss %.4f\n", p.views[c].camera->id.c_str(),
+                    silhouette_loss(p.hull_mesh, one), silhouette_loss(p.carved_mesh, one));
+      }
+    }
     std::printf("pose %s f%lld seed %llu %s: hull %.2f / %.2f, carved %.2f / %.2f (loss %.4f)\n",
                 sim::motion_name(poses[i].motion), (long long)poses[i].frame,
                 (unsigned long long)poses[i].seed, poses[i].train ? "train" : "valid",
