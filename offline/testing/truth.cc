@@ -3,55 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <unordered_map>
 
 #include "keyer/keyer.h"
+#include "testing/point_index.h"
 #include "testing/raster.h"
 
 namespace studio::offline::testing {
 namespace {
-
-// Nearest-neighbour distances through a hash grid of cell h.
-class PointIndex {
- public:
-  PointIndex(const std::vector<Eigen::Vector3d>& pts, double h) : pts_(pts), h_(h) {
-    for (std::size_t n = 0; n < pts.size(); ++n) cells_[key(cell(pts[n]))].push_back(uint32_t(n));
-  }
-  double nearest(const Eigen::Vector3d& x) const {
-    const Eigen::Vector3i c = cell(x);
-    double best2 = std::numeric_limits<double>::max();
-    for (int r = 0; r < 64; ++r) {
-      // The cells of shell r only (Chebyshev distance r from c): where neither dz nor dy is on
-      // the shell, only dx = -r and dx = r are (stepping over the interior keeps the query
-      // O(r^2) per shell instead of O(r^3); the cells visited, hence the result, are the same).
-      for (int dz = -r; dz <= r; ++dz)
-        for (int dy = -r; dy <= r; ++dy) {
-          const bool face = std::abs(dz) == r || std::abs(dy) == r;
-          for (int dx = -r; dx <= r; dx += (face || r == 0) ? 1 : 2 * r) {
-            auto it = cells_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
-            if (it == cells_.end()) continue;
-            for (uint32_t n : it->second) best2 = std::min(best2, (pts_[n] - x).squaredNorm());
-          }
-        }
-      // Cells of shell r + 1 and beyond are at least r cells away.
-      if (best2 != std::numeric_limits<double>::max() && std::sqrt(best2) <= r * h_) break;
-    }
-    return std::sqrt(best2);
-  }
-
- private:
-  Eigen::Vector3i cell(const Eigen::Vector3d& x) const {
-    return Eigen::Vector3i(int(std::floor(x.x() / h_)), int(std::floor(x.y() / h_)),
-                           int(std::floor(x.z() / h_)));
-  }
-  static uint64_t key(const Eigen::Vector3i& c) {
-    return (uint64_t(uint32_t(c.x() + (1 << 20))) << 42) ^
-           (uint64_t(uint32_t(c.y() + (1 << 20))) << 21) ^ uint64_t(uint32_t(c.z() + (1 << 20)));
-  }
-  const std::vector<Eigen::Vector3d>& pts_;
-  double h_;
-  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
-};
 
 std::vector<Eigen::Vector3d> mesh_samples(const hull::Mesh& mesh, int n) {
   std::vector<double> cum;
