@@ -17,9 +17,11 @@ struct FrameMetrics {
         mesh_errors(loop.counter("mesh_motion_errors")),
         from_cache(loop.counter("frames_from_cache")),
         rerendered(loop.counter("scene_rerendered")),
+        held(loop.counter("frames_held")),
         fits_deferred(loop.counter("motion_fits_deferred")),
         moving_nodes(loop.metrics().gauge("scene_moving_nodes")),
         cache_move_mm(loop.metrics().gauge("scene_cache_move_mm")),
+        held_shift_px(loop.metrics().gauge("scene_held_shift_px")),
         cpu_per_frame_ms(loop.metrics().gauge("cpu_per_frame_ms")),
         margin_mm(loop.metrics().gauge("margin_mm")),
         latency_p_ms(loop.metrics().gauge("latency_p_ms")),
@@ -29,8 +31,8 @@ struct FrameMetrics {
     loop.count_as_output(rendered);
   }
   runtime::Counter &rendered, &eye_rejected, &head_stale, &scene_left_out, &assets_failed,
-      &superseded, &mesh_errors, &from_cache, &rerendered, &fits_deferred;
-  runtime::Gauge &moving_nodes, &cache_move_mm, &cpu_per_frame_ms, &margin_mm, &latency_p_ms,
+      &superseded, &mesh_errors, &from_cache, &rerendered, &held, &fits_deferred;
+  runtime::Gauge &moving_nodes, &cache_move_mm, &held_shift_px, &cpu_per_frame_ms, &margin_mm, &latency_p_ms,
       &render_ms, &overrun_p_ms, &mesh_triangles;
 };
 

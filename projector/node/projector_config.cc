@@ -123,6 +123,12 @@ runtime::ServiceDefinition projector_service_definition() {
       "      enabled: true         false: every frame draws the whole scene\n"
       "      max_error_px: 0.5     projector pixels (0..10]\n"
       "      settle: 1.0           seconds a changed node stays with the moving nodes\n"
+      "      hold_frames: 0        0..25: a layer drawn for a moving eye also serves this many\n"
+      "                            following frames however far the eye moved (the static\n"
+      "                            scene redrawn at most every hold_frames + 1 frames, lagging\n"
+      "                            the eye by up to that many; moving nodes and masks every\n"
+      "                            frame): for projector PCs without a GPU; 0 (default):\n"
+      "                            the bound alone decides\n"
       "  The frame is read back for studio/projector/frame (blackout mask, thumbnail) in both\n"
       "  outputs; a window needs a display (DISPLAY; under systemd a graphical session).\n"
       "  Topics: studio/scene/node, studio/actor/mesh, studio/actor/head in;\n"
@@ -136,7 +142,9 @@ runtime::ServiceDefinition projector_service_definition() {
       "  stage_latch_ms, stage_ahead_ms,\n"
       "  mesh_to_frame_ms: see projector/node/frame_stages.h; the scene cache: frames_from_cache,\n"
       "  scene_rerendered (frames that drew the static scene), scene_moving_nodes,\n"
-      "  scene_cache_move_mm (eye move the cached layer allows); cpu_per_frame_ms: the process's\n"
+      "  scene_cache_move_mm (eye move the cached layer allows), frames_held and\n"
+      "  scene_held_shift_px (frames served by hold_frames beyond the bound, and the last such\n"
+      "  frame's displacement bound, projector px); cpu_per_frame_ms: the process's\n"
       "  CPU time, every thread (llvmpipe's too), per rendered frame over about a second).\n";
   d.create = [](yaml::MapReader& config,
                 runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
@@ -167,6 +175,7 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("enabled", &SceneCacheOptions::enabled),
         yaml::field("max_error_px", &SceneCacheOptions::max_error_px).range(1e-3, 10),
         yaml::field("settle", &SceneCacheOptions::settle_s).range(0, 60),
+        yaml::field("hold_frames", &SceneCacheOptions::hold_frames).range(0, 25),
     };
     static const yaml::Schema<ProjectorNodeOptions> schema{
         yaml::field("rig", &ProjectorNodeOptions::rig).required().relative_path(),

@@ -328,6 +328,10 @@ class ProjectorNode : public runtime::Node {
       drawn = draw(eye);
     }
     if (drawn) (drawn->from_cache ? m_.from_cache : m_.rerendered).add();
+    if (drawn && drawn->held) {
+      m_.held.add();
+      m_.held_shift_px.set(drawn->shift_px);
+    }
     if (drawn && cache) m_.cache_move_mm.set(fr.cache_allowed_move_m(eye) * 1e3);
     return drawn;
   }

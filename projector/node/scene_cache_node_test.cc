@@ -68,14 +68,72 @@ class SceneCacheNodeTest : public studio::testing::ProcessTest {
     scene_ = scene_assets::build_scene(description, cache, 0).value();
   }
 
-  std::string config(bool enabled) {
-    const auto path = dir_ / (enabled ? "on.yaml" : "off.yaml");
+  std::string config(bool enabled, int hold_frames = 0) {
+    const auto path =
+        dir_ / ((enabled ? "on" : "off") + std::to_string(hold_frames) + ".yaml");
     std::ofstream(path) << "instance: proj-test\nstatus_period: 0.2\nprojector:\n"
                         << "  rig: rig.yaml\n  id: proj0\n  rate: 20\n"
                         << "  default_eye: [0, 1.6, 1.5]\n"
                         << "  scene_cache: {enabled: " << (enabled ? "true" : "false")
-                        << ", max_error_px: 0.5, settle: 1.0}\n";
+                        << ", max_error_px: 0.5, settle: 1.0, hold_frames: " << hold_frames
+                        << "}\n";
     return path.string();
+  }
+
+  struct Walk {
+    double held = -1, rerendered = -1, from_cache = -1, held_shift_px = -1;
+  };
+  // Runs a projector while the head walks 5 mm every 50 ms (5-10x the bound per frame) for 3 s;
+  // returns the counters' growth over the last 2 s and the last held frame's bound.
+  Walk walk(int hold_frames) {
+    auto& node = spawn("projector", "projector/studio-projector",
+                       {"--config", config(true, hold_frames)});
+    EXPECT_TRUE(node.wait_ready(30s)) << node.log();
+    auto p = wire::Participant::create().value();
+    auto status_topic = wire::Topic<studio_ServiceStatus>::create(p).value();
+    auto status = wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
+    auto node_topic = wire::Topic<studio_SceneNode>::create(p).value();
+    auto nodes = wire::Writer<studio_SceneNode>::create(p, node_topic).value();
+    auto head_topic = wire::Topic<studio_HeadPose>::create(p).value();
+    auto heads = wire::Writer<studio_HeadPose>::create(p, head_topic).value();
+    EXPECT_TRUE(nodes.wait_for_readers(1, 10s));
+    for (const auto& [id, n] : scene_.nodes()) {
+      wire::Owned<studio_SceneNode> s;
+      EXPECT_TRUE(wire::from_core(n, *s).has_value());
+      EXPECT_TRUE(nodes.write(*s).has_value());
+    }
+    auto latest = [&] {
+      Walk w;
+      for (auto until = SteadyClock::now() + 5s; w.held < 0 && SteadyClock::now() < until;) {
+        for (auto& s : status.take())
+          if (s.meta.valid_data && std::string(s.data->service) == "projector")
+            w = {counter(*s.data, "frames_held"), counter(*s.data, "scene_rerendered"),
+                 counter(*s.data, "frames_from_cache"), counter(*s.data, "scene_held_shift_px")};
+        std::this_thread::sleep_for(20ms);
+      }
+      return w;
+    };
+    Walk start;
+    for (int k = 0; k < 60; ++k) {
+      if (k == 20) {
+        (void)status.take();
+        start = latest();
+      }
+      wire::Owned<studio_HeadPose> h;
+      wire::set(h->actor_id, "actor");
+      h->capture_ns = realtime_ns();
+      const Eigen::Vector3d eye(-0.3 + 0.005 * k, 1.65, 1.2);
+      for (int i = 0; i < 3; ++i) h->position[i] = eye[i];
+      h->confidence = 1;
+      EXPECT_TRUE(heads.write(*h).has_value());
+      std::this_thread::sleep_for(50ms);
+    }
+    (void)status.take();
+    const Walk end = latest();
+    EXPECT_TRUE(node.running());
+    EXPECT_EQ(node.stop(), 0) << node.log();
+    return {end.held - start.held, end.rerendered - start.rerendered,
+            end.from_cache - start.from_cache, end.held_shift_px};
   }
 
   // Runs a projector; returns the counts while only the probe moved and after the eye moved.
@@ -187,6 +245,32 @@ TEST_F(SceneCacheNodeTest, CacheOffRendersEveryFrame) {
   EXPECT_EQ(right, 8);
   EXPECT_EQ(b.from_cache, 0);
   EXPECT_GE(b.rerendered - a.rerendered, 20);
+}
+
+}  // namespace
+}  // namespace studio::projector
+
+namespace studio::projector {
+namespace {
+
+// scene_cache.hold_frames 2 with a walking head: about two frames in three restore the layer
+// beyond the bound (frames_held, counted as from the cache) and one in three draws the scene;
+// the held frames' bound is reported (scene_held_shift_px, beyond max_error_px). Control:
+// hold_frames 0 draws every frame of the walk.
+TEST_F(SceneCacheNodeTest, HoldFramesServeAWalkingHeadBetweenRedraws) {
+  const Walk on = walk(2);
+  const Walk off = walk(0);
+  std::printf("walking head, 2 s: hold 2: held %.0f, re-rendered %.0f, from the cache %.0f, last "
+              "held bound %.2f px; hold 0: held %.0f, re-rendered %.0f, from the cache %.0f\n",
+              on.held, on.rerendered, on.from_cache, on.held_shift_px, off.held, off.rerendered,
+              off.from_cache);
+  EXPECT_GE(on.held + on.rerendered, 20);  // ~40 frames at 20 fps
+  EXPECT_GE(on.held, on.rerendered);
+  EXPECT_LE(on.held, 2 * on.rerendered + 2);  // a layer serves at most 2 frames
+  EXPECT_GE(on.from_cache, on.held);          // (+ frames before the next head pose)
+  EXPECT_GT(on.held_shift_px, 0.5);
+  EXPECT_EQ(off.held, 0);
+  EXPECT_GE(off.rerendered, 20);
 }
 
 }  // namespace

@@ -240,13 +240,17 @@ Expected<FrameInfo> FrameRenderer::Impl::render(const scene::Scene& still, std::
   FrameInfo info;
   info.shift_px = l ? l->shift_px(version, eye) : std::numeric_limits<double>::infinity();
   info.from_cache = l && info.shift_px <= l->options().max_error_px;
+  // Beyond the bound, a layer may still serve hold_frames frames after it was drawn.
+  info.held = l && !info.from_cache && l->holds(version);
+  info.from_cache = info.from_cache || info.held;
   // A re-rendered static layer is kept (a blit and a depth read, ~a fifth of a frame) only when
-  // it may serve the next frame: a new static version, nothing cached yet, or an eye that moved
-  // less than the bound since the previous frame (a still eye). An eye moving every frame by
-  // more than the bound (a walking actor, tracker noise) costs no more than a full render.
+  // it may serve the next frame: a new static version, nothing cached yet, an eye that moved
+  // less than the bound since the previous frame (a still eye), or frames to hold it for. An
+  // eye moving every frame by more than the bound (a walking actor, tracker noise) without a
+  // hold costs no more than a full render.
   const bool keep =
       l && !info.from_cache &&
-      (!l->valid() || l->version() != version || !r.last_eye ||
+      (l->options().hold_frames > 0 || !l->valid() || l->version() != version || !r.last_eye ||
        l->bound().shift_px(l->heights(), *r.last_eye, eye) <= l->options().max_error_px);
   r.last_eye = eye;
   const double near = r.options.off_axis.near_m, far = r.options.off_axis.far_m;

@@ -30,7 +30,9 @@
 // `TwoPass_720p` / `TwoPassHalfEye_720p`: the two pass at 1280x720 with the eye texture at its
 // suggested size and at half of it each side (FrameRendererOptions::eye_texture_scale 0.5: a
 // quarter of the scene's fragments; baseline `SinglePass_720p`). `HullMask_720p`: the mask of the
-// hull's own mesh per simplification setting (after BM_HullMask_720p below).
+// hull's own mesh per simplification setting (after BM_HullMask_720p below). `SinglePassHold`,
+// `TwoPassHold` (1920x1080) and `SinglePassHold_720p`: the cache miss's walking eye with
+// scene_cache.hold_frames = the argument (0: the cache miss itself, the baseline).
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -107,7 +109,9 @@ enum class Work {
   single_pass_cache_miss,
   two_pass_cached,
   two_pass_half_eye,
-  late_latch
+  late_latch,
+  single_pass_hold,  // the cache miss's walking eye with scene_cache.hold_frames = state.range(0)
+  two_pass_hold
 };
 
 // The back-wall projector at 1280x720 (intrinsics scaled about the pixel-centre convention).
@@ -145,9 +149,12 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
   FrameRendererOptions fo;
   const bool two_pass = work == Work::two_pass || work == Work::two_pass_full_warp ||
                         work == Work::two_pass_half_eye ||
-                        work == Work::two_pass_cached;
+                        work == Work::two_pass_cached || work == Work::two_pass_hold;
   const bool layered = work == Work::single_pass_cached || work == Work::single_pass_cache_miss ||
-                       work == Work::two_pass_cached;
+                       work == Work::two_pass_cached || work == Work::single_pass_hold ||
+                       work == Work::two_pass_hold;
+  if (work == Work::single_pass_hold || work == Work::two_pass_hold)
+    fo.scene_cache.hold_frames = int(state.range(0));
   std::int64_t hits = 0, misses = 0;
   const double pixels = double(projector.camera.width) * projector.camera.height;
   fo.form = two_pass ? Form::two_pass : Form::single_pass;
@@ -189,8 +196,10 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
       const projector::SceneLayers layers = projector::split_scene(f.scene, f.moving);
       // Miss: the eye on a 2 cm circle, 6 mm further each frame (10x the bound).
       const double turn = 0.3 * double(frame);
+      const bool walking = work == Work::single_pass_cache_miss ||
+                           work == Work::single_pass_hold || work == Work::two_pass_hold;
       const Eigen::Vector3d eye =
-          work == Work::single_pass_cache_miss
+          walking
               ? Eigen::Vector3d(kEye + 0.02 * Eigen::Vector3d(std::cos(turn), std::sin(turn), 0))
               : kEye;
       auto info = fr->render(LayeredScene{layers.still, layers.still_version, &layers.moving},
@@ -276,6 +285,11 @@ void BM_TwoPassHalfEye_720p(benchmark::State& s) { run(s, Work::two_pass_half_ey
 void BM_SinglePassCacheMiss_720p(benchmark::State& s) {
   run(s, Work::single_pass_cache_miss, true);
 }
+// scene_cache.hold_frames = arg with the cache miss's walking eye: the static layer drawn every
+// arg + 1 frames and held in between (arg 0 = the cache miss, the baseline in the same run).
+void BM_SinglePassHold(benchmark::State& s) { run(s, Work::single_pass_hold); }
+void BM_TwoPassHold(benchmark::State& s) { run(s, Work::two_pass_hold); }
+void BM_SinglePassHold_720p(benchmark::State& s) { run(s, Work::single_pass_hold, true); }
 // The mask of a live-like hull mesh (the arm swing's, testing/hull_meshes.h, ~38k triangles)
 // simplified by GrowOptions max_triangles (arg 0) and cluster_factor (arg 1), as the late-latched
 // node draws it per frame at 720p: grown by arg 2 mm (+ the simplification's error; 200: the
@@ -334,6 +348,9 @@ BENCHMARK(BM_SinglePassCached_720p) OPTS;
 BENCHMARK(BM_SinglePassCacheMiss_720p) OPTS;
 BENCHMARK(BM_TwoPass_720p) OPTS;
 BENCHMARK(BM_TwoPassHalfEye_720p) OPTS;
+BENCHMARK(BM_SinglePassHold) OPTS->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK(BM_TwoPassHold) OPTS->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK(BM_SinglePassHold_720p) OPTS->Arg(0)->Arg(1)->Arg(2);
 BENCHMARK(BM_HullMask_720p)
     ->Args({3000, 4, 30})
     ->Args({12000, 1, 30})

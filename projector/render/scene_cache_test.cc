@@ -7,6 +7,7 @@
 //   render) and the frame from the first eye is > 0.5 px off there — the comparison can fail;
 // - a moving node (a marker changed every frame) is drawn where it is in every cached frame;
 // - a new static version re-renders;
+// - hold_frames: a walking eye served by the layer between redraws, within the reported bound;
 // - the default museum: cached vs full render from a moved eye under the bound, PSNR.
 #include <gtest/gtest.h>
 
@@ -288,6 +289,69 @@ TEST(SceneCache, MovingEyeDoesNotKeepTheLayerAStillEyeDoes) {
   EXPECT_TRUE(infos[6].stored);
   EXPECT_TRUE(infos[7].from_cache);
   EXPECT_TRUE(infos[8].from_cache);
+}
+
+// hold_frames (CPU-only projector PCs): an eye walking 5 mm a frame (5-10x the bound) gets the
+// layer drawn every hold_frames + 1 frames and restored in between: a held frame is exactly the
+// full render from the eye that drew the layer, and every marker lies within the frame's
+// reported bound (FrameInfo::shift_px) of a full render from the current eye, a bound beyond
+// max_error_px (the frame really is off by more than the cache otherwise allows). Control:
+// hold_frames 0 draws every frame of the walk.
+TEST(SceneCache, HoldServesAWalkingEyeThenRedrawsWithinTheReportedBound) {
+  (void)context();
+  const Projector p = projector::testing::studio_projectors()[0];
+  auto view = projector::ProjectorView::create(p).value();
+  std::mt19937 rng(16);
+  const Eigen::Vector3d eye0(0.2, 1.6, 1.0);
+  const Markers m = make_markers(p, eye0, rng);
+  const scene::Scene empty;
+  for (Form form : {Form::single_pass, Form::two_pass}) {
+    for (int hold : {2, 0}) {
+      FrameRendererOptions fo;
+      fo.form = form;
+      fo.renderer.clear_colour = {0, 0, 0, 1};
+      fo.thumb_width = fo.thumb_height = 0;
+      fo.scene_cache.hold_frames = hold;
+      auto fr = FrameRenderer::create(view, fo);
+      ASSERT_TRUE(fr) << fr.error().message;
+      ASSERT_TRUE(fr->renderer().upload(square_asset()));
+      const LayeredScene layered{m.scene, 1, &empty};
+      Eigen::Vector3d drawn_from = eye0;
+      int held = 0;
+      double worst_excess = -1e9, smallest_bound = 1e9;
+      for (int k = 0; k < 9; ++k) {
+        const Eigen::Vector3d eye = eye0 + 0.005 * k * view.screen().right;
+        auto info = fr->render(layered, eye, {});
+        ASSERT_TRUE(info) << info.error().message;
+        const bool want_held = hold > 0 && k % (hold + 1) != 0;
+        EXPECT_EQ(info->from_cache, want_held) << name(form) << " hold " << hold << " frame " << k;
+        EXPECT_EQ(info->held, want_held) << name(form) << " hold " << hold << " frame " << k;
+        if (!info->held) {
+          drawn_from = eye;
+          continue;
+        }
+        ++held;
+        const auto got = frame_of(*fr);
+        ASSERT_TRUE(fr->render(m.scene, drawn_from, {}));
+        EXPECT_EQ(got, frame_of(*fr)) << "frame " << k << ": not the layer drawn from its eye";
+        ASSERT_TRUE(fr->render(m.scene, eye, {}));
+        const auto full = frame_of(*fr);
+        worst_excess =
+            std::max(worst_excess, worst_marker_distance(p, m, eye, got, full) - info->shift_px);
+        smallest_bound = std::min(smallest_bound, info->shift_px);
+      }
+      if (hold == 0) {
+        EXPECT_EQ(held, 0);
+        continue;
+      }
+      std::printf("%s, hold %d: %d of 9 walking frames held, bound %.2f px at least, markers "
+                  "within the bound by %.3f px\n",
+                  name(form), hold, held, smallest_bound, -worst_excess);
+      EXPECT_EQ(held, 6);
+      EXPECT_LE(worst_excess, 0.0);
+      EXPECT_GT(smallest_bound, fo.scene_cache.max_error_px);
+    }
+  }
 }
 
 TEST(SceneCache, DefaultMuseumFromTheCacheMatchesAFullRender) {

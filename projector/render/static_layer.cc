@@ -44,7 +44,8 @@ void blit(unsigned from, unsigned to, int w, int h) {
 }
 }  // namespace
 
-void StaticLayer::restore(const scene_render::RenderTarget& into) const {
+void StaticLayer::restore(const scene_render::RenderTarget& into) {
+  ++served_;
   const bool scissor = glIsEnabled(GL_SCISSOR_TEST);  // the blit honours the scissor box
   if (scissor) glDisable(GL_SCISSOR_TEST);
   blit(target_.framebuffer(), into.framebuffer(), into.width(), into.height());
@@ -124,6 +125,7 @@ void StaticLayer::store(const scene_render::RenderTarget& from, std::uint64_t ve
                        : projector::HeightRange{1, 0};  // nothing static shown: hi < lo
   version_ = version;
   eye_ = eye;
+  served_ = 0;
   valid_ = true;
 }
 

@@ -34,8 +34,15 @@ class StaticLayer {
   bool usable(std::uint64_t version, const Eigen::Vector3d& eye) const {
     return shift_px(version, eye) <= options_.max_error_px;
   }
-  // Copies the cached colour and depth into `into` (same size), which is left bound.
-  void restore(const scene_render::RenderTarget& into) const;
+  // Whether the layer may serve the next frame whatever the eye's move (the version is the
+  // same and fewer than SceneCacheOptions::hold_frames frames have restored it since it was
+  // drawn).
+  bool holds(std::uint64_t version) const {
+    return valid_ && version == version_ && served_ < options_.hold_frames;
+  }
+  // Copies the cached colour and depth into `into` (same size), which is left bound; counts one
+  // frame served.
+  void restore(const scene_render::RenderTarget& into);
 
   // How the depth of the layer maps to the eye's view distance: `eye_clip_from_world` is the
   // eye's off-axis projection; `projector_clip_from_world` the single pass's (its depth is the
@@ -48,7 +55,8 @@ class StaticLayer {
     std::array<int, 4> box{0, 0, 0, 0};
   };
   // Keeps `from`'s colour and depth (the static scene just drawn from `eye`) as the layer and
-  // reads the heights of the points it shows from its depth. `from` is left bound.
+  // reads the heights of the points it shows from its depth (a new layer: no frame served).
+  // `from` is left bound.
   void store(const scene_render::RenderTarget& from, std::uint64_t version,
              const Eigen::Vector3d& eye, const DepthModel& model);
   void invalidate() { valid_ = false; }
@@ -70,6 +78,7 @@ class StaticLayer {
   int projector_height_ = 0;
   bool valid_ = false;
   std::uint64_t version_ = 0;
+  int served_ = 0;  // frames restored from this layer since it was drawn
   Eigen::Vector3d eye_ = Eigen::Vector3d::Zero();
   projector::HeightRange heights_;
   std::vector<float> depth_;

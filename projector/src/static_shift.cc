@@ -11,6 +11,7 @@ Expected<void> SceneCacheOptions::validate() const {
   if (!(max_error_px > 0 && max_error_px <= 10))
     return fail("scene_cache.max_error_px: in (0, 10] projector pixels");
   if (!(settle_s >= 0 && settle_s <= 60)) return fail("scene_cache.settle_s: in [0, 60] seconds");
+  if (hold_frames < 0 || hold_frames > 25) return fail("scene_cache.hold_frames: in [0, 25]");
   return {};
 }
 

@@ -49,6 +49,14 @@ struct SceneCacheOptions {
   // A scene node that changes is drawn every frame (with the animated ones) until it has not
   // changed for this long; then it joins the cached static part (seconds; projector node).
   double settle_s = 1.0;
+  // A layer drawn for a moving eye also serves up to this many following frames, however far
+  // the eye moved, so the static scene is redrawn at most every hold_frames + 1 frames (0: the
+  // bound above alone decides). The static scene then lags the eye by up to hold_frames frames
+  // (FrameInfo::shift_px bounds each held frame's error); the moving nodes and the masks are
+  // drawn every frame from the current eye and prediction, so the actor's blackout is
+  // unaffected. For projector PCs without a GPU, where drawing the static scene costs most of a
+  // frame (BENCHMARKS.md, projector).
+  int hold_frames = 0;
   Expected<void> validate() const;
 };
 

@@ -86,12 +86,15 @@ struct LayeredScene {
 struct FrameInfo {
   int masks = 0;            // mask meshes drawn
   bool from_cache = false;  // the static layer was restored, not drawn
+  // Restored beyond the bound, by SceneCacheOptions::hold_frames (shift_px is then the static
+  // scene's error bound in this frame).
+  bool held = false;
   // The displacement bound (projector px) of the cached layer at this frame's eye; +inf when
   // nothing was cached for this static version (a full render follows either way when it
   // exceeds SceneCacheOptions::max_error_px).
   double shift_px = 0;
   // A re-rendered static layer was kept for later frames (not when the eye moved more than the
-  // bound since the previous frame: it would not serve the next one).
+  // bound since the previous frame and nothing is held: it would not serve the next one).
   bool stored = false;
 };
 
