@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <thread>
 
 #include "harness/fixture.h"
+#include "runtime/status_publisher.h"
 #include "wire/endpoint.h"
 
 namespace studio::runtime {
@@ -102,6 +105,37 @@ TEST_F(ServiceTest, LifecycleNotifiesAndPublishesStatus) {
 // A service killed without a word (kill -9: no dispose, no unregister) disappears from every
 // status reader when its liveliness lease (3 s, wire QoS table) runs out: the reader's writer
 // loses liveliness and the service's instance turns not-alive.
+// A gauge that is not finite (an unbounded allowance) is left out of the status; the status
+// still reaches a validated reader with every other value (before, the reader refused the whole
+// sample and the service looked silent). Control: the finite value arrives.
+TEST_F(ServiceTest, NonFiniteGaugeIsLeftOutNotTheWholeStatus) {
+  auto participant = wire::Participant::create().value();
+  auto topic = wire::Topic<studio_ServiceStatus>::create(participant).value();
+  auto reader = wire::Reader<studio_ServiceStatus>::create(participant, topic).value();
+  auto publisher = StatusPublisher::create(participant, "gauges", "g-1").value();
+  MetricsSnapshot m;
+  m.counters = {{"finite", 7}, {"unbounded", INFINITY}, {"unknown", NAN}};
+  bool got = false;
+  double finite = -1;
+  int others = 0;
+  for (auto until = std::chrono::steady_clock::now() + 10s;
+       !got && std::chrono::steady_clock::now() < until;) {
+    ASSERT_TRUE(publisher.publish(studio_SERVICE_RUNNING, NodeHealth{}, m).has_value());
+    std::this_thread::sleep_for(50ms);
+    for (auto& s : reader.take()) {
+      if (!s.meta.valid_data || std::string(s.data->service) != "gauges") continue;
+      got = true;
+      for (const auto& c : wire::view(s.data->counters)) {
+        if (std::string(c.name) == "finite") finite = c.value;
+        else ++others;
+      }
+    }
+  }
+  ASSERT_TRUE(got) << "the status was refused";
+  EXPECT_EQ(finite, 7);
+  EXPECT_EQ(others, 0);
+}
+
 TEST_F(ServiceTest, KilledServiceLosesLivelinessWhenItsLeaseExpires) {
   auto participant = wire::Participant::create().value();
   auto topic = wire::Topic<studio_ServiceStatus>::create(participant).value();

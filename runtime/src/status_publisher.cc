@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "wire/sample.h"
 
@@ -47,8 +48,10 @@ Expected<void> StatusPublisher::publish(studio_ServiceState state, const NodeHea
   s->latency_ms = metrics.latency_mean_ms;
   std::vector<studio_Counter> counters;
   // Totals as they are, rates as "<name>_hz"; the IDL bounds the list at 64.
+  // A gauge that is not finite (an unbounded allowance, a ratio before its first sample) is left
+  // out: the readers validate every value, and one would refuse the whole status.
   auto add = [&](const std::string& name, double value) {
-    if (counters.size() >= 64) return;
+    if (counters.size() >= 64 || !std::isfinite(value)) return;
     studio_Counter c{};
     set_clipped(c.name, name);
     c.value = value;
