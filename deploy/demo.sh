@@ -133,6 +133,14 @@ if [ "$keyer" = separate ]; then
   sed -i 's|^keyer: \.\./keyer\.yaml|keyer: keyer.yaml|' "$cfg"/keyer-keyer*.yaml
 fi
 sed -i "s|^takes_dir: .*|takes_dir: $out/takes|" "$cfg"/capture-cam*.yaml
+# The simulated cameras' clock starts with this run (its epoch a second ago, every camera and the
+# probe reading the same configs): the simulated actor's motion (sim/'s sequence: a 16 s cycle
+# while it walks round a circle) is then at the same phase in every run's window, so runs can be
+# compared. With the examples' epoch 0 the phase followed the wall clock: runs a minute and a
+# half apart saw the actor in different places (in the projector's view 8 000 px in one run and
+# 27 000 in the next; BENCHMARKS.md, demo, session 14).
+epoch_ns=$((($(date +%s) - 1) * 1000000000))
+sed -i "s|^clock: {fps: \([0-9.]*\), epoch_ns: 0}|clock: {fps: \1, epoch_ns: $epoch_ns}|" "$cfg"/capture-cam*.yaml
 # The scene server: the demo scene of this build tree (installed: /usr/share/studio/scene), its
 # persisted state under $out/scene (fresh each run: the scene starts from the file).
 if [ -f "$cfg/scene.yaml" ]; then
