@@ -50,6 +50,7 @@ Expected<SweepResult> margin_sweep(const SweepOptions& o, bool progress) {
 
   projector::MaskPlannerOptions po;
   po.initial_latency_s = o.latency_s;  // never replaced: shown() is not called
+  if (o.outline) po.grow.projector = proj;
   projector::MaskPlanner planner(po);
   SweepResult r;
   r.options = o;

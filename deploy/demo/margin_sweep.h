@@ -29,6 +29,9 @@ struct SweepOptions {
   int first_frame = 25;
   int frames = 100;
   int grid = 160;  // hull columns per side, as hull.yaml
+  // The mask's growth, as the projector node's mask_growth: true = outline (its default), false
+  // = the vertex push.
+  bool outline = true;
   Eigen::Vector3d box_min{-1.5, 0, -1.5}, box_max{1.5, 2.4, 1.5};
   std::vector<double> margins_m{0,    0.005, 0.01, 0.015, 0.02, 0.025, 0.03,
                                 0.04, 0.05,  0.06, 0.08,  0.1,  0.12};

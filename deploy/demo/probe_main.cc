@@ -43,7 +43,8 @@ constexpr const char* kUsage = R"(usage: studio-demo-probe watch --capture FILE.
        studio-demo-probe rig   (--from RIG | --published --capture FILE...) [--cameras ID,...] --out FILE
        studio-demo-probe score --rig RIG --meshes DIR [--out FILE]
        studio-demo-probe sweep --rig RIG --latency-ms L [--projectors RIG --projector ID]
-                               [--frames N] [--grid N] [--display-lag S] [--out FILE] [--png PNG]
+                               [--frames N] [--grid N] [--display-lag S] [--mask-growth G]
+                               [--out FILE] [--png PNG]
 
 The demo's measuring instrument (deploy/demo.sh runs it; not a service). It joins the studio's
 DDS domain ($STUDIO_DDS_DOMAIN, profile $CYCLONEDDS_URI) like any subscriber.
@@ -91,7 +92,8 @@ sweep   the projector mask's margin sweep, offline (margin_sweep.h): the simulat
         lit-actor and
         wasted pixels against the true actor, the mesh drawn --latency-ms after its capture
         (the demo passes its live motion-to-photon p99) and shown --display-lag later (0.016).
-        --frames N (default 100) scored frames. JSON: both curves and needed_margin_m (the
+        --frames N (default 100) scored frames; --mask-growth outline|push (default
+        outline, as the projector's mask_growth). JSON: both curves and needed_margin_m (the
         smallest margin with 0 lit pixels); --png: the plot.
 Exit status: 0 done; 1 the pipeline delivered nothing / the take did not complete; 2 bad
 arguments or setup error (one line on stderr).
@@ -298,9 +300,14 @@ int sweep(const Args& a) {
   o.frames = int(*frames);
   o.grid = int(*grid);
   o.display_lag_s = *lag;
+  if (const std::string g = opt(a, "mask-growth"); !g.empty()) {
+    if (g != "outline" && g != "push")
+      return usage_error("sweep: --mask-growth '" + g + "' (expected outline or push)");
+    o.outline = g == "outline";
+  }
   for (const auto& [k, v] : a.opts)
     if (k != "rig" && k != "projectors" && k != "projector" && k != "latency-ms" && k != "frames" &&
-        k != "grid" && k != "display-lag" && k != "out" && k != "png")
+        k != "grid" && k != "display-lag" && k != "out" && k != "png" && k != "mask-growth")
       return usage_error("sweep: unknown option --" + k);
   auto r = demo::margin_sweep(o, !a.quiet);
   if (!r) return usage_error(r.error().message);

@@ -34,7 +34,7 @@ MaskPlannerOptions ProjectorNodeOptions::mask_options() const {
   m.initial_latency_s = latency.initial;
   m.parallel_mesh_work = parallel_mesh_work;
   m.grow.presimplify = mask_presimplify;
-  return m;
+  return m;  // the outline's viewpoint is the projector's: set by the node (mask_outline)
 }
 
 runtime::ServiceDefinition projector_service_definition() {
@@ -94,6 +94,12 @@ runtime::ServiceDefinition projector_service_definition() {
       "                            hull meshes; both errors x 1.5 added to the mask's push,\n"
       "                            so the mask is ~1 cm fatter); false: the edge\n"
       "                            collapse alone (projector/mask_geometry.h)\n"
+      "    mask_growth: outline    how the mask grows by the margin: outline = the mesh plus a\n"
+      "                            band of the margin's angular size round its silhouette as\n"
+      "                            this projector sees it (the margin ball's projection, no\n"
+      "                            more); push = every vertex moved out along its normal by\n"
+      "                            margin / cosine (up to 3.3 x the margin where a hull mesh's\n"
+      "                            normals spread: spikes of wasted black)\n"
       "    margin:                 the mask's security margin (projector/mask_margin.h)\n"
       "      floor: 0.01           metres, what motion does not explain (hull error, ...)\n"
       "      cap: 0.20             metres, largest margin (clamped and flagged above)\n"
@@ -199,6 +205,8 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("late_latch", &ProjectorNodeOptions::late_latch),
         yaml::field("parallel_mesh_work", &ProjectorNodeOptions::parallel_mesh_work),
         yaml::field("mask_presimplify", &ProjectorNodeOptions::mask_presimplify),
+        yaml::enum_field("mask_growth", &ProjectorNodeOptions::mask_outline,
+                         {{"outline", true}, {"push", false}}),
         yaml::field("margin", &ProjectorNodeOptions::margin, margin_schema),
         yaml::field("latency", &ProjectorNodeOptions::latency, latency_schema),
         yaml::field("scene_cache", &ProjectorNodeOptions::scene_cache, cache_schema),

@@ -39,7 +39,11 @@ class ProjectorNode : public runtime::Node {
         eye_(Eigen::Vector3d(options_.default_eye[0], options_.default_eye[1],
                              options_.default_eye[2]),
              options_.head_timeout_s),
-        planner_(options_.mask_options()),
+        planner_([&] {
+          MaskPlannerOptions m = options_.mask_options();
+          if (options_.mask_outline) m.grow.projector = projector.camera;
+          return m;
+        }()),
         loop_(ctx, kLog),
         stages_(loop_.metrics()),
         m_(loop_) {

@@ -70,6 +70,11 @@ struct ProjectorNodeOptions {
   bool parallel_mesh_work = true;
   // Hull meshes clustered before the edge collapse (GrowOptions::presimplify).
   bool mask_presimplify = true;
+  // How the mask grows by the margin: true = by its outline as this projector sees it (the mesh
+  // plus a band of the margin's angular radius round its silhouette: mask_geometry.h
+  // grow_outline); false = every vertex pushed out along its normal (margin / cosine, up to
+  // 3.3 x the margin: spikes where a hull mesh's normals spread).
+  bool mask_outline = true;
   MarginOptions margin;
   LatencyOptions latency;
   // The static scene rendered once and reused while it is unchanged and the eye stays within

@@ -189,7 +189,12 @@ TEST_F(ProjectorNodeTest, RendersTheSceneMasksTheActorAndReportsOverDds) {
   ASSERT_EQ(blackout.width(), 960);
   const Mask bm = blackout.to_mask();
   const cv::Mat got_mask(bm.height(), bm.width(), CV_8UC1, const_cast<uint8_t*>(bm.data()));
-  const cv::Mat want = expected_mask(projector.camera, grow_mesh(actor, f.margin_m).value());
+  // The node's default mask_growth: outline (mask_geometry.h grow_outline; its own tests check
+  // it against ray casting).
+  GrowOptions outline;
+  outline.projector = projector.camera;
+  const cv::Mat want =
+      expected_mask(projector.camera, grow_mask(MaskBase{actor, 0, {}}, f.margin_m, outline).value());
   ASSERT_FALSE(want.empty());
   const double mask_iou = iou(got_mask, want);
   std::printf("frame %llu: latency %.1f ms, margin %.1f mm, blackout %d px, IoU %.4f\n",

@@ -293,7 +293,8 @@ void BM_SinglePassHold_720p(benchmark::State& s) { run(s, Work::single_pass_hold
 // The mask of a live-like hull mesh (the arm swing's, testing/hull_meshes.h, ~38k triangles)
 // simplified by GrowOptions max_triangles (arg 0) and cluster_factor (arg 1), as the late-latched
 // node draws it per frame at 720p: grown by arg 2 mm (+ the simplification's error; 200: the
-// margin's cap, where a starved projector's margin sits), drawn over the
+// margin's cap, where a starved projector's margin sits) — arg 3: 0 the vertex push, 1 the
+// outline (GrowOptions::projector, the node's default mask_growth) —, drawn over the
 // scene prepared ahead (outside the timing), finished and read back. Counters: triangles drawn,
 // the simplification's error (added to the margin) and the pixels blacked out.
 void BM_HullMask_720p(benchmark::State& state) {
@@ -310,6 +311,7 @@ void BM_HullMask_720p(benchmark::State& state) {
   projector::GrowOptions o;
   o.max_triangles = std::size_t(state.range(0));
   o.cluster_factor = std::size_t(state.range(1));
+  if (state.range(3)) o.projector = view->camera();  // the outline form
   const projector::MaskBase base = projector::simplify_for_mask(hull, o).value();
   Readback rb;
   std::vector<projector::ActorMesh> masks(1);
@@ -352,11 +354,14 @@ BENCHMARK(BM_SinglePassHold) OPTS->Arg(0)->Arg(1)->Arg(2);
 BENCHMARK(BM_TwoPassHold) OPTS->Arg(0)->Arg(1)->Arg(2);
 BENCHMARK(BM_SinglePassHold_720p) OPTS->Arg(0)->Arg(1)->Arg(2);
 BENCHMARK(BM_HullMask_720p)
-    ->Args({3000, 4, 30})
-    ->Args({12000, 1, 30})
-    ->Args({8000, 1, 30})
-    ->Args({3000, 4, 100})
-    ->Args({3000, 4, 200}) OPTS;
+    ->Args({3000, 4, 30, 0})
+    ->Args({12000, 1, 30, 0})
+    ->Args({8000, 1, 30, 0})
+    ->Args({3000, 4, 100, 0})
+    ->Args({3000, 4, 200, 0})
+    ->Args({3000, 4, 30, 1})
+    ->Args({3000, 4, 100, 1})
+    ->Args({3000, 4, 200, 1}) OPTS;
 }  // namespace
 
 BENCHMARK_MAIN();

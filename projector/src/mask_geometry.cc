@@ -116,6 +116,9 @@ Expected<ActorMesh> grow_mask(const MaskBase& base, double margin_m, const GrowO
     return fail("grow mask: margin must be >= 0");
   if (auto ok = check(options); !ok) return std::unexpected(ok.error());
   margin_m += base.error_m;
+  if (options.projector) {  // the outline form; the push where it cannot be made
+    if (auto outline = grow_outline(mesh, margin_m, *options.projector); outline) return outline;
+  }
   const std::vector<Eigen::Vector3f> normals = vertex_normals(mesh);
   std::vector<float> min_cos(mesh.vertices.size(), 1.0f);
   for (const auto& t : mesh.triangles) {
@@ -129,6 +132,216 @@ Expected<ActorMesh> grow_mask(const MaskBase& base, double margin_m, const GrowO
   for (size_t i = 0; i < out.vertices.size(); ++i) {
     const float c = std::max(min_cos[i], static_cast<float>(options.min_cosine));
     out.vertices[i] += normals[i] * static_cast<float>(margin_m / c);
+  }
+  return out;
+}
+
+namespace {
+
+// Squared Euclidean distance transform of one line (Felzenszwalb & Huttenlocher 2012, the lower
+// envelope of the parabolas of the finite values): f in, d out (n values; all infinite when f
+// is), v (n) and z (n + 1) scratch.
+void edt_1d(const double* f, double* d, int n, int* v, double* z) {
+  auto meet = [&](int q, int r) {
+    return ((f[q] + double(q) * q) - (f[r] + double(r) * r)) / (2.0 * (q - r));
+  };
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (!std::isfinite(f[q])) continue;
+    if (k < 0) {
+      k = 0;
+      v[0] = q;
+      z[0] = -INFINITY;
+      z[1] = INFINITY;
+      continue;
+    }
+    double s = meet(q, v[k]);
+    while (s <= z[k]) s = meet(q, v[--k]);  // z[0] = -inf ends it
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = INFINITY;
+  }
+  if (k < 0) {
+    std::fill(d, d + n, INFINITY);
+    return;
+  }
+  k = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[k + 1] < q) ++k;
+    const double dq = q - v[k];
+    d[q] = dq * dq + f[v[k]];
+  }
+}
+
+}  // namespace
+
+Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const Camera& projector,
+                                 int cell) {  // cell: the smallest cell size
+  if (auto v = mesh.validate(); !v) return std::unexpected(v.error());
+  if (!(margin_m >= 0) || !std::isfinite(margin_m)) return fail("grow mask: margin must be >= 0");
+  const Intrinsics& in = projector.intrinsics;
+  if (projector.width <= 0 || projector.height <= 0 || !(in.fx > 0) || !(in.fy > 0) || cell < 1 ||
+      cell > 16)
+    return fail("grow mask: the projector needs a size and focal lengths (cell 1..16)");
+  const Eigen::Matrix<double, 3, 4> P = projector.projection_matrix();
+  const Eigen::Matrix3d R = projector.cam_from_world.R();
+  const Eigen::Vector3d t = projector.cam_from_world.translation;
+  const Eigen::Vector3d centre = projector.centre_in_world();
+  // Pixels of the vertices; the nearest vertex's distance.
+  const std::size_t nv = mesh.vertices.size();
+  std::vector<Eigen::Vector2d> px(nv);
+  double d_min = INFINITY;
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY), hi = -lo;
+  for (std::size_t i = 0; i < nv; ++i) {
+    const Eigen::Vector3d x = mesh.vertices[i].cast<double>();
+    const Eigen::Vector3d h = P * x.homogeneous();
+    if (!(h.z() > 0.05)) return fail("grow mask: a mesh vertex is behind the projector's near plane");
+    px[i] = h.head<2>() / h.z();
+    lo = lo.cwiseMin(px[i]);
+    hi = hi.cwiseMax(px[i]);
+    d_min = std::min(d_min, (x - centre).norm());
+  }
+  if (!(d_min > 1.001 * margin_m))
+    return fail("grow mask: the projector is within the margin of the actor mesh");
+  const double a_max = std::asin(margin_m / d_min);
+  const double f_max = std::max(in.fx, in.fy), tan_a = std::tan(a_max);
+  const double cos_2a = std::cos(2 * a_max), sin_2a = std::sin(2 * a_max);
+  // rho at a pixel: f_max tan(a_max) / cos^2(theta + 2 a_max), theta its angle from the axis
+  // (cos(theta + b) = cos theta cos b - sin theta sin b, no trigonometry per cell).
+  auto rho_at = [&](double u, double v) {
+    const double x = (u - in.cx) / in.fx, y = (v - in.cy) / in.fy;
+    const double c = 1 / std::sqrt(1 + x * x + y * y), sn = std::sqrt(std::max(0.0, 1 - c * c));
+    const double cb = std::max(c * cos_2a - sn * sin_2a, 0.05);
+    return f_max * tan_a / (cb * cb);
+  };
+  // The largest radius the mask needs: at the image pixels near the mesh's image (only pixels
+  // of the image are drawn; a ball's centre is within a_max of the pixels it covers, which
+  // rho_at's 2 a_max allows for). Its bounding box grown by a first radius, clamped to the image;
+  // the stretch grows away from the axis, so the corners and the centre bound it.
+  double rho_max = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double g = rho_max;
+    const double u0 = std::clamp(lo.x() - g, -0.5, projector.width - 0.5),
+                 u1 = std::clamp(hi.x() + g, -0.5, projector.width - 0.5),
+                 v0 = std::clamp(lo.y() - g, -0.5, projector.height - 0.5),
+                 v1 = std::clamp(hi.y() + g, -0.5, projector.height - 0.5);
+    for (double u : {u0, u1, 0.5 * (u0 + u1)})
+      for (double v : {v0, v1, 0.5 * (v0 + v1)}) rho_max = std::max(rho_max, rho_at(u, v));
+  }
+  // Cells of about a tenth of the radius (2..4 px): the band's slack (a cell's diagonal, and
+  // the raster's conservative cell) stays a fraction of it, the grid small.
+  cell = std::clamp(int(rho_max / 10), cell, 4);
+  const double reach = rho_max + 2.0 * cell;
+  // The grid (fine pixel coordinates of its top-left corner; cell (i, j) covers
+  // [x0 + i cell, x0 + (i + 1) cell) x [y0 + j cell, ...)): the mesh's image and `reach` round
+  // it, clipped to the projector's image and `reach` round that.
+  const double x0 = std::floor(std::max(lo.x() - reach, -0.5 - reach));
+  const double y0 = std::floor(std::max(lo.y() - reach, -0.5 - reach));
+  const double x1 = std::min(hi.x() + reach, projector.width - 0.5 + reach);
+  const double y1 = std::min(hi.y() + reach, projector.height - 0.5 + reach);
+  ActorMesh out;
+  out.capture_ns = mesh.capture_ns;
+  if (!(x1 > x0 && y1 > y0)) return out;  // the mesh's image and the projector's do not meet
+  const int W = int(std::ceil((x1 - x0) / cell)), H = int(std::ceil((y1 - y0) / cell));
+  if (double(W) * H > 16e6) return fail("grow mask: the outline grid would be too large");
+  std::vector<double> f(std::size_t(W) * H, INFINITY);  // 0: set (the mesh's image)
+  const double half = 0.5 * cell;
+  auto set_point = [&](const Eigen::Vector2d& p) {
+    const int i = int(std::floor((p.x() - x0) / cell)), j = int(std::floor((p.y() - y0) / cell));
+    if (i >= 0 && j >= 0 && i < W && j < H) f[std::size_t(j) * W + i] = 0;
+  };
+  // 1. Conservative raster of every triangle.
+  for (const auto& tri : mesh.triangles) {
+    const Eigen::Vector2d &a = px[tri[0]], &b = px[tri[1]], &c = px[tri[2]];
+    const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    const double scale = (b - a).squaredNorm() + (c - a).squaredNorm() + 1e-300;
+    if (std::abs(area) <= 1e-9 * scale) {  // edge-on: its image is its edges
+      for (const auto& [p, q] : {std::pair{&a, &b}, std::pair{&b, &c}, std::pair{&c, &a}}) {
+        const int steps = int(std::ceil((*q - *p).norm() / half)) + 1;
+        for (int k = 0; k <= steps; ++k) set_point(*p + (*q - *p) * (double(k) / steps));
+      }
+      continue;
+    }
+    const double sign = area > 0 ? 1 : -1;
+    // Edge functions e(p) = n . p + k, >= 0 inside; a cell overlaps the half-plane when e at its
+    // centre + half (|n.x| + |n.y|) >= 0.
+    std::array<Eigen::Vector3d, 3> e;
+    const std::array<const Eigen::Vector2d*, 3> v{&a, &b, &c};
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d& p = *v[k];
+      const Eigen::Vector2d& q = *v[(k + 1) % 3];
+      const Eigen::Vector2d n = sign * Eigen::Vector2d(p.y() - q.y(), q.x() - p.x());
+      e[k] = {n.x(), n.y(), -n.dot(p)};
+    }
+    const Eigen::Vector2d tlo = a.cwiseMin(b).cwiseMin(c), thi = a.cwiseMax(b).cwiseMax(c);
+    const int i0 = std::max(0, int(std::floor((tlo.x() - x0) / cell)));
+    const int i1 = std::min(W - 1, int(std::floor((thi.x() - x0) / cell)));
+    const int j0 = std::max(0, int(std::floor((tlo.y() - y0) / cell)));
+    const int j1 = std::min(H - 1, int(std::floor((thi.y() - y0) / cell)));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const double u = x0 + (i + 0.5) * cell, w = y0 + (j + 0.5) * cell;
+        bool inside = true;
+        for (int k = 0; k < 3 && inside; ++k)
+          inside = e[k].x() * u + e[k].y() * w + e[k].z() +
+                       half * (std::abs(e[k].x()) + std::abs(e[k].y())) >=
+                   0;
+        if (inside) f[std::size_t(j) * W + i] = 0;
+      }
+  }
+  // 2. Squared distances (in cells) to the nearest set cell: columns, then rows.
+  const int n = std::max(W, H);
+  std::vector<double> line(n), dist(n), z(n + 1);
+  std::vector<int> vv(n);
+  for (int i = 0; i < W; ++i) {
+    for (int j = 0; j < H; ++j) line[j] = f[std::size_t(j) * W + i];
+    edt_1d(line.data(), dist.data(), H, vv.data(), z.data());
+    for (int j = 0; j < H; ++j) f[std::size_t(j) * W + i] = dist[j];
+  }
+  for (int j = 0; j < H; ++j) {
+    double* row = f.data() + std::size_t(j) * W;
+    std::copy(row, row + W, line.begin());
+    edt_1d(line.data(), row, W, vv.data(), z.data());
+  }
+  // 3-4. The mask's cells, each row's runs as quads 1 m in front of the projector.
+  const Eigen::Matrix3d K_inv = in.K().inverse();
+  const Eigen::Matrix3d R_t = R.transpose();
+  auto at_pixel = [&](double u, double v) {
+    const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(u, v, 1);  // z = 1 in the camera frame
+    out.vertices.push_back((R_t * (ray / ray.z() - t)).cast<float>());
+    return static_cast<uint32_t>(out.vertices.size() - 1);
+  };
+  const double slack = std::sqrt(2.0) * cell;
+  for (int j = 0; j < H; ++j) {
+    const double vc = y0 + (j + 0.5) * cell;
+    if (vc + half < -0.5 || vc - half > projector.height - 0.5) continue;  // outside the image
+    const double* row = f.data() + std::size_t(j) * W;
+    int i = 0;
+    while (i < W) {
+      auto in_mask = [&](int k) {
+        if (!(row[k] * cell * cell <= (rho_max + slack) * (rho_max + slack))) return false;
+        const double r = rho_at(x0 + (k + 0.5) * cell, vc) + slack;
+        return row[k] * cell * cell <= r * r;
+      };
+      if (!in_mask(i)) {
+        ++i;
+        continue;
+      }
+      int k = i;
+      while (k < W && in_mask(k)) ++k;
+      const double u0 = std::max(x0 + i * cell - 0.5, -1.0);
+      const double u1 = std::min(x0 + k * cell + 0.5, projector.width + 0.0);
+      const double v0 = std::max(y0 + j * cell - 0.5, -1.0);
+      const double v1 = std::min(y0 + (j + 1) * cell + 0.5, projector.height + 0.0);
+      if (u1 > u0 && v1 > v0) {
+        const uint32_t q0 = at_pixel(u0, v0), q1 = at_pixel(u1, v0), q2 = at_pixel(u1, v1),
+                       q3 = at_pixel(u0, v1);
+        out.triangles.push_back({q0, q1, q2});
+        out.triangles.push_back({q0, q2, q3});
+      }
+      i = k;
+    }
   }
   return out;
 }

@@ -15,8 +15,10 @@
 //   the projector's larger focal length and z_min the nearest mesh vertex's depth in the projector
 //   frame (conservative: the radius of the nearest part, applied everywhere).
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/camera.h"
@@ -47,6 +49,9 @@ struct GrowOptions {
   // tessellated swing (test TwoStageSimplification...: 178-226 points 5 cm out inside it, not
   // 148-152).
   std::size_t cluster_factor = 4;
+  // The projector the mask is drawn by: grow_mask() then grows the mask in that projector's
+  // image (grow_outline below) instead of pushing the vertices out. None: the vertex push.
+  std::optional<Camera> projector;
 };
 
 // Errors: invalid mesh, negative or non-finite margin. = grow_mask(simplify_for_mask(mesh)).
@@ -66,10 +71,35 @@ struct MaskBase {
 };
 // Errors: invalid mesh or options.
 Expected<MaskBase> simplify_for_mask(const ActorMesh& mesh, const GrowOptions& options = {});
-// Every vertex pushed out by (margin + base.error_m) / c (see above); no further simplification.
-// Errors: invalid mesh, negative or non-finite margin, invalid options.
+// Every vertex pushed out by (margin + base.error_m) / c (see above), or with
+// GrowOptions::projector the outline form (falling back to the push where it cannot be made); no
+// further simplification. Errors: invalid mesh, negative or non-finite margin, invalid options.
 Expected<ActorMesh> grow_mask(const MaskBase& base, double margin_m,
                               const GrowOptions& options = {});
+
+// The outline form (GrowOptions::projector): what a projector must black out is the projection
+// of the mesh grown by the margin m in every direction (its Minkowski sum with a ball), and a
+// ball of radius m at distance d from the projector's centre is seen within the angle
+// a = asin(m / d) of its centre's ray. So the mask is made in the projector's image (its
+// distortion-free pinhole, as the renderer draws it), on a grid of `cell` x `cell` pixels over the
+// mesh's image grown by the radius (clipped to the image and that radius round it):
+//   1. conservative raster: a cell is set when any triangle's projection overlaps it;
+//   2. exact Euclidean distance transform (Felzenszwalb & Huttenlocher) of the set cells;
+//   3. a cell joins the mask when the distance between its centre and a set cell's is at most
+//      rho + sqrt(2) cell, rho = f_max tan(a_max) / cos^2(theta + 2 a_max): f_max the larger
+//      focal length, a_max the angle for the nearest vertex, theta the cell's angle from the
+//      optical axis (a pinhole stretches angles by up to 1 / cos^2 there);
+//   4. each row's runs of mask cells become quads (0.5 px wider each side), placed 1 m in front
+//      of the projector on the rays of their corners, so drawn from the projector they cover
+//      exactly those pixels.
+// Every pixel within rho of the mesh's projection is covered, so the actor grown by the margin
+// is; the black reaches at most rho + ~2 cells beyond the outline where the vertex push reaches
+// margin / cosine along averaged normals (up to 3.3 x the margin: spikes). Errors: invalid
+// mesh or margin, a vertex closer to the projector's centre than the margin or behind its near
+// plane (5 cm), a projector without a valid size or focal lengths; grow_mask() then falls back to
+// the vertex push, which has none of these limits.
+Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const Camera& projector,
+                                 int cell = 2);
 
 // Errors: invalid mesh, negative margin, no vertex in front of the projector.
 Expected<double> dilation_radius_px(const Camera& projector, const ActorMesh& mesh,
