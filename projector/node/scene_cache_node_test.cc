@@ -50,6 +50,37 @@ std::optional<double> red_column(const studio_ProjectorFrame& f) {
   return sum / n / f.thumb_width;
 }
 
+// The test's side of the wire: the projector's status and frames in, scene nodes and the
+// followed head out.
+struct Wires {
+  wire::Participant p = wire::Participant::create().value();
+  wire::Topic<studio_ServiceStatus> status_topic =
+      wire::Topic<studio_ServiceStatus>::create(p).value();
+  wire::Reader<studio_ServiceStatus> status =
+      wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
+  wire::Topic<studio_ProjectorFrame> frame_topic =
+      wire::Topic<studio_ProjectorFrame>::create(p).value();
+  wire::Reader<studio_ProjectorFrame> frames =
+      wire::Reader<studio_ProjectorFrame>::create(p, frame_topic).value();
+  wire::Topic<studio_SceneNode> node_topic = wire::Topic<studio_SceneNode>::create(p).value();
+  wire::Writer<studio_SceneNode> nodes = wire::Writer<studio_SceneNode>::create(p, node_topic).value();
+  wire::Topic<studio_HeadPose> head_topic = wire::Topic<studio_HeadPose>::create(p).value();
+  wire::Writer<studio_HeadPose> heads = wire::Writer<studio_HeadPose>::create(p, head_topic).value();
+
+  bool node(const scene::Node& n) {
+    wire::Owned<studio_SceneNode> s;
+    return wire::from_core(n, *s).has_value() && nodes.write(*s).has_value();
+  }
+  bool head(const Eigen::Vector3d& eye) {
+    wire::Owned<studio_HeadPose> h;
+    wire::set(h->actor_id, "actor");
+    h->capture_ns = realtime_ns();
+    for (int i = 0; i < 3; ++i) h->position[i] = eye[i];
+    h->confidence = 1;
+    return heads.write(*h).has_value();
+  }
+};
+
 class SceneCacheNodeTest : public studio::testing::ProcessTest {
  protected:
   struct Counts {
@@ -89,29 +120,20 @@ class SceneCacheNodeTest : public studio::testing::ProcessTest {
     auto& node = spawn("projector", "projector/studio-projector",
                        {"--config", config(true, hold_frames)});
     EXPECT_TRUE(node.wait_ready(30s)) << node.log();
-    auto p = wire::Participant::create().value();
-    auto status_topic = wire::Topic<studio_ServiceStatus>::create(p).value();
-    auto status = wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
-    auto node_topic = wire::Topic<studio_SceneNode>::create(p).value();
-    auto nodes = wire::Writer<studio_SceneNode>::create(p, node_topic).value();
-    auto head_topic = wire::Topic<studio_HeadPose>::create(p).value();
-    auto heads = wire::Writer<studio_HeadPose>::create(p, head_topic).value();
-    EXPECT_TRUE(nodes.wait_for_readers(1, 10s));
-    for (const auto& [id, n] : scene_.nodes()) {
-      wire::Owned<studio_SceneNode> s;
-      EXPECT_TRUE(wire::from_core(n, *s).has_value());
-      EXPECT_TRUE(nodes.write(*s).has_value());
-    }
+    Wires w;
+    auto& status = w.status;
+    EXPECT_TRUE(w.nodes.wait_for_readers(1, 10s));
+    for (const auto& [id, n] : scene_.nodes()) EXPECT_TRUE(w.node(n));
     auto latest = [&] {
-      Walk w;
-      for (auto until = SteadyClock::now() + 5s; w.held < 0 && SteadyClock::now() < until;) {
+      Walk got;
+      for (auto until = SteadyClock::now() + 5s; got.held < 0 && SteadyClock::now() < until;) {
         for (auto& s : status.take())
           if (s.meta.valid_data && std::string(s.data->service) == "projector")
-            w = {counter(*s.data, "frames_held"), counter(*s.data, "scene_rerendered"),
-                 counter(*s.data, "frames_from_cache"), counter(*s.data, "scene_held_shift_px")};
+            got = {counter(*s.data, "frames_held"), counter(*s.data, "scene_rerendered"),
+                   counter(*s.data, "frames_from_cache"), counter(*s.data, "scene_held_shift_px")};
         std::this_thread::sleep_for(20ms);
       }
-      return w;
+      return got;
     };
     Walk start;
     for (int k = 0; k < 60; ++k) {
@@ -119,13 +141,7 @@ class SceneCacheNodeTest : public studio::testing::ProcessTest {
         (void)status.take();
         start = latest();
       }
-      wire::Owned<studio_HeadPose> h;
-      wire::set(h->actor_id, "actor");
-      h->capture_ns = realtime_ns();
-      const Eigen::Vector3d eye(-0.3 + 0.005 * k, 1.65, 1.2);
-      for (int i = 0; i < 3; ++i) h->position[i] = eye[i];
-      h->confidence = 1;
-      EXPECT_TRUE(heads.write(*h).has_value());
+      EXPECT_TRUE(w.head(Eigen::Vector3d(-0.3 + 0.005 * k, 1.65, 1.2)));
       std::this_thread::sleep_for(50ms);
     }
     (void)status.take();
@@ -140,32 +156,19 @@ class SceneCacheNodeTest : public studio::testing::ProcessTest {
   void run(bool enabled, Counts& still_start, Counts& still_end, Counts& moved, int& shown_right) {
     auto& node = spawn("projector", "projector/studio-projector", {"--config", config(enabled)});
     ASSERT_TRUE(node.wait_ready(30s)) << node.log();
-    auto p = wire::Participant::create().value();
-    auto frame_topic = wire::Topic<studio_ProjectorFrame>::create(p).value();
-    auto frames = wire::Reader<studio_ProjectorFrame>::create(p, frame_topic).value();
-    auto status_topic = wire::Topic<studio_ServiceStatus>::create(p).value();
-    auto status = wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
-    auto node_topic = wire::Topic<studio_SceneNode>::create(p).value();
-    auto nodes = wire::Writer<studio_SceneNode>::create(p, node_topic).value();
-    auto head_topic = wire::Topic<studio_HeadPose>::create(p).value();
-    auto heads = wire::Writer<studio_HeadPose>::create(p, head_topic).value();
-    ASSERT_TRUE(nodes.wait_for_readers(1, 10s));
+    Wires w;
+    auto& frames = w.frames;
+    auto& status = w.status;
+    ASSERT_TRUE(w.nodes.wait_for_readers(1, 10s));
     const scene::Node* flyer = nullptr;
     for (const auto& [id, n] : scene_.nodes()) {
-      wire::Owned<studio_SceneNode> s;
-      ASSERT_TRUE(wire::from_core(n, *s).has_value());
-      ASSERT_TRUE(nodes.write(*s).has_value());
+      ASSERT_TRUE(w.node(n));
       if (id.ends_with("flyer")) flyer = &n;
     }
     ASSERT_TRUE(flyer);
     Eigen::Vector3d eye(0.1, 1.65, 1.2);
     auto publish = [&](double probe_x) {
-      wire::Owned<studio_HeadPose> h;
-      wire::set(h->actor_id, "actor");
-      h->capture_ns = realtime_ns();
-      for (int i = 0; i < 3; ++i) h->position[i] = eye[i];
-      h->confidence = 1;
-      ASSERT_TRUE(heads.write(*h).has_value());
+      ASSERT_TRUE(w.head(eye));
       scene::Node probe = *flyer;  // wings facing the eye, 1 m behind the screen
       probe.id = "probe";
       probe.parent = "";
@@ -173,9 +176,7 @@ class SceneCacheNodeTest : public studio::testing::ProcessTest {
       probe.local.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());
       probe.material.colour = {1, 0, 0, 1};
       probe.material.high_contrast = true;
-      wire::Owned<studio_SceneNode> s;
-      ASSERT_TRUE(wire::from_core(probe, *s).has_value());
-      ASSERT_TRUE(nodes.write(*s).has_value());
+      ASSERT_TRUE(w.node(probe));
     };
     auto counts = [&] {
       Counts c;
