@@ -1,7 +1,8 @@
 #pragma once
 // The grown actor mask as geometry a renderer draws (TCSVT 2004 §V-D: the actor mesh rendered
 // black from the projector's viewpoint with no depth test, enlarged by the security margin).
-// Two forms, same margin:
+// Growing by the margin, in two forms (GrowOptions::projector chooses; the projector node's
+// mask_growth, default outline), and a radius:
 // - grow_mesh(): every vertex pushed out along its area-weighted normal by margin / c, where c is
 //   the smallest cosine between the vertex normal and the normals of its triangles (clamped at
 //   min_cosine), so every triangle's plane moves out by at least the margin, also at the box-like
@@ -10,6 +11,9 @@
 //   dense hull mesh does not become thousands of margin-sized triangles drawn over one another.
 //   Draw it like the mesh (no depth test, black, both faces). Self-overlaps in concave places are
 //   harmless: the mask is a union.
+// - grow_outline() (below): the mesh's image in one projector grown by the margin ball's
+//   projected radius, drawn as quads; covers the margin, not the push's spikes (about half the
+//   black at the demo's margins: BENCHMARKS.md, demo, session 14).
 // - dilation_radius_px(): the margin as a screen-space radius in projector pixels, for a renderer
 //   that dilates the mesh's silhouette (a max filter or a wide outline): margin * f / z_min with f
 //   the projector's larger focal length and z_min the nearest mesh vertex's depth in the projector
@@ -81,8 +85,9 @@ Expected<ActorMesh> grow_mask(const MaskBase& base, double margin_m,
 // of the mesh grown by the margin m in every direction (its Minkowski sum with a ball), and a
 // ball of radius m at distance d from the projector's centre is seen within the angle
 // a = asin(m / d) of its centre's ray. So the mask is made in the projector's image (its
-// distortion-free pinhole, as the renderer draws it), on a grid of `cell` x `cell` pixels over the
-// mesh's image grown by the radius (clipped to the image and that radius round it):
+// distortion-free pinhole, as the renderer draws it), on a grid of square cells of about a tenth
+// of the radius (2..4 px; `cell` the smallest) over the mesh's image grown by the radius
+// (clipped to the image and that radius round it):
 //   1. conservative raster: a cell is set when any triangle's projection overlaps it;
 //   2. exact Euclidean distance transform (Felzenszwalb & Huttenlocher) of the set cells;
 //   3. a cell joins the mask when the distance between its centre and a set cell's is at most
