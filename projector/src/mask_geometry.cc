@@ -217,10 +217,11 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
   };
   // The largest radius the mask needs: at the image pixels near the mesh's image (only pixels
   // of the image are drawn; a ball's centre is within a_max of the pixels it covers, which
-  // rho_at's 2 a_max allows for). Its bounding box grown by a first radius, clamped to the image;
-  // the stretch grows away from the axis, so the corners and the centre bound it.
+  // rho_at's 2 a_max allows for): over its bounding box grown by the radius itself, clamped to
+  // the image, until the radius stops growing (the stretch grows away from the axis, so a
+  // rectangle's corners and centre bound it).
   double rho_max = 0;
-  for (int pass = 0; pass < 2; ++pass) {
+  for (int pass = 0; pass < 8; ++pass) {
     const double g = rho_max;
     const double u0 = std::clamp(lo.x() - g, -0.5, projector.width - 0.5),
                  u1 = std::clamp(hi.x() + g, -0.5, projector.width - 0.5),
@@ -228,6 +229,7 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
                  v1 = std::clamp(hi.y() + g, -0.5, projector.height - 0.5);
     for (double u : {u0, u1, 0.5 * (u0 + u1)})
       for (double v : {v0, v1, 0.5 * (v0 + v1)}) rho_max = std::max(rho_max, rho_at(u, v));
+    if (rho_max <= g + 0.25) break;
   }
   // Cells of about a tenth of the radius (2..4 px): the band's slack (a cell's diagonal, and
   // the raster's conservative cell) stays a fraction of it, the grid small.
