@@ -164,7 +164,7 @@ TEST(MaskOutline, CoversLessThanTheVertexPushAndCloseToTheIdealMask) {
       const Eigen::Vector3d z = (centre - eye).normalized(), x = z.unitOrthogonal(),
                             y = z.cross(x);
       const double half_angle = std::atan(1.6 / (centre - eye).norm());
-      const int n = 90;
+      const int n = 60;
       int in_outline = 0, in_push = 0, in_ideal = 0, ideal_not_outline = 0;
       for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
