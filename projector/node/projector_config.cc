@@ -34,7 +34,7 @@ MaskPlannerOptions ProjectorNodeOptions::mask_options() const {
   m.initial_latency_s = latency.initial;
   m.parallel_mesh_work = parallel_mesh_work;
   m.grow.presimplify = mask_presimplify;
-  return m;  // the outline's viewpoint is the projector's: set by the node (mask_outline)
+  return m;  // the outline's projector (mask_outline): set by the node, which holds it
 }
 
 runtime::ServiceDefinition projector_service_definition() {
