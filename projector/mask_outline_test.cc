@@ -8,7 +8,9 @@
 // - tight: seen from the viewpoint, the outline mask covers every ray that passes within the
 //   margin of the surface (the ideal mask) and at most 1.3x as many; fewer than the vertex push
 //   (grow_mask without a viewpoint) of the same margin on shapes with edges and corners (a hull
-//   mesh's), within 25 % of it on a smooth sphere (the band's cell slack).
+//   mesh's), within 25 % of it on a smooth sphere (the band's cell slack);
+// - whole: the outline form grows the mesh as it is (a dense one too: tighter than from its
+//   simplification), and its push fallback simplifies it first.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -143,7 +145,9 @@ TEST(MaskOutline, EveryRayWithinTheMarginOfTheActorMeetsTheMask) {
         EXPECT_EQ(missed, 0) << c.name << " margin " << margin << " eye " << eye.transpose();
         EXPECT_GT(bare_missed, 0) << c.name << " margin " << margin;
         // (At 2 cm the band's cell slack, ~5 px, is most of a quarter margin.)
-        if (margin > 0.1) EXPECT_GT(quarter_missed, 0) << c.name << " margin " << margin;
+        if (margin > 0.1) {
+          EXPECT_GT(quarter_missed, 0) << c.name << " margin " << margin;
+        }
       }
     }
   }
@@ -222,6 +226,70 @@ TEST(MaskOutline, RefusesWhatItCannotMaskAndGrowMaskFallsBackToThePush) {
   const Camera away = projector_at({0, 1, 3}, {0, 1, 6});
   auto none = grow_outline(box({0, 1, 0}, {0.2, 0.3, 0.1}, 2), 0.05, away);
   EXPECT_FALSE(none);  // behind its near plane
+}
+
+TEST(MaskOutline, GrowsTheWholeMeshAndTheFallbackPushSimplifiesIt) {
+  // A hull-like dense mesh: the outline form keeps every triangle (no simplifier error in the
+  // margin), so its mask is tighter than the outline of the simplified mesh and still covers
+  // every ray within the margin; simplify_outline restores the simplification.
+  const ActorMesh dense = sphere({0, 1.2, 0}, 0.3, Eigen::Matrix3d::Identity(), 72, 144);
+  ASSERT_GT(dense.triangles.size(), 4 * GrowOptions{}.max_triangles);
+  const Eigen::Vector3d eye = kViewpoints[0];
+  Camera cam = projector_at(eye, {0, 1.2, 0});
+  cam.intrinsics.cx = 639.5;
+  cam.intrinsics.cy = 359.5;
+  GrowOptions whole, simplified;
+  whole.projector = simplified.projector = cam;
+  simplified.simplify_outline = true;
+  auto a = simplify_for_mask(dense, whole);
+  auto b = simplify_for_mask(dense, simplified);
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(a->mesh.triangles, dense.triangles);
+  EXPECT_EQ(a->mesh.vertices, dense.vertices);
+  EXPECT_EQ(a->error_m, 0);
+  EXPECT_LE(b->mesh.triangles.size(), GrowOptions{}.max_triangles);
+  EXPECT_GT(b->error_m, 0);
+  const double margin = 0.03;
+  auto mask_whole = grow_mask(*a, margin, whole);
+  auto mask_simplified = grow_mask(*b, margin, simplified);
+  ASSERT_TRUE(mask_whole && mask_simplified);
+  const Eigen::Vector3d z = (Eigen::Vector3d(0, 1.2, 0) - eye).normalized(),
+                        x = z.unitOrthogonal(), y = z.cross(x);
+  const double half_angle = std::atan(0.45 / (Eigen::Vector3d(0, 1.2, 0) - eye).norm());
+  const int n = 40;
+  int in_whole = 0, in_simplified = 0, ideal_missed = 0, ideal = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector3d d = (z + std::tan(half_angle * (2.0 * (i + 0.5) / n - 1)) * x +
+                                 std::tan(half_angle * (2.0 * (j + 0.5) / n - 1)) * y)
+                                    .normalized();
+      const bool w = hits(*mask_whole, eye, d);
+      in_whole += w;
+      in_simplified += hits(*mask_simplified, eye, d);
+      // The sphere grown by the margin, exactly: the ray passes within 0.33 m of the centre.
+      if (ray_to_point(eye, d, {0, 1.2, 0}) < 0.3 + margin) {
+        ++ideal;
+        ideal_missed += !w;
+      }
+    }
+  std::printf("rays covered: whole mesh %d, simplified %d, ideal %d\n", in_whole, in_simplified,
+              ideal);
+  EXPECT_EQ(ideal_missed, 0);
+  EXPECT_LT(in_whole, in_simplified);
+  // Where the outline cannot be made (the projector inside the margin), the push falls back to
+  // the simplified mesh, exactly as grow_mask() without a projector would draw it.
+  const Camera inside = projector_at({0, 1.2, 0.32}, {0, 1.2, -1});
+  GrowOptions fallback = whole;
+  fallback.projector = inside;
+  auto c = simplify_for_mask(dense, fallback);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->mesh.triangles.size(), dense.triangles.size());
+  auto pushed = grow_mask(*c, 0.05, fallback);
+  auto reference = grow_mesh(dense, 0.05);
+  ASSERT_TRUE(pushed && reference);
+  EXPECT_LE(pushed->triangles.size(), GrowOptions{}.max_triangles);
+  EXPECT_EQ(pushed->vertices, reference->vertices);
+  EXPECT_EQ(pushed->triangles, reference->triangles);
 }
 
 }  // namespace

@@ -294,7 +294,9 @@ void BM_SinglePassHold_720p(benchmark::State& s) { run(s, Work::single_pass_hold
 // simplified by GrowOptions max_triangles (arg 0) and cluster_factor (arg 1), as the late-latched
 // node draws it per frame at 720p: grown by arg 2 mm (+ the simplification's error; 200: the
 // margin's cap, where a starved projector's margin sits) — arg 3: 0 the vertex push, 1 the
-// outline (GrowOptions::projector, the node's default mask_growth) —, drawn over the
+// outline (GrowOptions::projector, the node's default mask_growth) from the whole mesh (its
+// default: args 0 and 1 then do nothing), 2 the outline from the simplified mesh
+// (GrowOptions::simplify_outline, the baseline) —, drawn over the
 // scene prepared ahead (outside the timing), finished and read back. Counters: triangles drawn,
 // the simplification's error (added to the margin) and the pixels blacked out.
 void BM_HullMask_720p(benchmark::State& state) {
@@ -312,6 +314,7 @@ void BM_HullMask_720p(benchmark::State& state) {
   o.max_triangles = std::size_t(state.range(0));
   o.cluster_factor = std::size_t(state.range(1));
   if (state.range(3)) o.projector = view->camera();  // the outline form
+  o.simplify_outline = state.range(3) == 2;
   const projector::MaskBase base = projector::simplify_for_mask(hull, o).value();
   Readback rb;
   std::vector<projector::ActorMesh> masks(1);
@@ -359,6 +362,9 @@ BENCHMARK(BM_HullMask_720p)
     ->Args({8000, 1, 30, 0})
     ->Args({3000, 4, 100, 0})
     ->Args({3000, 4, 200, 0})
+    ->Args({3000, 4, 30, 2})
+    ->Args({3000, 4, 100, 2})
+    ->Args({3000, 4, 200, 2})
     ->Args({3000, 4, 30, 1})
     ->Args({3000, 4, 100, 1})
     ->Args({3000, 4, 200, 1}) OPTS;

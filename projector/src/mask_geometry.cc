@@ -103,7 +103,11 @@ Expected<MaskBase> simplify_for_mask(const ActorMesh& input, const GrowOptions& 
   // Fewer, larger triangles first: pushed out by the margin, each small triangle of a hull mesh
   // grows to the margin's size, and a renderer rasterises all of them over one another. The
   // simplification's error is added to the push, so the mask still covers the mesh.
-  auto [mesh, error_m] = simplified(input, options);
+  // The outline form rasterises the mesh in the projector's image: whole is cheaper and tighter
+  // (GrowOptions::simplify_outline).
+  auto [mesh, error_m] = options.projector && !options.simplify_outline
+                             ? std::pair{ActorMesh{{}, input.triangles, input.capture_ns}, 0.0}
+                             : simplified(input, options);
   MaskBase base{std::move(mesh), error_m, {}};
   compact(input.vertices, base.mesh, base.source);
   return base;
@@ -115,10 +119,21 @@ Expected<ActorMesh> grow_mask(const MaskBase& base, double margin_m, const GrowO
   if (!(margin_m >= 0) || !std::isfinite(margin_m) || !(base.error_m >= 0))
     return fail("grow mask: margin must be >= 0");
   if (auto ok = check(options); !ok) return std::unexpected(ok.error());
-  margin_m += base.error_m;
   if (options.projector) {  // the outline form; the push where it cannot be made
-    if (auto outline = grow_outline(mesh, margin_m, *options.projector); outline) return outline;
+    if (auto outline = grow_outline(mesh, margin_m + base.error_m, *options.projector); outline)
+      return outline;
+    // The push from a whole mesh would draw every small triangle margin-sized: simplified here.
+    if (!options.simplify_outline && options.max_triangles > 0 &&
+        mesh.triangles.size() > options.max_triangles) {
+      GrowOptions push = options;
+      push.projector.reset();
+      auto simpler = simplify_for_mask(mesh, push);
+      if (!simpler) return std::unexpected(simpler.error());
+      simpler->error_m += base.error_m;
+      return grow_mask(*simpler, margin_m, push);
+    }
   }
+  margin_m += base.error_m;
   const std::vector<Eigen::Vector3f> normals = vertex_normals(mesh);
   std::vector<float> min_cos(mesh.vertices.size(), 1.0f);
   for (const auto& t : mesh.triangles) {
