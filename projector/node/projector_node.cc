@@ -254,7 +254,7 @@ class ProjectorNode : public runtime::Node {
     // scene and the eye move without meshes too).
     // Late latching (the default): after each frame the next frame's scene is drawn ahead
     // (flushed: llvmpipe rasterises it on its threads) and the frame's meshes' motion fitted,
-    // so a new mesh waits only for its simplification, its mask and the finish.
+    // so a new mesh waits only for its mask and the finish.
     while (loop_.running()) {
       {
         std::unique_lock lock(mutex_);

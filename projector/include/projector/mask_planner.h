@@ -17,9 +17,9 @@
 // actor from set_head_speed(), 0 when unknown).
 //
 // Cost: set_mesh() does the per-mesh work once — the motion estimate and the mask mesh's
-// simplification (mask_geometry.h simplify_for_mask), by default on two threads at once
-// (MaskPlannerOptions::parallel_mesh_work) — and times both (last_mesh_cost());
-// plan() per frame only moves the simplified mesh forward and grows it.
+// simplification (mask_geometry.h simplify_for_mask; the outline form keeps the mesh whole), by
+// default on two threads at once (MaskPlannerOptions::parallel_mesh_work) — and times both
+// (last_mesh_cost()); plan() per frame only moves the mask mesh forward and grows it.
 //
 // Late latching (issues 15/20: the mesh off the long path; the projector node's default,
 // ProjectorNodeOptions::late_latch): latch_mesh() takes a new mesh with only what its first
