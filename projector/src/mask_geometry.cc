@@ -370,17 +370,4 @@ Expected<ActorMesh> grow_mesh(const ActorMesh& input, double margin_m, const Gro
   return grow_mask(*base, margin_m, options);
 }
 
-Expected<double> dilation_radius_px(const Camera& projector, const ActorMesh& mesh,
-                                    double margin_m) {
-  if (auto v = mesh.validate(); !v) return std::unexpected(v.error());
-  if (!(margin_m >= 0) || !std::isfinite(margin_m)) return fail("dilation: margin must be >= 0");
-  double z_min = INFINITY;
-  for (const auto& v : mesh.vertices) {
-    const double z = (projector.cam_from_world * v.cast<double>()).z();
-    if (z > 1e-3) z_min = std::min(z_min, z);
-  }
-  if (!std::isfinite(z_min)) return fail("dilation: the mesh is behind the projector");
-  return margin_m * std::max(projector.intrinsics.fx, projector.intrinsics.fy) / z_min;
-}
-
 }  // namespace studio::projector

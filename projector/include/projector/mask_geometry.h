@@ -14,10 +14,6 @@
 // - grow_outline() (below): the mesh's image in one projector grown by the margin ball's
 //   projected radius, drawn as quads; covers the margin, not the push's spikes (about half the
 //   black at the demo's margins: BENCHMARKS.md, demo, session 14).
-// - dilation_radius_px(): the margin as a screen-space radius in projector pixels, for a renderer
-//   that dilates the mesh's silhouette (a max filter or a wide outline): margin * f / z_min with f
-//   the projector's larger focal length and z_min the nearest mesh vertex's depth in the projector
-//   frame (conservative: the radius of the nearest part, applied everywhere).
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -114,9 +110,5 @@ Expected<ActorMesh> grow_mask(const MaskBase& base, double margin_m,
 // the vertex push, which has none of these limits.
 Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const Camera& projector,
                                  int cell = 2);
-
-// Errors: invalid mesh, negative margin, no vertex in front of the projector.
-Expected<double> dilation_radius_px(const Camera& projector, const ActorMesh& mesh,
-                                    double margin_m);
 
 }  // namespace studio::projector
