@@ -276,6 +276,26 @@ TEST(MaskOutline, GrowsTheWholeMeshAndTheFallbackPushSimplifiesIt) {
               ideal);
   EXPECT_EQ(ideal_missed, 0);
   EXPECT_LT(in_whole, in_simplified);
+  // A mesh above outline_max_triangles is clustered to about that many, its error in the margin:
+  // it still covers every ray of the grown sphere.
+  GrowOptions bounded = whole;
+  bounded.outline_max_triangles = 5000;
+  auto clustered = simplify_for_mask(dense, bounded);
+  ASSERT_TRUE(clustered);
+  EXPECT_LE(clustered->mesh.triangles.size(), 5000u);
+  EXPECT_GT(clustered->error_m, 0);
+  auto mask_clustered = grow_mask(*clustered, margin, bounded);
+  ASSERT_TRUE(mask_clustered);
+  int clustered_missed = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector3d d = (z + std::tan(half_angle * (2.0 * (i + 0.5) / n - 1)) * x +
+                                 std::tan(half_angle * (2.0 * (j + 0.5) / n - 1)) * y)
+                                    .normalized();
+      if (ray_to_point(eye, d, {0, 1.2, 0}) < 0.3 + margin)
+        clustered_missed += !hits(*mask_clustered, eye, d);
+    }
+  EXPECT_EQ(clustered_missed, 0);
   // Where the outline cannot be made (the projector inside the margin), the push falls back to
   // the simplified mesh, exactly as grow_mask() without a projector would draw it.
   const Camera inside = projector_at({0, 1.2, 0.32}, {0, 1.2, -1});

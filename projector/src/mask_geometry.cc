@@ -104,10 +104,15 @@ Expected<MaskBase> simplify_for_mask(const ActorMesh& input, const GrowOptions& 
   // grows to the margin's size, and a renderer rasterises all of them over one another. The
   // simplification's error is added to the push, so the mask still covers the mesh.
   // The outline form rasterises the mesh in the projector's image: whole is cheaper and tighter
-  // (GrowOptions::simplify_outline).
-  auto [mesh, error_m] = options.projector && !options.simplify_outline
-                             ? std::pair{ActorMesh{{}, input.triangles, input.capture_ns}, 0.0}
-                             : simplified(input, options);
+  // (GrowOptions::simplify_outline), up to outline_max_triangles (clustered beyond).
+  const bool whole = options.projector && !options.simplify_outline;
+  GrowOptions bound = options;
+  if (whole) {
+    bound.max_triangles = options.outline_max_triangles;
+    bound.cluster_factor = 1;
+    bound.presimplify = true;
+  }
+  auto [mesh, error_m] = simplified(input, bound);
   MaskBase base{std::move(mesh), error_m, {}};
   compact(input.vertices, base.mesh, base.source);
   return base;

@@ -60,6 +60,10 @@ struct GrowOptions {
   // 3000, and 197k black pixels against 223k. The vertex push still simplifies (grow_mask()
   // does it when the outline falls back on a whole mesh).
   bool simplify_outline = false;
+  // The outline form's bound: a mesh of more triangles (a hull far finer than the demo's 160
+  // columns) is clustered to about this many first (meshoptimizer's sloppy simplifier, its error
+  // x error_safety added to the margin), so the per-frame raster stays bounded (0: no bound).
+  std::size_t outline_max_triangles = 100000;
 };
 
 // Errors: invalid mesh, negative or non-finite margin. = grow_mask(simplify_for_mask(mesh)).
