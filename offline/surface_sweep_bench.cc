@@ -104,6 +104,7 @@ int main(int argc, char** argv) {
     (void)hull::refine_crossings(p.hull_mesh, set, cut);
     CarveOptions co;
     co.threads = 2;
+    if (const char* j = std::getenv("CARVE_MAX_JUDGES")) co.max_judges = std::atoi(j);
     const auto carved = photo_carve(set, p.views, co).value();
     p.carved_mesh = refined_mesh(carved.set, set, p.views, 2).value();
     p.hull = testing::surface_distance(p.hull_mesh, p.f.truth.body);

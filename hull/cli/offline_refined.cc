@@ -42,7 +42,8 @@ constexpr const char* kUsage =
                            --out DIR (--refine | --texture | --surface S, any together)
                            [--frames A:B] [--name NAME] [--fps F] [--axis x|y|z]
                            [--keyer keyer.yaml | --key blue|green] [--min-views N|all]
-                           [--threshold T] [--ncc T|off] [--max-depth CELLS] [--threads N]
+                           [--threshold T] [--ncc T|off] [--judges N|all]
+                           [--max-depth CELLS] [--threads N]
                            [--surface STEPS|off] [--surface-photo ITERATIONS]
                            [--json | --progress | --quiet]
        studio-hull offline --take DIR [--rig rig.yaml] --plan SHARDS   (prints A:B per shard)
@@ -63,6 +64,9 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
   --ncc T|off       also carve where shading patches disagree: mean NCC over camera pairs below
                     T (default 0) and a point 1-3 cells deeper matching clearly better; off:
                     colours alone
+  --judges N|all    at most N of the cameras that see a voxel judge it, the most frontal
+                    (default 3: on large rigs the grazing views' spill and light tint carve
+                    the true surface); all: every camera that sees it
   --max-depth C     carving stops C cells below the hull (default 12)
   --surface S|off   surface stage on the mesh (after carving with --refine): S Laplacian steps
                     with the silhouette rims (the middle of each facet) anchored, each move
@@ -102,6 +106,7 @@ struct Args {
   double fps = 25, threshold = 6, ncc = 0;
   bool patches = true;
   int max_depth = 12;
+  int judges = offline::CarveOptions{}.max_judges;  // 0: all
   int surface = -1, surface_photo = 0;  // -1: no surface stage
   std::optional<bool> progress;
 };
@@ -187,6 +192,15 @@ Expected<Args> parse(int argc, char** argv) {
         return fail(opt + ": '" + v + "': expected 0..1000" +
                     (opt == "--surface" ? " or off" : ""));
       (opt == "--surface" ? a.surface : a.surface_photo) = int(*d);
+    } else if (opt == "--judges") {
+      if (v == "all") {
+        a.judges = 0;
+      } else {
+        auto d = number(opt, v);
+        if (!d || *d != std::floor(*d) || *d < 2 || *d > 64)
+          return fail("--judges: '" + v + "': expected 2..64 or all");
+        a.judges = int(*d);
+      }
     } else if (opt == "--ncc") {
       if (v == "off") {
         a.patches = false;
@@ -377,6 +391,7 @@ int run_refined(int argc, char** argv) {
   carve.threshold = a.threshold;
   carve.max_depth_cells = a.max_depth;
   carve.ncc_threshold = a.ncc;
+  carve.max_judges = a.judges;
   if (!a.patches) carve.patch_half = 0;
   if (auto ok = carve.validate(); !ok) {
     std::cerr << "studio-hull: " << ok.error().message << "\n";
@@ -412,6 +427,10 @@ int run_refined(int argc, char** argv) {
                   a.box_max.z(), int(a.axis), a.min_views, int(a.refine), int(a.texture),
                   a.threshold, a.ncc, carve.patch_half, a.max_depth, int(key.mode));
     settings += buf;
+    if (a.refine) {  // (a carve's judges; absent without --refine, where they change nothing)
+      std::snprintf(buf, sizeof buf, " judges %d", a.judges);
+      settings += buf;
+    }
     if (a.surface >= 0) {  // (absent when off: files made without it keep their fingerprint)
       std::snprintf(buf, sizeof buf, " surface %d photo %d inside_hull %d rim_band %.9g", a.surface,
                     a.surface_photo, int(surface.inside_hull), surface.rim_band_cells);

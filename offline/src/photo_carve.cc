@@ -36,6 +36,8 @@ using detail::parallel_for;
 Expected<void> CarveOptions::validate() const {
   if (!(threshold > 0) || !std::isfinite(threshold)) return fail("carve: threshold must be > 0");
   if (min_cameras < 2 || min_cameras > 64) return fail("carve: min_cameras must be 2..64");
+  if (max_judges != 0 && (max_judges < min_cameras || max_judges > 64))
+    return fail("carve: max_judges must be 0 (all) or min_cameras..64");
   if (!(min_cos >= 0 && min_cos < 1)) return fail("carve: min_cos must be in [0, 1)");
   if (edge_margin_px < 0 || edge_margin_px > 16) return fail("carve: edge_margin_px must be 0..16");
   if (sample_radius_px < 0 || sample_radius_px > 4)
@@ -201,6 +203,20 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
           }
         }
         if (int(obs.size()) < options.min_cameras) continue;
+        if (options.max_judges > 0 && int(obs.size()) > options.max_judges) {
+          // The most frontal judge (the grazing ones carry the spill and the ring light's tint).
+          std::vector<std::size_t> order(obs.size());
+          for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+          std::partial_sort(order.begin(), order.begin() + options.max_judges, order.end(),
+                            [&](std::size_t a, std::size_t b) { return obs[a].cos > obs[b].cos; });
+          order.resize(std::size_t(options.max_judges));
+          std::sort(order.begin(), order.end());  // camera order kept
+          std::vector<Observation> o2;
+          std::vector<std::size_t> s2;
+          for (std::size_t i : order) o2.push_back(obs[i]), s2.push_back(seen[i]);
+          obs.swap(o2);
+          seen.swap(s2);
+        }
         const double spread = colour_spread(obs);
         if (spread > options.threshold) {
           carve_flag[n] = 1;

@@ -52,6 +52,14 @@ struct ColourView {
 struct CarveOptions {
   double threshold = 6.0;        // carve above this weighted RGB spread (grey levels, RMS)
   int min_cameras = 2;           // consistency needs at least this many views of a voxel
+  // At most this many of the seeing cameras judge a voxel, the most frontal ones (0: all). More
+  // judges see the voxel from wider angles, where the ring lights' tint and the spill differ
+  // from camera to camera: on a 17-camera rig (8 ring + overhead + 8 low) all judges carved
+  // the true surface (carved + surface stage +11.6 % / +15.0 % mean / p95 against the hull on
+  // the train poses), 3 gives -4.0 % / -7.9 % (validation -6.0 / -13.3 against -1.1 / -5.9);
+  // on the 9-camera rig, where a voxel rarely has more than 3 judges, within 0.4 points of all
+  // (offline_surface_sweep, BENCHMARKS.md, offline, session 15). 2 loses 2-3 points there.
+  int max_judges = 3;
   double min_cos = 0.5;          // views more grazing than this do not judge a voxel (spill)
   int edge_margin_px = 2;        // silhouette border pixels not used (blue spill)
   int sample_radius_px = 0;      // colour = mean over a (2r+1)^2 pixel patch (noise)
