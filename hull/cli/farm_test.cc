@@ -197,6 +197,17 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
           dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("\"computed\":2,\"skipped\":0"), std::string::npos) << r.out;
+  // The carve's judges are a setting too: all judges recompute, the default's own value skips.
+  r = run(hull() + " offline " + args(whole) +
+              " --threshold 8 --judges all --frames 0:1 --threads 2 --json",
+          dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"computed\":2,\"skipped\":0"), std::string::npos) << r.out;
+  r = run(hull() + " offline " + args(whole) +
+              " --threshold 8 --judges all --frames 0:1 --threads 2 --json",
+          dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"computed\":0,\"skipped\":2"), std::string::npos) << r.out;
 }
 
 // --surface: the surface stage after carving (offline/surface_refine.h) runs in the process: the
@@ -253,7 +264,9 @@ TEST_F(HullFarm, BadInputIsOneLine) {
         "--take " + (dir_ / "take").string() + " --box 0,0,0,1,1,1 --grid 8 --out " + out.string() +
             " --refine --threshold -1",
         "--take " + (dir_ / "take").string() + " --refine --box 0,0,0,1,1,1 --grid 8 --out " +
-            out.string() + " --name a/b"}) {
+            out.string() + " --name a/b",
+        "--take " + (dir_ / "take").string() + " --refine --box 0,0,0,1,1,1 --grid 8 --out " +
+            out.string() + " --judges 1"}) {
     auto r = run(hull() + " offline " + a, dir_);
     EXPECT_EQ(r.code, 2) << a;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
