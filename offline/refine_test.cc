@@ -480,6 +480,9 @@ TEST(PhotoCarve, IndependentOfThreadsAndRefusesBadInput) {
   EXPECT_GT(a.carved, 0u);
   EXPECT_EQ(a.set, b.set);
   EXPECT_LE(a.set.volume(), set.volume());
+  // Two judges (fewer than the cameras that see many voxels here): also thread-independent.
+  one.max_judges = two.max_judges = 2;
+  EXPECT_EQ(photo_carve(set, views, one).value().set, photo_carve(set, views, two).value().set);
   // Bad options and a mask of the wrong size: one line each, nothing carved.
   CarveOptions bad;
   bad.threshold = -1;
