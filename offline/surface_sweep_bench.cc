@@ -6,7 +6,8 @@
 // LOW_RING=N (N more cameras on a second ring 0.9 m high looking at 1.0 m, between the main
 // ring's azimuths, the cyclorama's walls 6 m high instead of 4 so that they see cloth above the
 // actor: a larger studio's rig, e.g. 8 + overhead + 8 = 17 cameras), LOSS_PER_CAMERA=1 (the
-// hull's and the carved mesh's silhouette loss per camera: a mask wider than the actor shows).
+// hull's and the carved mesh's silhouette loss per camera: a mask wider than the actor shows),
+// CARVE_MAX_JUDGES / CARVE_MIN_COS / CARVE_THRESHOLD (the carve's CarveOptions, default otherwise).
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -105,6 +106,8 @@ int main(int argc, char** argv) {
     CarveOptions co;
     co.threads = 2;
     if (const char* j = std::getenv("CARVE_MAX_JUDGES")) co.max_judges = std::atoi(j);
+    if (const char* c = std::getenv("CARVE_MIN_COS")) co.min_cos = std::atof(c);
+    if (const char* t = std::getenv("CARVE_THRESHOLD")) co.threshold = std::atof(t);
     const auto carved = photo_carve(set, p.views, co).value();
     p.carved_mesh = refined_mesh(carved.set, set, p.views, 2).value();
     p.hull = testing::surface_distance(p.hull_mesh, p.f.truth.body);
