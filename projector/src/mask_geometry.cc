@@ -301,16 +301,23 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
     const int i1 = std::min(W - 1, int(std::floor((thi.x() - x0) / cell)));
     const int j0 = std::max(0, int(std::floor((tlo.y() - y0) / cell)));
     const int j1 = std::min(H - 1, int(std::floor((thi.y() - y0) / cell)));
-    for (int j = j0; j <= j1; ++j)
+    // (The cell's slack half (|n.x| + |n.y|) folded into each edge's constant; a cell already
+    // set by another triangle is not tested again: the same cells either way.)
+    std::array<double, 3> slack;
+    for (int k = 0; k < 3; ++k)
+      slack[k] = e[k].z() + half * (std::abs(e[k].x()) + std::abs(e[k].y()));
+    for (int j = j0; j <= j1; ++j) {
+      const double w = y0 + (j + 0.5) * cell;
+      double* row = f.data() + std::size_t(j) * W;
       for (int i = i0; i <= i1; ++i) {
-        const double u = x0 + (i + 0.5) * cell, w = y0 + (j + 0.5) * cell;
+        if (row[i] == 0) continue;
+        const double u = x0 + (i + 0.5) * cell;
         bool inside = true;
         for (int k = 0; k < 3 && inside; ++k)
-          inside = e[k].x() * u + e[k].y() * w + e[k].z() +
-                       half * (std::abs(e[k].x()) + std::abs(e[k].y())) >=
-                   0;
-        if (inside) f[std::size_t(j) * W + i] = 0;
+          inside = e[k].x() * u + e[k].y() * w + slack[k] >= 0;
+        if (inside) row[i] = 0;
       }
+    }
   }
   // 2. Squared distances (in cells) to the nearest set cell: columns, then rows.
   const int n = std::max(W, H);
@@ -335,16 +342,22 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
     return static_cast<uint32_t>(out.vertices.size() - 1);
   };
   const double slack = std::sqrt(2.0) * cell;
+  const double inner2 = (f_max * tan_a + slack) * (f_max * tan_a + slack);
+  const double outer2 = (rho_max + slack) * (rho_max + slack);
   for (int j = 0; j < H; ++j) {
     const double vc = y0 + (j + 0.5) * cell;
     if (vc + half < -0.5 || vc - half > projector.height - 0.5) continue;  // outside the image
     const double* row = f.data() + std::size_t(j) * W;
     int i = 0;
     while (i < W) {
+      // rho_at >= f_max tan(a_max) (its 1 / cos^2 >= 1): a cell within that of the mesh's
+      // image needs no rho_at, one beyond rho_max is out.
       auto in_mask = [&](int k) {
-        if (!(row[k] * cell * cell <= (rho_max + slack) * (rho_max + slack))) return false;
+        const double d2 = row[k] * cell * cell;
+        if (d2 <= inner2) return true;
+        if (!(d2 <= outer2)) return false;
         const double r = rho_at(x0 + (k + 0.5) * cell, vc) + slack;
-        return row[k] * cell * cell <= r * r;
+        return d2 <= r * r;
       };
       if (!in_mask(i)) {
         ++i;
