@@ -12,6 +12,9 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "projector/camera_clip.h"
 #include "scene_render/render_target.h"
@@ -40,6 +43,21 @@ Expected<void> FrameRendererOptions::validate() const {
 namespace {
 // The run mask of alpha-0 pixels of `rgba` (`width` x `height`); bottom_up: GL's row order
 // (the image's top row last), else the image's.
+// The first pixel at or after x whose alpha is zero (zero = true) or not (zero = false), or
+// width: four pixels at a time while none of them changes (SSE2), then one at a time.
+int next_alpha(const std::uint8_t* row, int x, int width, bool zero) {
+#if defined(__SSE2__)
+  const __m128i z = _mm_setzero_si128();
+  const int none = zero ? 0 : 0x8888;  // alpha bytes' compare bits when no pixel changes
+  for (; x + 4 <= width; x += 4) {
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 4 * x));
+    if ((_mm_movemask_epi8(_mm_cmpeq_epi8(v, z)) & 0x8888) != none) break;
+  }
+#endif
+  while (x < width && (row[4 * x + 3] == 0) != zero) ++x;
+  return x;
+}
+
 RunMask blackout_rows(std::span<const std::uint8_t> rgba, int width, int height, bool bottom_up) {
   RunMask mask(width, height);
   for (int y = 0; y < height; ++y) {
@@ -47,10 +65,10 @@ RunMask blackout_rows(std::span<const std::uint8_t> rgba, int width, int height,
     const std::uint8_t* row = rgba.data() + std::size_t(src) * width * 4;
     int x = 0;
     while (x < width) {
-      while (x < width && row[4 * x + 3] != 0) ++x;
+      x = next_alpha(row, x, width, true);
       if (x >= width) break;
       const int begin = x;
-      while (x < width && row[4 * x + 3] == 0) ++x;
+      x = next_alpha(row, x, width, false);
       mask.push_run(y, begin, x);
     }
   }

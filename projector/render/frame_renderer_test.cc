@@ -470,3 +470,38 @@ TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
     }
   }
 }
+
+// The blackout runs (alpha 0) of random frames against a pixel-by-pixel reference: widths that
+// are and are not multiples of the 4-pixel scan, runs of every length at every offset, and alpha
+// values 1 and 128 (not zero) beside 255.
+TEST(BlackoutOf, RunsMatchAPixelByPixelReference) {
+  std::mt19937 rng(7);
+  for (int width : {1, 3, 4, 5, 8, 13, 64, 67}) {
+    const int height = 9;
+    std::vector<std::uint8_t> rgba(std::size_t(width) * height * 4);
+    for (int y = 0; y < height; ++y) {
+      const int period = 1 + y;  // run lengths 1 .. 9
+      for (int x = 0; x < width; ++x) {
+        std::uint8_t* p = &rgba[(std::size_t(y) * width + x) * 4];
+        for (int c = 0; c < 3; ++c) p[c] = std::uint8_t(rng() & 0xff);  // RGB: anything, 0 too
+        const bool black = (x / period + y) % 2 == 0 || rng() % 11 == 0;
+        p[3] = black ? 0 : std::array<std::uint8_t, 3>{1, 128, 255}[rng() % 3];
+      }
+    }
+    RunMask want(width, height);
+    for (int y = 0; y < height; ++y) {
+      int x = 0;
+      while (x < width) {
+        if (rgba[(std::size_t(y) * width + x) * 4 + 3] != 0) {
+          ++x;
+          continue;
+        }
+        const int begin = x;
+        while (x < width && rgba[(std::size_t(y) * width + x) * 4 + 3] == 0) ++x;
+        want.push_run(y, begin, x);
+      }
+    }
+    want.finish();
+    EXPECT_EQ(blackout_of(rgba, width, height), want) << "width " << width;
+  }
+}

@@ -333,6 +333,22 @@ void BM_HullMask_720p(benchmark::State& state) {
   state.counters["blackout_px"] = double(rb.blackout.area());
 }
 
+// The blackout runs of a read-back 1280x720 frame (blackout_of; the node does this per frame):
+// an elliptical mask of ~200k pixels (the demo's at the margin's cap) over a lit frame.
+void BM_BlackoutRuns_720p(benchmark::State& state) {
+  const int w = 1280, h = 720;
+  std::vector<std::uint8_t> rgba(std::size_t(w) * h * 4, 200);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double u = (x - 640) / 220.0, v = (y - 360) / 300.0;
+      if (u * u + v * v <= 1) rgba[(std::size_t(y) * w + x) * 4 + 3] = 0;
+    }
+  std::size_t area = 0;
+  for (auto _ : state) area = blackout_of(rgba, w, h).area();
+  state.counters["blackout_px"] = double(area);
+}
+BENCHMARK(BM_BlackoutRuns_720p)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
 #define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(2.0)
 BENCHMARK(BM_Clear) OPTS;
 BENCHMARK(BM_GrowMask) OPTS;
