@@ -41,8 +41,6 @@ Expected<void> FrameRendererOptions::validate() const {
 }
 
 namespace {
-// The run mask of alpha-0 pixels of `rgba` (`width` x `height`); bottom_up: GL's row order
-// (the image's top row last), else the image's.
 // The first pixel at or after x whose alpha is zero (zero = true) or not (zero = false), or
 // width: four pixels at a time while none of them changes (SSE2), then one at a time.
 int next_alpha(const std::uint8_t* row, int x, int width, bool zero) {
@@ -58,6 +56,54 @@ int next_alpha(const std::uint8_t* row, int x, int width, bool zero) {
   return x;
 }
 
+}  // namespace
+
+// Rows are summed per column first (16-bit lanes: vectorised), then each block's columns.
+bool box_thumbnail(std::span<const std::uint8_t> rgba, int w, int h, int tw, int th,
+                   std::vector<std::uint8_t>& out) {
+  if (tw <= 0 || th <= 0 || w <= 0 || h <= 0 || w % tw != 0 || h % th != 0 ||
+      rgba.size() != std::size_t(w) * h * 4)
+    return false;
+  const int fx = w / tw, fy = h / th;
+  if (fy > 257) return false;
+  const std::uint32_t n = std::uint32_t(fx) * std::uint32_t(fy);
+  out.assign(std::size_t(tw) * th * 3, 0);
+  std::vector<std::uint16_t> column(std::size_t(w) * 4);
+  for (int ty = 0; ty < th; ++ty) {
+    std::fill(column.begin(), column.end(), std::uint16_t(0));
+    std::uint16_t* col = column.data();
+    const std::size_t m = column.size();
+    for (int r = 0; r < fy; ++r) {
+      const std::uint8_t* row = rgba.data() + std::size_t(h - 1 - (ty * fy + r)) * w * 4;
+      std::size_t k = 0;
+#if defined(__SSE2__)
+      const __m128i zero = _mm_setzero_si128();
+      for (; k + 16 <= m; k += 16) {  // 16 bytes widened to two 8 x 16-bit sums
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + k));
+        __m128i* c = reinterpret_cast<__m128i*>(col + k);
+        _mm_storeu_si128(c, _mm_add_epi16(_mm_loadu_si128(c), _mm_unpacklo_epi8(v, zero)));
+        _mm_storeu_si128(c + 1,
+                         _mm_add_epi16(_mm_loadu_si128(c + 1), _mm_unpackhi_epi8(v, zero)));
+      }
+#endif
+      for (; k < m; ++k) col[k] = std::uint16_t(col[k] + row[k]);
+    }
+    std::uint8_t* dst = out.data() + std::size_t(ty) * tw * 3;
+    for (int tx = 0; tx < tw; ++tx) {
+      std::uint32_t sum[3] = {0, 0, 0};
+      const std::uint16_t* c = column.data() + std::size_t(tx) * fx * 4;
+      for (int k = 0; k < fx; ++k)
+        for (int ch = 0; ch < 3; ++ch) sum[ch] += c[4 * k + ch];
+      for (int ch = 0; ch < 3; ++ch) dst[3 * tx + ch] = std::uint8_t((sum[ch] + n / 2) / n);
+    }
+  }
+  return true;
+}
+
+namespace {
+
+// The run mask of alpha-0 pixels of `rgba` (`width` x `height`); bottom_up: GL's row order
+// (the image's top row last), else the image's.
 RunMask blackout_rows(std::span<const std::uint8_t> rgba, int width, int height, bool bottom_up) {
   RunMask mask(width, height);
   for (int y = 0; y < height; ++y) {
@@ -389,14 +435,14 @@ void FrameRenderer::read(Readback& out, bool keep_rgba) {
   out.thumb_width = r.options.thumb_width;
   out.thumb_height = r.options.thumb_height;
   const cv::Mat full(h, w, CV_8UC4, r.rgba.data());
-  if (out.thumb_width > 0) {
+  if (out.thumb_width == 0) {
+    out.thumbnail.clear();
+  } else if (!box_thumbnail(r.rgba, w, h, out.thumb_width, out.thumb_height, out.thumbnail)) {
     cv::Mat small, rgb;
     cv::resize(full, small, cv::Size(out.thumb_width, out.thumb_height), 0, 0, cv::INTER_AREA);
     cv::flip(small, small, 0);
     cv::cvtColor(small, rgb, cv::COLOR_RGBA2RGB);
     out.thumbnail.assign(rgb.data, rgb.data + rgb.total() * 3);
-  } else {
-    out.thumbnail.clear();
   }
   if (keep_rgba) {
     out.rgba.resize(r.rgba.size());

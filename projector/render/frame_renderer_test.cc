@@ -505,3 +505,33 @@ TEST(BlackoutOf, RunsMatchAPixelByPixelReference) {
     EXPECT_EQ(blackout_of(rgba, width, height), want) << "width " << width;
   }
 }
+
+// The thumbnail's box average against OpenCV's area resize of the same frame flipped to image
+// order (what FrameRenderer::read did before): within one grey level everywhere, for the
+// projector sizes, with a refusal (OpenCV then) where the sizes do not divide.
+TEST(BoxThumbnail, MatchesAnAreaResize) {
+  std::mt19937 rng(3);
+  for (const auto& [w, h, tw, th] : std::vector<std::array<int, 4>>{
+           {1280, 720, 160, 90}, {1920, 1080, 160, 90}, {960, 540, 160, 90}, {64, 48, 8, 6}}) {
+    std::vector<std::uint8_t> rgba(std::size_t(w) * h * 4);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < 4; ++c)  // smooth gradients plus noise, all of 0..255
+          rgba[(std::size_t(y) * w + x) * 4 + c] =
+              std::uint8_t(std::clamp(int((x * (c + 1) + y * 3) % 256) + int(rng() % 21) - 10, 0,
+                                      255));
+    std::vector<std::uint8_t> box;
+    ASSERT_TRUE(box_thumbnail(rgba, w, h, tw, th, box)) << w << "x" << h;
+    cv::Mat full(h, w, CV_8UC4, rgba.data()), small, rgb;
+    cv::resize(full, small, cv::Size(tw, th), 0, 0, cv::INTER_AREA);
+    cv::flip(small, small, 0);
+    cv::cvtColor(small, rgb, cv::COLOR_RGBA2RGB);
+    ASSERT_EQ(box.size(), rgb.total() * 3);
+    int worst = 0;
+    for (std::size_t i = 0; i < box.size(); ++i) worst = std::max(worst, std::abs(box[i] - rgb.data[i]));
+    EXPECT_LE(worst, 1) << w << "x" << h;
+  }
+  std::vector<std::uint8_t> out, odd(std::size_t(1000) * 700 * 4, 0);
+  EXPECT_FALSE(box_thumbnail(odd, 1000, 700, 160, 90, out));
+  EXPECT_TRUE(out.empty());
+}

@@ -39,6 +39,7 @@
 #include <benchmark/benchmark.h>
 
 #include <numbers>
+#include <opencv2/imgproc.hpp>
 #include <set>
 
 #include "projector/mask_geometry.h"
@@ -348,6 +349,29 @@ void BM_BlackoutRuns_720p(benchmark::State& state) {
   state.counters["blackout_px"] = double(area);
 }
 BENCHMARK(BM_BlackoutRuns_720p)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+// The 160x90 thumbnail of a read-back 1280x720 frame: the box average (box_thumbnail, what read()
+// uses) against OpenCV's area resize, flip and colour conversion (the baseline, before).
+void BM_Thumbnail_720p(benchmark::State& state) {
+  const int w = 1280, h = 720;
+  std::vector<std::uint8_t> rgba(std::size_t(w) * h * 4);
+  for (std::size_t i = 0; i < rgba.size(); ++i) rgba[i] = std::uint8_t(i * 7 + i / 5120);
+  std::vector<std::uint8_t> out;
+  for (auto _ : state) {
+    if (state.range(0) == 1) {
+      box_thumbnail(rgba, w, h, 160, 90, out);
+    } else {
+      const cv::Mat full(h, w, CV_8UC4, rgba.data());
+      cv::Mat small, rgb;
+      cv::resize(full, small, cv::Size(160, 90), 0, 0, cv::INTER_AREA);
+      cv::flip(small, small, 0);
+      cv::cvtColor(small, rgb, cv::COLOR_RGBA2RGB);
+      out.assign(rgb.data, rgb.data + rgb.total() * 3);
+    }
+    benchmark::DoNotOptimize(out.data());
+  }
+}
+BENCHMARK(BM_Thumbnail_720p)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(1.0)->MeasureProcessCPUTime();
 
 #define OPTS ->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(2.0)
 BENCHMARK(BM_Clear) OPTS;

@@ -161,4 +161,11 @@ class FrameRenderer {
 // RGBA (top row first) → the run mask of pixels whose alpha is 0.
 RunMask blackout_of(std::span<const std::uint8_t> rgba, int width, int height);
 
+// The thumbnail (RGB, top row first) of a frame read back bottom row first (RGBA, w x h) whose
+// size is a whole multiple of it (1280x720 or 1920x1080 -> 160x90): each pixel the rounded mean
+// of its block, what an area resize gives there. False (nothing written) when the sizes do not
+// divide or a block is taller than 257 rows; FrameRenderer::read then resizes with OpenCV.
+bool box_thumbnail(std::span<const std::uint8_t> rgba_bottom_up, int w, int h, int tw, int th,
+                   std::vector<std::uint8_t>& out);
+
 }  // namespace studio::projector_render
