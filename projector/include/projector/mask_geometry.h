@@ -55,10 +55,11 @@ struct GrowOptions {
   // With `projector` (the outline form), simplify_for_mask() keeps the mesh whole unless this is
   // set: the outline's raster is linear in the triangles and cheap per triangle, the
   // simplification is not, and a whole mesh adds no simplifier error to the margin. The demo's
-  // hull mesh (29k triangles, projector_bench HullMask_720p, 0.2 m): 12.0 ms CPU to grow and
-  // draw it whole against 6.8 (simplify, projector_mask_bench SimplifyHull) + 11.0 simplified to
-  // 3000, and 197k black pixels against 223k. The vertex push still simplifies (grow_mask()
-  // does it when the outline falls back on a whole mesh).
+  // hull mesh (29k triangles, projector_bench HullMask_720p, 0.2 m, same run): 12.8 ms CPU per
+  // frame to grow and draw it whole against 10.4 simplified to 3000 + 6.8 per mesh to simplify
+  // (projector_mask_bench SimplifyHull), and 197k black pixels against 223k (BENCHMARKS.md,
+  // demo, session 15). The vertex push still simplifies (grow_mask() does it when the outline
+  // falls back on a whole mesh).
   bool simplify_outline = false;
   // The outline form's bound: a mesh of more triangles (a hull far finer than the demo's 160
   // columns) is clustered to about this many first (meshoptimizer's sloppy simplifier, its error
