@@ -171,8 +171,8 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
     // 2-3. Photo-consistency of every carvable surface voxel.
     carve_flag.assign(surface.size(), 0);
     parallel_for(surface.size(), options.threads, [&](std::size_t a, std::size_t b) {
-      std::vector<Observation> obs;
-      std::vector<std::size_t> seen;
+      std::vector<Observation> obs, judged;
+      std::vector<std::size_t> seen, judged_seen, order;
       std::vector<std::vector<float>> patches;
       for (std::size_t n = a; n < b; ++n) {
         const Surface& s = surface[n];
@@ -205,17 +205,17 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         if (int(obs.size()) < options.min_cameras) continue;
         if (options.max_judges > 0 && int(obs.size()) > options.max_judges) {
           // The most frontal judge (the grazing ones carry the spill and the ring light's tint).
-          std::vector<std::size_t> order(obs.size());
+          order.resize(obs.size());
           for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
           std::partial_sort(order.begin(), order.begin() + options.max_judges, order.end(),
                             [&](std::size_t a, std::size_t b) { return obs[a].cos > obs[b].cos; });
           order.resize(std::size_t(options.max_judges));
           std::sort(order.begin(), order.end());  // camera order kept
-          std::vector<Observation> o2;
-          std::vector<std::size_t> s2;
-          for (std::size_t i : order) o2.push_back(obs[i]), s2.push_back(seen[i]);
-          obs.swap(o2);
-          seen.swap(s2);
+          judged.clear();
+          judged_seen.clear();
+          for (std::size_t i : order) judged.push_back(obs[i]), judged_seen.push_back(seen[i]);
+          obs.swap(judged);
+          seen.swap(judged_seen);
         }
         const double spread = colour_spread(obs);
         if (spread > options.threshold) {
