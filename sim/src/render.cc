@@ -335,25 +335,90 @@ std::array<float, 3> sub_sample(const CameraCache& cam, const Shader& shader,
   return shader(parts[static_cast<std::size_t>(best_k)], d, best, bg);
 }
 
-// sub_sample() among the candidate parts `cand` (ascending indices) only: the same nearest part
-// (ties go to the lower index either way) when the parts left out cannot be hit (cone_misses).
-std::array<float, 3> sub_sample_among(const CameraCache& cam, const Shader& shader,
-                                      const std::vector<CamPart>& parts, const uint8_t* cand,
-                                      int n_cand, int x, int y, const std::array<double, 2>& o,
-                                      const Rgb8& bg, int* hits) {
-  const Eigen::Vector3d d = sub_ray(cam, x + o[0], y + o[1]);
+// The nearest part a sub-pixel ray hits (part -1: none) and where.
+struct SubHit {
+  int part = -1;
+  Eigen::Vector3d d;
+  double t = 0;
+};
+
+// sub_sample()'s hit test alone, among the candidate parts `cand` (ascending indices) only: the
+// same nearest part (ties go to the lower index either way) when the parts left out cannot be
+// hit (cone_misses). cand == nullptr: every part whose rectangle holds pixel (x, y).
+SubHit sub_hit(const CameraCache& cam, const std::vector<CamPart>& parts, const uint8_t* cand,
+               int n_cand, int x, int y, const std::array<double, 2>& o) {
+  SubHit h;
+  h.d = sub_ray(cam, x + o[0], y + o[1]);
   double best = std::numeric_limits<double>::infinity();
-  int best_k = -1;
-  for (int j = 0; j < n_cand; ++j) {
-    const double t = parts[cand[j]].hit(d);
+  auto test = [&](std::size_t k) {
+    const double t = parts[k].hit(h.d);
     if (t < best) {
       best = t;
-      best_k = cand[j];
+      h.part = static_cast<int>(k);
     }
+  };
+  if (cand) {
+    for (int j = 0; j < n_cand; ++j) test(cand[j]);
+  } else {
+    for (std::size_t k = 0; k < parts.size(); ++k)
+      if (parts[k].rect.contains(x, y)) test(k);
   }
-  if (best_k < 0) return {float(bg.r), float(bg.g), float(bg.b)};
-  ++*hits;
-  return shader(parts[static_cast<std::size_t>(best_k)], d, best, bg);
+  h.t = best;
+  return h;
+}
+
+// Area-integrated colour of an edge pixel from its sub-samples' hits `h` (offsets `o`): each
+// sub-sample that misses takes the background; the sub-samples on one part are shaded once, at
+// the one nearest to their centroid, weighted by their count. Coverage — which part, or none,
+// each sub-sample sees — is exact; the shading varies little across one pixel (a sub-sample's
+// own shading would cost as many shader calls as sub-samples, most of the anti-aliasing's time).
+// Counts the hits in *hits.
+// every_sample: each sub-sample shaded (StudioOptions::aa_shade_every_sample).
+std::array<float, 3> edge_colour(const Shader& shader, const std::vector<CamPart>& parts,
+                                 const SubHit* h, const std::vector<std::array<double, 2>>& o,
+                                 const Rgb8& bg, bool every_sample, int* hits) {
+  const int n = static_cast<int>(o.size());
+  int misses = 0;
+  for (int k = 0; k < n; ++k) misses += h[k].part < 0;
+  *hits += n - misses;
+  std::array<float, 3> sum{float(bg.r) * misses, float(bg.g) * misses, float(bg.b) * misses};
+  if (every_sample) {
+    for (int k = 0; k < n; ++k) {
+      if (h[k].part < 0) continue;
+      const auto c = shader(parts[static_cast<std::size_t>(h[k].part)], h[k].d, h[k].t, bg);
+      for (int i = 0; i < 3; ++i) sum[i] += c[i];
+    }
+    return sum;
+  }
+  uint64_t done = 0;  // sub-samples already accounted for (n <= 64)
+  for (int k = 0; k < n; ++k) {
+    if (h[k].part < 0 || (done >> k & 1)) continue;
+    const int part = h[k].part;
+    double cx = 0, cy = 0;
+    int count = 0;
+    for (int j = k; j < n; ++j)
+      if (h[j].part == part) {
+        cx += o[j][0];
+        cy += o[j][1];
+        ++count;
+      }
+    cx /= count;
+    cy /= count;
+    int rep = k;
+    double rep_d2 = std::numeric_limits<double>::infinity();
+    for (int j = k; j < n; ++j)
+      if (h[j].part == part) {
+        done |= uint64_t{1} << j;
+        const double d2 = (o[j][0] - cx) * (o[j][0] - cx) + (o[j][1] - cy) * (o[j][1] - cy);
+        if (d2 < rep_d2) {
+          rep_d2 = d2;
+          rep = j;
+        }
+      }
+    const auto c = shader(parts[static_cast<std::size_t>(part)], h[rep].d, h[rep].t, bg);
+    for (int i = 0; i < 3; ++i) sum[i] += c[i] * count;
+  }
+  return sum;
 }
 
 // Angle (radians) that bounds, for a pinhole camera, the angle between the ray through a pixel's
@@ -481,6 +546,7 @@ void render_actor(const StudioOptions& options, const CameraCache& cam, const Pr
   const float inv = 1.0f / static_cast<float>(samples.size());
   const double cone = cull ? pixel_cone(cam) : -1;
   std::vector<uint8_t> cand(parts.size());
+  std::vector<SubHit> sub_hits(samples.size());
   for (int y = U.y0; y < U.y1; ++y) {
     const uint8_t* m = &(*mask)(0, y);
     const uint8_t* up = y > 0 ? &(*mask)(0, y - 1) : m;
@@ -490,28 +556,22 @@ void render_actor(const StudioOptions& options, const CameraCache& cam, const Pr
       const bool edge = (x > 0 && m[x - 1] != c) || (x + 1 < width && m[x + 1] != c) ||
                         up[x] != c || down[x] != c;
       if (!edge) continue;
-      std::array<float, 3> sum{0, 0, 0};
       int hits = 0;
-      if (cone > 0) {
+      const bool culled = cone > 0;
+      int n_cand = 0;
+      if (culled) {
         // The parts some sub-sample may hit: rectangle holds the pixel, the cone cannot miss.
         const Eigen::Vector3d d0 = cam.ray(x, y);
-        int n_cand = 0;
         for (std::size_t k = 0; k < parts.size(); ++k) {
           if (parts[k].rect.contains(x, y) && !parts[k].cone_misses(d0, cone)) {
             cand[static_cast<std::size_t>(n_cand++)] = static_cast<uint8_t>(k);
           }
         }
-        for (const auto& o : samples) {
-          const auto col = sub_sample_among(cam, shader, parts, cand.data(), n_cand, x, y, o,
-                                            s.bg[at(x, y)], &hits);
-          for (int k = 0; k < 3; ++k) sum[k] += col[k];
-        }
-      } else {
-        for (const auto& o : samples) {
-          const auto col = sub_sample(cam, shader, parts, x, y, o, s.bg[at(x, y)], &hits);
-          for (int k = 0; k < 3; ++k) sum[k] += col[k];
-        }
       }
+      for (std::size_t k = 0; k < samples.size(); ++k)
+        sub_hits[k] = sub_hit(cam, parts, culled ? cand.data() : nullptr, n_cand, x, y, samples[k]);
+      const auto sum = edge_colour(shader, parts, sub_hits.data(), samples, s.bg[at(x, y)],
+                                   options.aa_shade_every_sample, &hits);
       (*image)(x, y) = to_rgb({sum[0] * inv, sum[1] * inv, sum[2] * inv});
       if (matte) (*matte)(x, y) = matte_value(hits, static_cast<int>(samples.size()));
     }
