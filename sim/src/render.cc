@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -246,18 +247,69 @@ struct Scratch {
 };
 thread_local Scratch scratch;
 
-// Nearest part per pixel of rect U: depth (ray parameter) and id (kNoPart for none).
+// Pinhole cameras: the pixels [x0, x1) of row y (within the part's rectangle) whose centre ray
+// may hit `part`; hit() is +inf on every other pixel of the row, so casting only these gives the
+// same depth and id. The rays of row y span the plane p.y = Y p.z (Y = (y - cy) / fy); a point of
+// the part in it lies within `r` of a core point c (capsule: its axis; ellipsoid: its centre,
+// r its largest radius) at distance <= r from that plane, i.e. on the core's piece [t0, t1]
+// clipped to that slab. Its X = p.x / p.z lies within the box relaxation of the ball around c,
+// between (c.x - r) / (c.z -+ r) and (c.x + r) / (c.z -+ r), each a linear-fractional function
+// along the piece and so extreme at its ends (with c.z > r along it; else the whole row). Pixel
+// x = fx X + cx + skew Y; one pixel of slack each side for rounding.
+std::pair<int, int> row_span(const CameraCache& cam, const CamPart& part, int y) {
+  const int rx0 = part.rect.x0, rx1 = part.rect.x1;
+  const auto& k = cam.camera.intrinsics;
+  const double Y = (y - k.cy) / k.fy;
+  const double inv_n = 1 / std::sqrt(1 + Y * Y);
+  Eigen::Vector3d a, b;
+  double r;
+  if (part.capsule) {
+    a = part.a, b = part.b, r = part.r;
+  } else {
+    a = b = part.c, r = part.bound;
+  }
+  // Signed distances to the row's plane, normal (0, 1, -Y) / |.|.
+  const double sa = (a.y() - Y * a.z()) * inv_n, sb = (b.y() - Y * b.z()) * inv_n;
+  double t0 = 0, t1 = 1;
+  if (sa == sb) {
+    if (std::abs(sa) > r) return {rx0, rx0};
+  } else {
+    const double ta = (-r - sa) / (sb - sa), tb = (r - sa) / (sb - sa);
+    t0 = std::max(0.0, std::min(ta, tb));
+    t1 = std::min(1.0, std::max(ta, tb));
+    if (t0 > t1) return {rx0, rx0};  // the part does not reach the row's plane
+  }
+  const Eigen::Vector3d c0 = a + t0 * (b - a), c1 = a + t1 * (b - a);
+  if (!(c0.z() > r * 1.001 + 1e-6) || !(c1.z() > r * 1.001 + 1e-6)) return {rx0, rx1};
+  double lo = INFINITY, hi = -INFINITY;
+  for (const Eigen::Vector3d& c : {c0, c1}) {
+    for (const double z : {c.z() - r, c.z() + r}) {
+      lo = std::min(lo, (c.x() - r) / z);
+      hi = std::max(hi, (c.x() + r) / z);
+    }
+  }
+  const double base = k.cx + k.skew * Y;
+  const double x0 = std::floor(k.fx * lo + base) - 1, x1 = std::ceil(k.fx * hi + base) + 2;
+  if (!(x0 < x1)) return {rx0, rx0};
+  const int from = int(std::clamp<double>(x0, rx0, rx1)), to = int(std::clamp<double>(x1, rx0, rx1));
+  return {from, std::max(from, to)};
+}
+
+// Nearest part per pixel of rect U: depth (ray parameter) and id (kNoPart for none). `cull`
+// (pinhole cameras): each part's rows only over row_span().
 void cast(const CameraCache& cam, const std::vector<CamPart>& parts, const Rect& U,
-          std::vector<float>* depth, std::vector<uint8_t>* id) {
+          std::vector<float>* depth, std::vector<uint8_t>* id, bool cull = false) {
   const int w = U.x1 - U.x0;
   const std::size_t n = static_cast<std::size_t>(w) * (U.y1 - U.y0);
   depth->assign(n, std::numeric_limits<float>::infinity());
   id->assign(n, kNoPart);
   for (std::size_t k = 0; k < parts.size(); ++k) {
     const CamPart& part = parts[k];
-    const int x0 = std::max(part.rect.x0, U.x0), x1 = std::min(part.rect.x1, U.x1);
     const int y0 = std::max(part.rect.y0, U.y0), y1 = std::min(part.rect.y1, U.y1);
     for (int y = y0; y < y1; ++y) {
+      int x0 = part.rect.x0, x1 = part.rect.x1;
+      if (cull) std::tie(x0, x1) = row_span(cam, part, y);
+      x0 = std::max(x0, U.x0), x1 = std::min(x1, U.x1);
       float* drow = depth->data() + static_cast<std::size_t>(y - U.y0) * w - U.x0;
       uint8_t* irow = id->data() + static_cast<std::size_t>(y - U.y0) * w - U.x0;
       for (int x = x0; x < x1; ++x) {
@@ -483,7 +535,7 @@ void render_actor(const StudioOptions& options, const CameraCache& cam, const Pr
   // Background behind the actor (after shadow) for spill, anti-aliasing and blur.
   s.bg.resize(n);
   for (int y = U.y0; y < U.y1; ++y) std::copy_n(&(*image)(U.x0, y), w, s.bg.data() + at(U.x0, y));
-  cast(cam, parts, U, &s.depth, &s.id);
+  cast(cam, parts, U, &s.depth, &s.id, cull);
   for (int y = U.y0; y < U.y1; ++y) {
     uint8_t* mrow = &(*mask)(0, y);
     Rgb8* irow = &(*image)(0, y);
