@@ -40,7 +40,7 @@ const char kConfigHelp[] =
     "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true,\n"
     "               frame_code: false, stamp: false, offset_us: 0, jitter_us: 0, drop_every: 0,\n"
     "               readout_us: -1, motion: sequence, swing_peak_speed: 1.5,\n"
-    "               costume: plain}\n"
+    "               costume: plain, buffers: 8}\n"
     "                                    readout_us: exposure instant -> frame on the host (the\n"
     "                                    rest of the exposure, read-out, transfer); -1 (default):\n"
     "                                    a GigE camera's, half the exposure + 8 bits a pixel at\n"
@@ -51,6 +51,9 @@ const char kConfigHelp[] =
     "                                    of a studio must give the same\n"
     "                                    stamp: frame number as a corner code in the pixels;\n"
     "                                    offset/jitter/drop_every: a real camera's imperfections\n"
+    "                                    buffers: frames the camera holds for a late consumer\n"
+    "                                    (older ones are lost, counted as drops), as an aravis\n"
+    "                                    source's buffers (default 8: a 280 ms stall at 25 fps)\n"
     "                                    frame_code: the actor wears the frame number (preview tests)\n"
     "                                    costume: plain (evenly coloured clothing) or patterned\n"
     "                                    (a fixed pattern on the clothing's surface, the same from\n"
@@ -99,6 +102,7 @@ struct SimKeys {
   double offset_us = 0, jitter_us = 0;
   double readout_us = -1;  // -1: a GigE camera's (see kUsage)
   int drop_every = 0;
+  int buffers = 8;  // SimSourceOptions::buffer_frames
   sim::Motion motion = sim::Motion::sequence;  // the simulated actor's motion (sim/actor.h)
   double swing_peak_speed = 1.5;               // arm_swing: fingertip peak speed, m/s
   Expected<void> validate() const {
@@ -149,6 +153,7 @@ const yaml::Schema<SimKeys> kSim{
     yaml::field("jitter_us", &SimKeys::jitter_us).range(0, 1e6),
     yaml::field("readout_us", &SimKeys::readout_us).range(-1, 1e6),
     yaml::field("drop_every", &SimKeys::drop_every).range(0, 1e9),
+    yaml::field("buffers", &SimKeys::buffers).range(1, 64),
     yaml::field("motion", &SimKeys::motion,
                 [](const yaml::Node& n) -> Expected<sim::Motion> {
                   auto s = n.as_string();
@@ -271,6 +276,7 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
     so.offset_ns = int64_t(c.sim.offset_us * 1000);
     so.jitter_ns = int64_t(c.sim.jitter_us * 1000);
     so.drop_every = uint64_t(c.sim.drop_every);
+    so.buffer_frames = c.sim.buffers;
     so.camera = sim::ring_cameras(ring)[std::size_t(c.sim.index)];
     so.camera.id = c.id;
     so.clock = clock;

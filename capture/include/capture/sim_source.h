@@ -53,7 +53,9 @@ struct SimSourceOptions {
   sim::StudioOptions studio;  // the scene (actor motion, realism knobs); threads forced to 1
   FrameClock clock;
   bool paced = true;
-  int buffer_frames = 4;  // 1 .. 64
+  // 1 .. 64. 8, as an Aravis stream's default pool (aravis_source.h `buffers`): a consumer held up
+  // for up to 7 frame periods (280 ms at 25 fps: a host stall) catches up with every frame.
+  int buffer_frames = 8;
   double gain_db = 0;
   double exposure_us = 10000;
   double nominal_exposure_us = 10000;  // exposure at which the image has its natural brightness
