@@ -102,7 +102,7 @@ struct SimKeys {
   double offset_us = 0, jitter_us = 0;
   double readout_us = -1;  // -1: a GigE camera's (see kUsage)
   int drop_every = 0;
-  int buffers = 8;  // SimSourceOptions::buffer_frames
+  int buffers = SimSourceOptions{}.buffer_frames;
   sim::Motion motion = sim::Motion::sequence;  // the simulated actor's motion (sim/actor.h)
   double swing_peak_speed = 1.5;               // arm_swing: fingertip peak speed, m/s
   Expected<void> validate() const {

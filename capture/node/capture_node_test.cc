@@ -128,6 +128,7 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
        "sequence or arm_swing)"},
       {"cameras:\n  - id: a\n    source: {type: sim, costume: tartan}\n",
        "expected one of plain, patterned, got 'tartan'"},
+      {"cameras:\n  - id: a\n    source: {type: sim, buffers: 0}\n", "buffers"},
       {"image: {rate: fast}\ncameras:\n  - id: a\n    source: {type: sim}\n", "image.rate"},
       {"cameras:\n  - id: a\n    source: {type: files, path: nowhere}\n", "nowhere"},
       {"clock: {fps: 25, period_ns: 40000000}\ncameras: []\n", "not both"},
@@ -148,7 +149,8 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
   auto& ok = spawn("capture", "capture/studio-capture",
                    {"--config", write_config("costume.yaml",
                                              "cameras:\n  - id: a\n    source: {type: sim, "
-                                             "width: 176, height: 144, costume: patterned}\n")});
+                                             "width: 176, height: 144, costume: patterned, "
+                                             "buffers: 16}\n")});
   EXPECT_TRUE(ok.wait_ready(30s)) << ok.log();
 }
 

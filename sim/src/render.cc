@@ -369,28 +369,6 @@ std::vector<int> instant_sample_order(int n) {
   return order;
 }
 
-// Colour of one sub-pixel sample at (x + o[0], y + o[1]): the nearest of `parts` whose rectangle
-// holds pixel (x, y) (rectangles carry a 1 px margin), or the background colour behind it.
-// Counts the sample in *hits when it is on the actor.
-std::array<float, 3> sub_sample(const CameraCache& cam, const Shader& shader,
-                                const std::vector<CamPart>& parts, int x, int y,
-                                const std::array<double, 2>& o, const Rgb8& bg, int* hits) {
-  const Eigen::Vector3d d = sub_ray(cam, x + o[0], y + o[1]);
-  double best = std::numeric_limits<double>::infinity();
-  int best_k = -1;
-  for (std::size_t k = 0; k < parts.size(); ++k) {
-    if (!parts[k].rect.contains(x, y)) continue;
-    const double t = parts[k].hit(d);
-    if (t < best) {
-      best = t;
-      best_k = static_cast<int>(k);
-    }
-  }
-  if (best_k < 0) return {float(bg.r), float(bg.g), float(bg.b)};
-  ++*hits;
-  return shader(parts[static_cast<std::size_t>(best_k)], d, best, bg);
-}
-
 // The nearest part a sub-pixel ray hits (part -1: none) and where.
 struct SubHit {
   int part = -1;
@@ -398,9 +376,9 @@ struct SubHit {
   double t = 0;
 };
 
-// sub_sample()'s hit test alone, among the candidate parts `cand` (ascending indices) only: the
-// same nearest part (ties go to the lower index either way) when the parts left out cannot be
-// hit (cone_misses). cand == nullptr: every part whose rectangle holds pixel (x, y).
+// The hit test of a sub-pixel sample, among the candidate parts `cand` (ascending indices)
+// only: the same nearest part (ties go to the lower index either way) when the parts left out
+// cannot be hit (cone_misses). cand == nullptr: every part whose rectangle holds pixel (x, y).
 SubHit sub_hit(const CameraCache& cam, const std::vector<CamPart>& parts, const uint8_t* cand,
                int n_cand, int x, int y, const std::array<double, 2>& o) {
   SubHit h;
@@ -421,6 +399,18 @@ SubHit sub_hit(const CameraCache& cam, const std::vector<CamPart>& parts, const 
   }
   h.t = best;
   return h;
+}
+
+// Colour of one sub-pixel sample at (x + o[0], y + o[1]): the nearest of `parts` whose rectangle
+// holds pixel (x, y) (rectangles carry a 1 px margin), or the background colour behind it.
+// Counts the sample in *hits when it is on the actor.
+std::array<float, 3> sub_sample(const CameraCache& cam, const Shader& shader,
+                                const std::vector<CamPart>& parts, int x, int y,
+                                const std::array<double, 2>& o, const Rgb8& bg, int* hits) {
+  const SubHit h = sub_hit(cam, parts, nullptr, 0, x, y, o);
+  if (h.part < 0) return {float(bg.r), float(bg.g), float(bg.b)};
+  ++*hits;
+  return shader(parts[static_cast<std::size_t>(h.part)], h.d, h.t, bg);
 }
 
 // Area-integrated colour of an edge pixel from its sub-samples' hits `h` (offsets `o`): each
