@@ -208,7 +208,7 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
           order.resize(obs.size());
           for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
           std::partial_sort(order.begin(), order.begin() + options.max_judges, order.end(),
-                            [&](std::size_t a, std::size_t b) { return obs[a].cos > obs[b].cos; });
+                            [&](std::size_t i, std::size_t j) { return obs[i].cos > obs[j].cos; });
           order.resize(std::size_t(options.max_judges));
           std::sort(order.begin(), order.end());  // camera order kept
           judged.clear();
