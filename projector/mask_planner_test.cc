@@ -125,6 +125,65 @@ TEST(MaskPlanner, LatchedMeshUsesThePreviousFitUntilItsOwnIsFitted) {
   EXPECT_FALSE(late.latch_mesh("a", 6, sphere({0.2f, 1, 0}, 0.2f, kT0)));
 }
 
+// A fit computed off the render thread (FitWorker's fit_motion, installed by apply_fit) gives the
+// plan fit_pending gives; a fit that lands after a newer mesh was latched re-latches that mesh
+// with its fresher field (the velocity's age drops by a mesh interval), and stale or foreign fits
+// are ignored.
+TEST(MaskPlanner, FitsInstalledFromElsewhereMatchAndALateFitRelatches) {
+  MaskPlannerOptions o;
+  MaskPlanner sync(o), async(o);
+  MotionTracker tracker(o.motion);  // the fit thread's
+  auto at = [](int k) { return sphere({0.04f * k, 1, 0}, 0.2f, kT0 + k * kDt); };
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(sync.latch_mesh("a", k, at(k)));
+    ASSERT_TRUE(async.latch_mesh("a", k, at(k)));
+    EXPECT_EQ(sync.fit_pending(), 1);
+    const auto applied = async.apply_fit(fit_motion(tracker, "a", at(k), o.motion.region_size_m));
+    EXPECT_EQ(applied, k == 0 ? MaskPlanner::Applied::ignored : MaskPlanner::Applied::own);
+  }
+  const int64_t display = kT0 + 2 * kDt + 30'000'000;
+  auto s = sync.plan(display), a = async.plan(display);
+  ASSERT_TRUE(s && a);
+  EXPECT_TRUE(a->margin.predicted);
+  EXPECT_NEAR(a->margin.margin_m, s->margin.margin_m, 1e-12);
+  EXPECT_NEAR(centroid(a->masks[0]).x(), centroid(s->masks[0]).x(), 1e-6f);
+
+  // Mesh 3 latched (field of fit 2: age 40 + 20 ms), then mesh 4 latched before fit 3 lands:
+  // from field 2, 80 + 20 ms old.
+  ASSERT_TRUE(async.latch_mesh("a", 3, at(3)));
+  FitResult fit3 = fit_motion(tracker, "a", at(3), o.motion.region_size_m);
+  ASSERT_TRUE(async.latch_mesh("a", 4, at(4)));
+  const int64_t display4 = kT0 + 4 * kDt + 30'000'000;
+  auto before = async.plan(display4);
+  ASSERT_TRUE(before && before->margin.predicted);
+  EXPECT_NEAR(before->margin.velocity_age_s, 0.10, 1e-6);
+  FitResult again = fit3;
+  EXPECT_EQ(async.apply_fit(std::move(fit3)), MaskPlanner::Applied::field);
+  auto after = async.plan(display4);
+  ASSERT_TRUE(after && after->margin.predicted);
+  EXPECT_NEAR(after->margin.velocity_age_s, 0.06, 1e-6);  // from field 3
+  EXPECT_LE(after->margin.margin_m, before->margin.margin_m);
+  EXPECT_NEAR(centroid(after->masks[0]).x(), 0.16f + 0.03f, 0.01f);  // moved on by 1 m/s
+  // The same field again, an unknown actor, a fit newer than the mesh, a refused fit: ignored.
+  EXPECT_EQ(async.apply_fit(std::move(again)), MaskPlanner::Applied::ignored);
+  MotionTracker other(o.motion);
+  FitResult unknown = fit_motion(other, "b", at(4), o.motion.region_size_m);
+  EXPECT_EQ(async.apply_fit(std::move(unknown)), MaskPlanner::Applied::ignored);
+  FitResult newer;
+  newer.actor = "a";
+  newer.capture_ns = kT0 + 9 * kDt;
+  EXPECT_EQ(async.apply_fit(std::move(newer)), MaskPlanner::Applied::ignored);
+  auto unchanged = async.plan(display4);
+  ASSERT_TRUE(unchanged);
+  EXPECT_NEAR(unchanged->margin.velocity_age_s, 0.06, 1e-6);
+  // Mesh 4's own fit: predicted by its own motion from now on.
+  EXPECT_EQ(async.apply_fit(fit_motion(tracker, "a", at(4), o.motion.region_size_m)),
+            MaskPlanner::Applied::own);
+  auto own = async.plan(display4);
+  ASSERT_TRUE(own);
+  EXPECT_NEAR(own->margin.velocity_age_s, 0.02, 1e-6);
+}
+
 // A mesh older at display than the measured latency (no newer mesh came): the margin covers its
 // real age, up to the cap.
 TEST(MaskPlanner, StaleMeshIsCoveredForItsAge) {

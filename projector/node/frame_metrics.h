@@ -19,6 +19,7 @@ struct FrameMetrics {
         rerendered(loop.counter("scene_rerendered")),
         held(loop.counter("frames_held")),
         fits_deferred(loop.counter("motion_fits_deferred")),
+        fits_relatched(loop.counter("motion_fits_relatched")),
         moving_nodes(loop.metrics().gauge("scene_moving_nodes")),
         cache_move_mm(loop.metrics().gauge("scene_cache_move_mm")),
         held_shift_px(loop.metrics().gauge("scene_held_shift_px")),
@@ -31,7 +32,7 @@ struct FrameMetrics {
     loop.count_as_output(rendered);
   }
   runtime::Counter &rendered, &eye_rejected, &head_stale, &scene_left_out, &assets_failed,
-      &superseded, &mesh_errors, &from_cache, &rerendered, &held, &fits_deferred;
+      &superseded, &mesh_errors, &from_cache, &rerendered, &held, &fits_deferred, &fits_relatched;
   runtime::Gauge &moving_nodes, &cache_move_mm, &held_shift_px, &cpu_per_frame_ms, &margin_mm, &latency_p_ms,
       &render_ms, &overrun_p_ms, &mesh_triangles;
 };

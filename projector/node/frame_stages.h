@@ -7,7 +7,8 @@
 //                      latching: the scene drawn ahead or the previous mesh's fit)
 //   stage_motion_ms    the mesh's motion estimate (once per mesh, MaskPlanner::set_mesh; late
 //                      latching: after the mesh's first frame, off its path, fit_pending with
-//                      the velocity field it builds)
+//                      the velocity field it builds; with the fit thread, the fit's wall time
+//                      there, at its lower priority, added when the render thread installs it)
 //   stage_simplify_ms  the mask mesh simplified (once per mesh)
 //   stage_latch_ms     late latching: the previous fit's velocities looked up for the new mesh's
 //                      vertices (once per mesh, MaskPlanner::latch_mesh)

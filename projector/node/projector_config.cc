@@ -22,6 +22,7 @@ Expected<void> ProjectorNodeOptions::validate() const {
     return fail("eye_texture_scale: 0.1..1");
   if (!(display_lag_s >= 0 && display_lag_s <= 1)) return fail("display_lag: 0..1 seconds");
   if (!(head_timeout_s > 0)) return fail("head_timeout: > 0 seconds");
+  if (fit_nice < 0 || fit_nice > 19) return fail("fit_nice: 0..19");
   if (auto ok = scene_cache.validate(); !ok) return ok;
   return mask_options().validate();
 }
@@ -85,6 +86,18 @@ runtime::ServiceDefinition projector_service_definition() {
       "                            finish and read-back (the margin counts the older\n"
       "                            velocity: projector/mask_margin.h);\n"
       "                            false: motion fit, scene and masks after the mesh arrives\n"
+      "    fit_thread: true        late_latch: the motion fits run on a thread of their own, so\n"
+      "                            a new mesh never waits for the previous mesh's fit; each\n"
+      "                            finished fit is installed at the next frame (a fit that lands\n"
+      "                            after a newer mesh re-latches it with fresher velocities:\n"
+      "                            motion_fits_relatched); a mesh waiting for the thread when a\n"
+      "                            newer one comes is not fitted (motion_fits_deferred);\n"
+      "                            false: fitted on the render thread after each frame\n"
+      "    fit_nice: 14            fit_thread: its nice value above the process's (0..19): the\n"
+      "                            render thread and the rasteriser come first and the fit takes\n"
+      "                            what they leave (the systemd unit's Nice=5 + 14: the lowest);\n"
+      "                            a fit that lands late only ages the velocities, which the\n"
+      "                            margin counts\n"
       "    parallel_mesh_work: true  late_latch false: a new mesh's mask simplification runs on\n"
       "                            a second thread while its motion is fitted (the mesh waits\n"
       "                            for the longer of the two, not their sum; same result and\n"
@@ -145,7 +158,7 @@ runtime::ServiceDefinition projector_service_definition() {
       "  (latency = motion to photon; margin_mm, latency_p_ms, overrun_p_ms (frames shown later\n"
       "  than planned: the margin covers the mesh's age at display + this), render_ms,\n"
       "  eye_rejected, meshes_rejected, meshes_superseded, mesh_motion_errors, mesh_triangles\n"
-      "  (of the last mesh received); where a mesh's\n"
+      "  (of the last mesh received), motion_fits_deferred, motion_fits_relatched; where a mesh's\n"
       "  time goes, ms: stage_wait_ms, stage_motion_ms, stage_simplify_ms, stage_mask_ms,\n"
       "  stage_draw_ms, stage_finish_ms, stage_readback_ms, stage_publish_ms, stage_present_ms,\n"
       "  stage_latch_ms, stage_ahead_ms,\n"
@@ -206,6 +219,8 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("frame_every", &ProjectorNodeOptions::frame_every).range(0, 100000),
         yaml::field("thumbnail", &ProjectorNodeOptions::thumbnail).size(2),
         yaml::field("late_latch", &ProjectorNodeOptions::late_latch),
+        yaml::field("fit_thread", &ProjectorNodeOptions::fit_thread),
+        yaml::field("fit_nice", &ProjectorNodeOptions::fit_nice).range(0, 19),
         yaml::field("parallel_mesh_work", &ProjectorNodeOptions::parallel_mesh_work),
         yaml::field("mask_presimplify", &ProjectorNodeOptions::mask_presimplify),
         yaml::enum_field("mask_growth", &ProjectorNodeOptions::mask_outline,

@@ -14,6 +14,7 @@
 #include "frame_output.h"
 #include "frame_stages.h"
 #include "projector/eye_source.h"
+#include "projector/fit_worker.h"
 #include "projector/mesh_inbox.h"
 #include "projector_wire.h"
 #include "runtime/service_loop.h"
@@ -87,6 +88,11 @@ class ProjectorNode : public runtime::Node {
       std::lock_guard lock(mutex_);
       stop_ = false;
       init_ = std::promise<Expected<void>>();
+    }
+    if (options_.late_latch && options_.fit_thread && !fits_) {
+      auto w = FitWorker::create({options_.mask_options().motion, options_.fit_nice});
+      if (!w) return std::unexpected(w.error());
+      fits_ = std::move(*w);
     }
     auto init = init_.get_future();
     if (auto ok = loop_.start(); !ok) return ok;
@@ -169,18 +175,25 @@ class ProjectorNode : public runtime::Node {
       head_speed = head_speed_;
       if (!taken.meshes.empty()) arrived = mesh_arrived_;
     }
+    if (fits_) install_fits();  // before the latches: a new mesh gets the newest field
     if (arrived && options_.late_latch) {
       stages_.add(FrameStages::wait, seconds(SteadyClock::now() - *arrived));
       // Removals, then each new mesh latched: simplified and given the previous fit's
-      // velocities; its own fit waits until after the frame (fit_after_frame).
-      for (const std::string& id : taken.removed) planner_.remove(id);
+      // velocities; its own fit follows, on the fit thread or after the frame.
+      for (const std::string& id : taken.removed) {
+        planner_.remove(id);
+        if (fits_) fits_->remove(id);
+      }
       int refused = 0;
       for (auto& [id, p] : taken.meshes) {
+        std::optional<ActorMesh> copy;  // the fit thread's (the planner keeps its own)
+        if (fits_) copy = p.mesh;
         if (auto ok = planner_.latch_mesh(id, p.frame, std::move(p.mesh)); !ok) {
           if (refused++ == 0) STUDIO_LOG(debug, kLog) << ok.error().message;
         } else {
           stages_.add(FrameStages::simplify, planner_.last_mesh_cost().simplify_s);
           stages_.add(FrameStages::latch, planner_.last_mesh_cost().latch_s);
+          if (copy && fits_->submit(id, std::move(*copy))) m_.fits_deferred.add();
         }
       }
       if (refused > 0) m_.mesh_errors.add(refused);
@@ -198,6 +211,17 @@ class ProjectorNode : public runtime::Node {
     }
     if (head_speed) planner_.set_head_speed(options_.mesh_actor, *head_speed);
     return arrived;
+  }
+  // The fits the fit thread finished since the last frame, installed in the planner (in order).
+  void install_fits() {
+    for (FitResult& r : fits_->take()) {
+      if (!r.error.empty()) {
+        m_.mesh_errors.add();
+        STUDIO_LOG(debug, kLog) << "actor " << r.actor << ": " << r.error;
+      }
+      stages_.add(FrameStages::motion, r.motion_s + r.field_s);
+      if (planner_.apply_fit(std::move(r)) == MaskPlanner::Applied::field) m_.fits_relatched.add();
+    }
   }
   static double seconds(SteadyClock::duration d) {
     return std::chrono::duration<double>(d).count();
@@ -265,6 +289,7 @@ class ProjectorNode : public runtime::Node {
       render_one(*fr, state, out.window ? &*out.window : nullptr);
       if (options_.late_latch) {
         prepare_ahead(*fr, state, seconds(next - SteadyClock::now()));
+        if (fits_) continue;  // the fit thread fits the frame's meshes
         // A newer mesh already waiting (the thread is behind): its frame goes first and this
         // mesh's fit is dropped; the next fit is against the last mesh fitted, over two mesh
         // intervals (MaskPlanner::latch_mesh), and the margin counts the velocities' age. Never
@@ -417,6 +442,7 @@ class ProjectorNode : public runtime::Node {
   runtime::Output<studio_ProjectorCalibration>* calibration_ = nullptr;
   runtime::Output<studio_ProjectorFrame>* frames_ = nullptr;
   MaskPlanner planner_;        // the render thread's alone
+  std::unique_ptr<FitWorker> fits_;  // late_latch + fit_thread: the motion fits' thread
   runtime::ServiceLoop loop_;  // stopped before the state above goes
   FrameStages stages_;         // the render thread's (gauges of loop_'s metrics)
   FrameMetrics m_;

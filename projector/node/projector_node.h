@@ -65,6 +65,11 @@ struct ProjectorNodeOptions {
   // (MaskPlanner::latch_mesh), its mask over the prepared scene, the finish and read-back.
   // false: the whole frame (motion fit, scene, masks) after the mesh arrives.
   bool late_latch = true;
+  // Late latching: the motion fits on a thread of their own (projector/fit_worker.h) instead of
+  // the render thread after each frame; the render thread installs each finished fit at its next
+  // frame. The thread runs fit_nice below the process (0..19). false: fitted on the render thread.
+  bool fit_thread = true;
+  int fit_nice = 14;
   // A mesh's simplification on a second thread beside its motion fit (MaskPlannerOptions; the
   // path without late latching).
   bool parallel_mesh_work = true;

@@ -259,6 +259,17 @@ TEST_F(ProjectorNodeTest, RendersTheSceneMasksTheActorAndReportsOverDds) {
   }
   EXPECT_TRUE(newest) << node.log();
   EXPECT_LT(drawn.size(), 30u);  // not one frame per mesh of the burst
+  // The burst's meshes were fitted on the fit thread (the default, fit_thread: true) and the fits
+  // installed: the status times them; the ones a newer mesh overtook are counted.
+  bool fitted = false;
+  for (auto until = SteadyClock::now() + 10s; !fitted && SteadyClock::now() < until;) {
+    for (auto& s : status.take())
+      if (s.meta.valid_data && std::string(s.data->service) == "projector")
+        fitted = counter(*s.data, "stage_motion_ms") > 0 &&
+                 counter(*s.data, "motion_fits_deferred") >= 0;
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_TRUE(fitted) << node.log();
 
   // The actor leaves (the hull disposes its mesh): no mask any more.
   ASSERT_TRUE(meshes.dispose(*m).has_value());

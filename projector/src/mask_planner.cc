@@ -101,55 +101,76 @@ Expected<void> MaskPlanner::latch_mesh(const std::string& actor_id, std::uint64_
   const auto t1 = Clock::now();
   // A mesh latched over one never fitted (two latches without fit_pending between them): that
   // one is skipped by the tracker; the next fit is against the last mesh fitted.
-  a.latched.clear();
-  a.latched_age_s = 0;
-  if (a.field && a.field_motion &&
-      (mesh.capture_ns - a.field->capture_ns()) * 1e-9 <= options_.motion.max_dt_s) {
-    if (auto v = a.field->at(base->mesh)) {
-      a.latched = std::move(*v);
-      a.latched_age_s =
-          (mesh.capture_ns - a.field->capture_ns()) * 1e-9 + 0.5 * a.field_motion->dt_s;
-    }
-  }
-  a.motion.reset();  // this mesh's own motion: after fit_pending()
+  a.motion.reset();  // this mesh's own motion: after fit_pending() / apply_fit()
   a.fitted.clear();
   a.mesh = std::move(mesh);
   a.base = std::move(*base);
   a.frame = frame;
   a.pending = true;
+  relatch(a);
   last_cost_ = {0, std::chrono::duration<double>(t1 - t0).count(),
                 std::chrono::duration<double>(Clock::now() - t1).count(), 0};
   return {};
 }
 
 int MaskPlanner::fit_pending() {
-  using Clock = std::chrono::steady_clock;
   int fitted = 0;
   double motion_s = 0, field_s = 0;
   for (auto& [id, a] : actors_) {
     if (!a.pending) continue;
-    a.pending = false;
     ++fitted;
-    const auto t0 = Clock::now();
-    auto m = a.tracker.update(a.mesh);
-    const auto t1 = Clock::now();
-    motion_s += std::chrono::duration<double>(t1 - t0).count();
-    a.field.reset();
-    a.field_motion.reset();
-    if (!m || !*m) continue;  // refused or no estimate (first mesh, gap): not predicted
-    a.motion = std::move(**m);
-    a.fitted = velocities_at(a.base, *a.motion);
-    a.known_speed_mps = a.motion->max_speed_mps;
-    a.latched.clear();  // the mesh's own motion from now on
-    if (auto f = VelocityField::create(a.mesh, *a.motion, options_.motion.region_size_m)) {
-      a.field = std::move(*f);
-      a.field_motion = a.motion;
-    }
-    field_s += std::chrono::duration<double>(Clock::now() - t1).count();
+    FitResult r = fit_motion(a.tracker, id, a.mesh, options_.motion.region_size_m);
+    motion_s += r.motion_s;
+    field_s += r.field_s;
+    apply_fit(std::move(r));
   }
   last_cost_.motion_s = motion_s;
   last_cost_.field_s = field_s;
   return fitted;
+}
+
+MaskPlanner::Applied MaskPlanner::apply_fit(FitResult fit) {
+  auto it = actors_.find(fit.actor);
+  if (it == actors_.end()) return Applied::ignored;
+  Actor& a = it->second;
+  if (fit.capture_ns == a.mesh.capture_ns) {  // the current mesh's own fit
+    a.pending = false;
+    a.field.reset();
+    a.field_motion.reset();
+    if (!fit.motion) return Applied::ignored;  // refused or no estimate: not predicted
+    a.motion = std::move(*fit.motion);
+    a.fitted = velocities_at(a.base, *a.motion);
+    a.known_speed_mps = a.motion->max_speed_mps;
+    a.latched.clear();  // the mesh's own motion from now on
+    if (fit.field) {
+      a.field = std::move(*fit.field);
+      a.field_motion = a.motion;
+    }
+    return Applied::own;
+  }
+  // An older mesh's fit that finished after a newer mesh was latched (FitWorker): its field is
+  // newer than the one that mesh was latched with, so the mesh is latched again from it.
+  if (fit.capture_ns > a.mesh.capture_ns || !fit.motion || !fit.field) return Applied::ignored;
+  if (a.field && a.field->capture_ns() >= fit.capture_ns) return Applied::ignored;
+  a.known_speed_mps = fit.motion->max_speed_mps;
+  a.field = std::move(*fit.field);
+  a.field_motion = std::move(*fit.motion);
+  if (a.motion) return Applied::field;  // the mesh has its own fit already
+  relatch(a);
+  return Applied::field;
+}
+
+void MaskPlanner::relatch(Actor& a) {
+  a.latched.clear();
+  a.latched_age_s = 0;
+  if (a.field && a.field_motion &&
+      (a.mesh.capture_ns - a.field->capture_ns()) * 1e-9 <= options_.motion.max_dt_s) {
+    if (auto v = a.field->at(a.base.mesh)) {
+      a.latched = std::move(*v);
+      a.latched_age_s =
+          (a.mesh.capture_ns - a.field->capture_ns()) * 1e-9 + 0.5 * a.field_motion->dt_s;
+    }
+  }
 }
 
 void MaskPlanner::remove(const std::string& actor_id) { actors_.erase(actor_id); }

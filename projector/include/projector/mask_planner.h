@@ -31,7 +31,9 @@
 // age (mask_margin.h: (capture - previous capture) + previous dt / 2 instead of dt / 2); frames
 // after the fit use the mesh's own motion, as set_mesh's. A latched mesh whose field is older
 // than MotionOptions::max_dt_s (or with no field yet) is not predicted: the no-prediction margin
-// with the actor's last known speed, as a mesh after a gap.
+// with the actor's last known speed, as a mesh after a gap. The fit may also run elsewhere
+// (FitWorker, projector/fit_worker.h, on its own thread): apply_fit() installs it, and a fit that
+// lands after a newer mesh was latched re-latches that mesh from its fresher field.
 //
 // A mesh without a motion estimate (the first after a gap longer than MotionOptions::max_dt_s,
 // e.g. the hull stalled) is not taken as still: its no-prediction margin uses the actor's last
@@ -51,6 +53,7 @@
 #include "projector/mask_geometry.h"
 #include "projector/mask_margin.h"
 #include "projector/motion.h"
+#include "projector/motion_fit.h"
 #include "projector/velocity_field.h"
 
 namespace studio::projector {
@@ -101,6 +104,15 @@ class MaskPlanner {
   // mesh of an actor gives no motion yet); the cost
   // lands in last_mesh_cost().motion_s / field_s. A failed fit leaves the mesh unpredicted.
   int fit_pending();
+  // Installs a fit computed elsewhere (FitWorker, projector/fit_worker.h; fit_pending() uses it
+  // too). The current mesh's own fit (same capture time): as fit_pending() — the mesh predicted by
+  // its own motion from now on, its field kept for the next latch. An older mesh's fit that
+  // finished after a newer mesh was latched: its field replaces an older one and the current mesh,
+  // while it has no fit of its own, is latched again from it (fresher velocities, a smaller age).
+  // Anything else (an unknown actor, a newer or refused fit, a field no newer than the one held):
+  // ignored.
+  enum class Applied { ignored, own, field };
+  Applied apply_fit(FitResult fit);
   void remove(const std::string& actor_id);
   void set_head_speed(const std::string& actor_id, double speed_mps);
   // Replaces the margin options for the next plans (a margin sweep: floor = cap = the margin
@@ -142,6 +154,9 @@ class MaskPlanner {
   // The actor a new mesh is for (created on its first mesh), once the mesh is valid and captured
   // after that actor's current one: the checks set_mesh() and latch_mesh() share.
   Expected<Actor*> accept(const std::string& actor_id, const ActorMesh& mesh);
+  // The latched velocities of a's current mesh from a's field (none when the field is missing or
+  // older than MotionOptions::max_dt_s).
+  void relatch(Actor& a);
   MaskPlannerOptions options_;
   std::map<std::string, Actor> actors_;
   LatencyWindow latencies_;

@@ -1,0 +1,178 @@
+// FitWorker (projector/fit_worker.h): the motion fits of late latching on a thread of their own
+// give the velocities the tracker gives on the caller's thread, in order; the newest mesh wins
+// while the thread is busy and the last mesh is always fitted; remove() starts an actor afresh;
+// a refused mesh is a result with its error, not a crash; the thread runs at its nice value.
+#include "projector/fit_worker.h"
+
+#include <gtest/gtest.h>
+
+#include <dirent.h>
+#include <sys/resource.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "testing/shapes.h"
+
+namespace studio::projector {
+namespace {
+
+constexpr int64_t kT0 = 1'700'000'000'000'000'000, kDt = 40'000'000;  // 25 fps
+
+// A sphere moving at 1 m/s along x, re-tessellated (rotated) every frame.
+ActorMesh moving(int k) {
+  const double a = 0.3 * k;
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(a, Eigen::Vector3d(0.3, 1, 0.2).normalized())
+                                .toRotationMatrix();
+  ActorMesh m = testing::sphere(Eigen::Vector3d(0.04 * k, 1.2, 0), 0.2, r);
+  m.capture_ns = kT0 + k * kDt;
+  return m;
+}
+
+std::unique_ptr<FitWorker> worker(int nice = 0) {
+  auto w = FitWorker::create({MotionOptions{}, nice});
+  EXPECT_TRUE(w) << (w ? "" : w.error().message);
+  return w ? std::move(*w) : nullptr;
+}
+
+TEST(FitWorker, GivesTheTrackersVelocitiesInOrder) {
+  auto w = worker();
+  ASSERT_TRUE(w);
+  MotionTracker reference;
+  std::vector<FitResult> got;
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_FALSE(w->submit("a", moving(k)));
+    w->drain();
+    for (auto& r : w->take()) got.push_back(std::move(r));
+  }
+  ASSERT_EQ(got.size(), 5u);
+  for (int k = 0; k < 5; ++k) {
+    const FitResult want = fit_motion(reference, "a", moving(k), MotionOptions{}.region_size_m);
+    EXPECT_EQ(got[k].actor, "a");
+    EXPECT_EQ(got[k].capture_ns, moving(k).capture_ns);
+    ASSERT_EQ(got[k].motion.has_value(), want.motion.has_value()) << k;
+    EXPECT_EQ(got[k].field.has_value(), want.field.has_value()) << k;
+    EXPECT_TRUE(got[k].error.empty()) << got[k].error;
+    if (!want.motion) continue;
+    ASSERT_EQ(got[k].motion->regions.size(), want.motion->regions.size());
+    for (std::size_t i = 0; i < want.motion->regions.size(); ++i)
+      EXPECT_EQ(got[k].motion->regions[i].velocity, want.motion->regions[i].velocity);
+    // The fitted motion itself: ~1 m/s along x.
+    EXPECT_NEAR(got[k].motion->global_velocity.x(), 1.0, 0.05);
+  }
+  EXPECT_FALSE(got[0].motion);  // the first mesh has nothing to be fitted against
+  EXPECT_EQ(w->fitted(), 5u);
+  EXPECT_EQ(w->dropped(), 0u);
+}
+
+TEST(FitWorker, NewestMeshWinsWhileBusyAndTheLastIsFitted) {
+  auto w = worker();
+  ASSERT_TRUE(w);
+  int replaced = 0;
+  const int n = 12;
+  for (int k = 0; k < n; ++k) replaced += w->submit("a", moving(k)) ? 1 : 0;
+  w->drain();
+  auto results = w->take();
+  EXPECT_EQ(w->dropped(), uint64_t(replaced));
+  EXPECT_EQ(w->fitted() + w->dropped(), uint64_t(n));
+  ASSERT_FALSE(results.empty());
+  EXPECT_EQ(results.size(), w->fitted());
+  EXPECT_EQ(results.back().capture_ns, moving(n - 1).capture_ns);
+  for (std::size_t i = 1; i < results.size(); ++i)
+    EXPECT_LT(results[i - 1].capture_ns, results[i].capture_ns);
+  // Over a skipped mesh the fit spans two intervals and still finds the motion.
+  if (results.size() >= 2) {
+    ASSERT_TRUE(results.back().motion);
+    EXPECT_NEAR(results.back().motion->global_velocity.x(), 1.0, 0.05);
+  }
+  EXPECT_TRUE(w->take().empty());  // taken once
+}
+
+TEST(FitWorker, RemovedActorStartsAfresh) {
+  auto w = worker();
+  ASSERT_TRUE(w);
+  w->submit("a", moving(0));
+  w->submit("b", moving(0));
+  w->drain();
+  EXPECT_EQ(w->take().size(), 2u);
+  // Positive control: the next mesh of a kept actor is fitted against its previous one.
+  w->submit("b", moving(1));
+  w->drain();
+  auto kept = w->take();
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_TRUE(kept[0].motion);
+  // Removed: a result not taken yet goes, and the next mesh is a first mesh again.
+  w->submit("a", moving(1));
+  w->drain();
+  w->remove("a");
+  EXPECT_TRUE(w->take().empty());
+  w->submit("a", moving(2));
+  w->drain();
+  auto fresh = w->take();
+  ASSERT_EQ(fresh.size(), 1u);
+  EXPECT_EQ(fresh[0].actor, "a");
+  EXPECT_FALSE(fresh[0].motion);
+  EXPECT_TRUE(fresh[0].error.empty());
+}
+
+TEST(FitWorker, RefusedMeshIsAResultWithItsError) {
+  auto w = worker();
+  ASSERT_TRUE(w);
+  w->submit("a", moving(0));
+  w->drain();
+  ActorMesh bad = moving(1);
+  bad.vertices[3].x() = NAN;
+  w->submit("a", std::move(bad));
+  w->drain();
+  w->submit("a", moving(2));  // after a refusal: a first mesh (the tracker was reset)
+  w->submit("a", moving(2));  // replaces the waiting one or comes after it: refused as not newer
+  w->drain();
+  w->submit("a", moving(3));  // positive control: fitted against mesh 2
+  w->drain();
+  auto r = w->take();
+  ASSERT_GE(r.size(), 4u);
+  EXPECT_FALSE(r[1].motion);
+  EXPECT_NE(r[1].error.find("finite"), std::string::npos) << r[1].error;
+  EXPECT_FALSE(r[2].motion);
+  ASSERT_TRUE(r.back().motion);
+  EXPECT_EQ(r.back().capture_ns, moving(3).capture_ns);
+  EXPECT_NEAR(r.back().motion->global_velocity.x(), 1.0, 0.05);
+}
+
+// The nice value of every thread of this process (Linux: /proc/self/task/*/stat, field 19).
+std::vector<int> thread_nice_values() {
+  std::vector<int> out;
+  DIR* d = opendir("/proc/self/task");
+  if (!d) return out;
+  while (dirent* e = readdir(d)) {
+    if (e->d_name[0] == '.') continue;
+    std::ifstream f(std::string("/proc/self/task/") + e->d_name + "/stat");
+    std::string line;
+    std::getline(f, line);
+    const auto close = line.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream rest(line.substr(close + 2));
+    std::string field;
+    for (int i = 3; i <= 19 && rest >> field; ++i)
+      if (i == 19) out.push_back(std::stoi(field));
+  }
+  closedir(d);
+  return out;
+}
+
+TEST(FitWorker, ThreadRunsAtItsNiceValue) {
+  EXPECT_FALSE(FitWorker::create({MotionOptions{}, 20}));
+  EXPECT_FALSE(FitWorker::create({MotionOptions{}, -1}));
+  const int base = getpriority(PRIO_PROCESS, 0);
+  auto w = worker(5);
+  ASSERT_TRUE(w);
+  w->submit("a", moving(0));
+  w->drain();  // the thread has run (and set its priority) by now
+  const auto nice = thread_nice_values();
+  EXPECT_EQ(std::count(nice.begin(), nice.end(), std::min(19, base + 5)), 1) << "base " << base;
+  EXPECT_GE(std::count(nice.begin(), nice.end(), base), 1);  // this thread unchanged
+}
+
+}  // namespace
+}  // namespace studio::projector

@@ -1,0 +1,124 @@
+#include "projector/fit_worker.h"
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <system_error>
+
+namespace studio::projector {
+
+Expected<void> FitWorkerOptions::validate() const {
+  if (auto ok = motion.validate(); !ok) return ok;
+  if (nice_increment < 0 || nice_increment > 19) return fail("nice_increment: 0..19");
+  return {};
+}
+
+Expected<std::unique_ptr<FitWorker>> FitWorker::create(const FitWorkerOptions& options) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  std::unique_ptr<FitWorker> w(new FitWorker(options));
+  try {
+    w->thread_ = std::thread([p = w.get()] { p->run(); });
+  } catch (const std::system_error& e) {
+    return fail(std::string("motion fit thread: ") + e.what());
+  }
+  return w;
+}
+
+FitWorker::FitWorker(const FitWorkerOptions& options) : options_(options) {}
+
+FitWorker::~FitWorker() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+bool FitWorker::submit(const std::string& actor, ActorMesh mesh) {
+  bool replaced = false;
+  {
+    std::lock_guard lock(mutex_);
+    const std::uint64_t epoch = epochs_[actor];
+    auto it = std::find_if(jobs_.begin(), jobs_.end(), [&](const Job& j) { return j.actor == actor; });
+    if (it != jobs_.end()) {
+      it->mesh = std::move(mesh);  // keeps its place in the queue
+      it->epoch = epoch;
+      ++dropped_;
+      replaced = true;
+    } else {
+      jobs_.push_back({actor, epoch, std::move(mesh)});
+    }
+  }
+  wake_.notify_one();
+  return replaced;
+}
+
+void FitWorker::remove(const std::string& actor) {
+  std::lock_guard lock(mutex_);
+  ++epochs_[actor];  // a fit running now for it is discarded when it lands
+  std::erase_if(jobs_, [&](const Job& j) { return j.actor == actor; });
+  std::erase_if(results_, [&](const FitResult& r) { return r.actor == actor; });
+}
+
+std::vector<FitResult> FitWorker::take() {
+  std::vector<FitResult> out;
+  std::lock_guard lock(mutex_);
+  out.swap(results_);
+  return out;
+}
+
+void FitWorker::drain() {
+  std::unique_lock lock(mutex_);
+  idle_.wait(lock, [this] { return (jobs_.empty() && !busy_) || stop_; });
+}
+
+std::uint64_t FitWorker::fitted() const {
+  std::lock_guard lock(mutex_);
+  return fitted_;
+}
+
+std::uint64_t FitWorker::dropped() const {
+  std::lock_guard lock(mutex_);
+  return dropped_;
+}
+
+void FitWorker::run() {
+  if (options_.nice_increment > 0) {
+    // Linux: the nice value is a per-thread attribute; PRIO_PROCESS with this thread's id sets
+    // this thread's alone. Failing to lower our own priority changes only the share, not results.
+    const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
+    errno = 0;
+    const int current = ::getpriority(PRIO_PROCESS, tid);
+    if (errno == 0)
+      (void)::setpriority(PRIO_PROCESS, tid, std::min(19, current + options_.nice_increment));
+  }
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_.wait(lock, [this] { return stop_ || !jobs_.empty(); });
+    if (stop_) break;
+    Job job = std::move(jobs_.front());
+    jobs_.pop_front();
+    busy_ = true;
+    // Trackers of actors removed since (their epoch moved on) go; a new one starts below.
+    std::erase_if(trackers_, [this](const auto& t) { return epochs_[t.first] != t.second.first; });
+    lock.unlock();
+    auto it = trackers_.find(job.actor);
+    if (it == trackers_.end())
+      it = trackers_.emplace(job.actor, std::pair(job.epoch, MotionTracker(options_.motion))).first;
+    FitResult r =
+        fit_motion(it->second.second, job.actor, job.mesh, options_.motion.region_size_m);
+    lock.lock();
+    busy_ = false;
+    ++fitted_;
+    if (epochs_[job.actor] == job.epoch) results_.push_back(std::move(r));
+    if (jobs_.empty()) idle_.notify_all();
+  }
+  busy_ = false;
+  idle_.notify_all();
+}
+
+}  // namespace studio::projector
