@@ -36,8 +36,10 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
   --scheduling S     realtime (default when permitted): the services run SCHED_FIFO at the
                      priorities of their systemd units, in pipeline order (capture 52, keyer
                      54, hull 56, tracker 58, scene 50; the probe's receive path 45, its
-                     scoring 41), as installed; the projector (see --projector-priority)
-                     and the preview time-sharing, as their units run them;
+                     scoring SCHED_IDLE), as installed; the projector (see
+                     --projector-priority) and the preview time-sharing, as their units run
+                     them (the headless preview, the report's picture taker, at nice 10:
+                     below the projector, whose frames the actor sees);
                      normal: time-sharing
   --projector-priority P
                      nice:N (default nice:5, the projector's systemd unit) or, with realtime
@@ -245,8 +247,11 @@ if have $preview_bin preview.yaml; then
     # Low-rate pictures (the issue's "taking its pictures at a low rate"): one mesh drawn every
     # 2 s, textured from the capture servers' image rings with only its own frame's images
     # requested; each picture replaces preview.png; SIGTERM at the end like the others (exit 0
-    # when it drew a mesh; exit status checked with the others).
-    start preview nice:0 "$preview_bin" --config "$cfg/preview.yaml" --headless --every 2 \
+    # when it drew a mesh; exit status checked with the others). At nice 10, below the
+    # projector (nice 5): on this one machine a picture (~130 ms of llvmpipe every 2 s) at nice 0
+    # took CPU from the projector's frames, i.e. from what the actor sees; in a studio the
+    # preview has a PC of its own. BENCHMARKS.md, demo, session 17: p99 115 -> 96 ms.
+    start preview nice:10 "$preview_bin" --config "$cfg/preview.yaml" --headless --every 2 \
       --screenshot "$out/preview.png"
   fi
 fi
