@@ -1,14 +1,18 @@
 // FitWorker (projector/fit_worker.h): the motion fits of late latching on a thread of their own
 // give the velocities the tracker gives on the caller's thread, in order; the newest mesh wins
 // while the thread is busy and the last mesh is always fitted; remove() starts an actor afresh;
-// a refused mesh is a result with its error, not a crash; the thread runs at its nice value.
+// a refused mesh is a result with its error, not a crash; the thread runs at its nice value,
+// time-sharing under a real-time caller.
 #include "projector/fit_worker.h"
 
 #include <gtest/gtest.h>
 
 #include <dirent.h>
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -140,9 +144,13 @@ TEST(FitWorker, RefusedMeshIsAResultWithItsError) {
   EXPECT_NEAR(r.back().motion->global_velocity.x(), 1.0, 0.05);
 }
 
-// The nice value of every thread of this process (Linux: /proc/self/task/*/stat, field 19).
-std::vector<int> thread_nice_values() {
-  std::vector<int> out;
+// The nice value and scheduling policy of every thread of this process (Linux:
+// /proc/self/task/*/stat, fields 19 and 41).
+struct ThreadSched {
+  int nice = 0, policy = 0;
+};
+std::vector<ThreadSched> threads_sched() {
+  std::vector<ThreadSched> out;
   DIR* d = opendir("/proc/self/task");
   if (!d) return out;
   while (dirent* e = readdir(d)) {
@@ -154,8 +162,12 @@ std::vector<int> thread_nice_values() {
     if (close == std::string::npos) continue;
     std::istringstream rest(line.substr(close + 2));
     std::string field;
-    for (int i = 3; i <= 19 && rest >> field; ++i)
-      if (i == 19) out.push_back(std::stoi(field));
+    ThreadSched t;
+    for (int i = 3; i <= 41 && rest >> field; ++i) {
+      if (i == 19) t.nice = std::stoi(field);
+      if (i == 41) t.policy = std::stoi(field);
+    }
+    out.push_back(t);
   }
   closedir(d);
   return out;
@@ -169,9 +181,43 @@ TEST(FitWorker, ThreadRunsAtItsNiceValue) {
   ASSERT_TRUE(w);
   w->submit("a", moving(0));
   w->drain();  // the thread has run (and set its priority) by now
-  const auto nice = thread_nice_values();
-  EXPECT_EQ(std::count(nice.begin(), nice.end(), std::min(19, base + 5)), 1) << "base " << base;
-  EXPECT_GE(std::count(nice.begin(), nice.end(), base), 1);  // this thread unchanged
+  const auto threads = threads_sched();
+  auto count = [&](int nice, int policy) {
+    return std::count_if(threads.begin(), threads.end(),
+                         [&](const ThreadSched& t) { return t.nice == nice && t.policy == policy; });
+  };
+  EXPECT_EQ(count(std::min(19, base + 5), SCHED_OTHER), 1) << "base " << base;
+  EXPECT_GE(count(base, SCHED_OTHER), 1);  // this thread unchanged
+}
+
+// A real-time caller (the projector at SCHED_FIFO below the pipeline): the fit thread is made
+// time-sharing at its nice value, out of the real-time budget; with no increment it keeps the
+// caller's policy (the control).
+TEST(FitWorker, RealTimeCallersFitThreadIsTimeSharing) {
+  sched_param rt{};
+  rt.sched_priority = 1;
+  ASSERT_EQ(pthread_setschedparam(pthread_self(), SCHED_FIFO, &rt), 0)
+      << "SCHED_FIFO not permitted: this test needs CAP_SYS_NICE (root, as ./studio test runs)";
+  const int base = getpriority(PRIO_PROCESS, 0);
+  {
+    auto lowered = worker(5);
+    auto same = worker(0);
+    ASSERT_TRUE(lowered && same);
+    lowered->submit("a", moving(0));
+    same->submit("a", moving(0));
+    lowered->drain();
+    same->drain();
+    const auto threads = threads_sched();
+    auto count = [&](int nice, int policy) {
+      return std::count_if(threads.begin(), threads.end(), [&](const ThreadSched& t) {
+        return t.nice == nice && t.policy == policy;
+      });
+    };
+    EXPECT_EQ(count(std::min(19, base + 5), SCHED_OTHER), 1);
+    EXPECT_GE(count(base, SCHED_FIFO), 2);  // this thread and the worker without an increment
+  }
+  sched_param normal{};
+  EXPECT_EQ(pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal), 0);
 }
 
 }  // namespace

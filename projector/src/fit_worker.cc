@@ -1,5 +1,6 @@
 #include "projector/fit_worker.h"
 
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -88,9 +89,16 @@ std::uint64_t FitWorker::dropped() const {
 
 void FitWorker::run() {
   if (options_.nice_increment > 0) {
-    // Linux: the nice value is a per-thread attribute; PRIO_PROCESS with this thread's id sets
-    // this thread's alone. Failing to lower our own priority changes only the share, not results.
+    // Linux: the policy and the nice value are per-thread attributes; PRIO_PROCESS with this
+    // thread's id sets this thread's alone. A real-time caller (a projector at SCHED_FIFO below
+    // the pipeline) leaves the fit time-sharing: below every real-time thread, and out of the
+    // kernel's real-time budget. Failing to lower our own priority changes only the share, not
+    // the results.
     const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
+    if (const int policy = ::sched_getscheduler(0); policy == SCHED_FIFO || policy == SCHED_RR) {
+      sched_param time_sharing{};
+      (void)::sched_setscheduler(0, SCHED_OTHER, &time_sharing);
+    }
     errno = 0;
     const int current = ::getpriority(PRIO_PROCESS, tid);
     if (errno == 0)

@@ -39,7 +39,8 @@ namespace studio::projector {
 
 struct FitWorkerOptions {
   MotionOptions motion;
-  // The fit thread's nice value above the process's (0..19; 0: the same priority as the caller).
+  // The fit thread's nice value above the process's (0..19; 0: the same priority and policy as
+  // the caller). Above 0 a real-time caller's fit thread is also made time-sharing.
   int nice_increment = 0;
   Expected<void> validate() const;
 };
