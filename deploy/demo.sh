@@ -46,7 +46,8 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
                      scheduling, a SCHED_FIFO priority 1..40: below every pipeline stage and
                      the probe, above all time-sharing work (other sessions' builds cannot
                      take its CPU, but the real-time total can then reach the kernel's 95 %
-                     throttle, which pauses the whole pipeline: BENCHMARKS.md, demo)
+                     throttle, which pauses the whole pipeline: BENCHMARKS.md, demo; its
+                     motion-fit thread runs at FIFO 1)
   --sweep-frames N   frames of the projector mask's margin sweep (default 100; 0: none), run
                      after the services stopped, offline (studio-demo-probe sweep: the fast
                      arm swing through the hull library and the projector's MaskPlanner, at

@@ -2,20 +2,27 @@
 // give the velocities the tracker gives on the caller's thread, in order; the newest mesh wins
 // while the thread is busy and the last mesh is always fitted; remove() starts an actor afresh;
 // a refused mesh is a result with its error, not a crash; the thread runs at its nice value,
-// time-sharing under a real-time caller.
+// real-time priority 1 under a real-time caller.
 #include "projector/fit_worker.h"
 
 #include <gtest/gtest.h>
 
 #include <dirent.h>
+#include <linux/filter.h>
+#include <linux/seccomp.h>
+#include <sys/prctl.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 #include <pthread.h>
 #include <sched.h>
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "testing/shapes.h"
 
@@ -144,10 +151,11 @@ TEST(FitWorker, RefusedMeshIsAResultWithItsError) {
   EXPECT_NEAR(r.back().motion->global_velocity.x(), 1.0, 0.05);
 }
 
-// The nice value and scheduling policy of every thread of this process (Linux:
-// /proc/self/task/*/stat, fields 19 and 41).
+// The nice value, real-time priority and scheduling policy of every thread of this process
+// (Linux: /proc/self/task/*/stat, fields 19, 40 and 41).
 struct ThreadSched {
-  int nice = 0, policy = 0;
+  int nice = 0, rt_priority = 0, policy = 0;
+  bool operator==(const ThreadSched&) const = default;
 };
 std::vector<ThreadSched> threads_sched() {
   std::vector<ThreadSched> out;
@@ -165,12 +173,17 @@ std::vector<ThreadSched> threads_sched() {
     ThreadSched t;
     for (int i = 3; i <= 41 && rest >> field; ++i) {
       if (i == 19) t.nice = std::stoi(field);
+      if (i == 40) t.rt_priority = std::stoi(field);
       if (i == 41) t.policy = std::stoi(field);
     }
     out.push_back(t);
   }
   closedir(d);
   return out;
+}
+
+long count(const std::vector<ThreadSched>& threads, const ThreadSched& want) {
+  return std::count(threads.begin(), threads.end(), want);
 }
 
 TEST(FitWorker, ThreadRunsAtItsNiceValue) {
@@ -181,21 +194,53 @@ TEST(FitWorker, ThreadRunsAtItsNiceValue) {
   ASSERT_TRUE(w);
   w->submit("a", moving(0));
   w->drain();  // the thread has run (and set its priority) by now
+  EXPECT_EQ(w->priority_note(), "");
   const auto threads = threads_sched();
-  auto count = [&](int nice, int policy) {
-    return std::count_if(threads.begin(), threads.end(),
-                         [&](const ThreadSched& t) { return t.nice == nice && t.policy == policy; });
-  };
-  EXPECT_EQ(count(std::min(19, base + 5), SCHED_OTHER), 1) << "base " << base;
-  EXPECT_GE(count(base, SCHED_OTHER), 1);  // this thread unchanged
+  EXPECT_EQ(count(threads, {std::min(19, base + 5), 0, SCHED_OTHER}), 1) << "base " << base;
+  EXPECT_GE(count(threads, {base, 0, SCHED_OTHER}), 1);  // this thread unchanged
 }
 
-// A real-time caller (the projector at SCHED_FIFO below the pipeline): the fit thread is made
-// time-sharing at its nice value, out of the real-time budget; with no increment it keeps the
-// caller's policy (the control).
-TEST(FitWorker, RealTimeCallersFitThreadIsTimeSharing) {
+// A thread whose setpriority is denied (what the hardening's SystemCallFilter=~@resources does to
+// a unit that does not allow it back, deploy/systemd): the worker says why in one line and still
+// fits. The filter (seccomp, EPERM for setpriority only) is installed on a thread of its own, so
+// that only it and the worker it creates carry it.
+TEST(FitWorker, PriorityNotLoweredIsReportedAndTheFitsGoOn) {
+  std::string note;
+  bool motion = false, filtered = false;
+  std::thread([&] {
+    sock_filter code[] = {
+        BPF_STMT(BPF_LD | BPF_W | BPF_ABS, offsetof(seccomp_data, nr)),
+        BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, __NR_setpriority, 0, 1),
+        BPF_STMT(BPF_RET | BPF_K, SECCOMP_RET_ERRNO | (EPERM & SECCOMP_RET_DATA)),
+        BPF_STMT(BPF_RET | BPF_K, SECCOMP_RET_ALLOW),
+    };
+    sock_fprog prog{static_cast<unsigned short>(std::size(code)), code};
+    filtered = prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) == 0 &&
+               syscall(SYS_seccomp, SECCOMP_SET_MODE_FILTER, 0, &prog) == 0;
+    if (!filtered) return;
+    auto w = worker(5);
+    if (!w) return;
+    note = w->priority_note();
+    w->submit("a", moving(0));
+    w->drain();
+    w->submit("a", moving(1));
+    w->drain();
+    auto r = w->take();
+    motion = !r.empty() && r.back().motion.has_value();
+  }).join();
+  ASSERT_TRUE(filtered) << "seccomp filter not installed";
+  EXPECT_NE(note.find("setpriority: Operation not permitted"), std::string::npos) << note;
+  EXPECT_EQ(note.find('\n'), std::string::npos);
+  EXPECT_TRUE(motion);
+  // The control, ThreadRunsAtItsNiceValue: unfiltered, the note is empty.
+}
+
+// A real-time caller (the projector at SCHED_FIFO below the pipeline): the fit thread goes to
+// real-time priority 1, below the caller and above all time-sharing work; with no increment it
+// keeps the caller's priority (the control).
+TEST(FitWorker, RealTimeCallersFitThreadTakesTheLowestRealTimePriority) {
   sched_param rt{};
-  rt.sched_priority = 1;
+  rt.sched_priority = 2;
   ASSERT_EQ(pthread_setschedparam(pthread_self(), SCHED_FIFO, &rt), 0)
       << "SCHED_FIFO not permitted: this test needs CAP_SYS_NICE (root, as ./studio test runs)";
   const int base = getpriority(PRIO_PROCESS, 0);
@@ -208,13 +253,8 @@ TEST(FitWorker, RealTimeCallersFitThreadIsTimeSharing) {
     lowered->drain();
     same->drain();
     const auto threads = threads_sched();
-    auto count = [&](int nice, int policy) {
-      return std::count_if(threads.begin(), threads.end(), [&](const ThreadSched& t) {
-        return t.nice == nice && t.policy == policy;
-      });
-    };
-    EXPECT_EQ(count(std::min(19, base + 5), SCHED_OTHER), 1);
-    EXPECT_GE(count(base, SCHED_FIFO), 2);  // this thread and the worker without an increment
+    EXPECT_EQ(count(threads, {base, 1, SCHED_FIFO}), 1);
+    EXPECT_GE(count(threads, {base, 2, SCHED_FIFO}), 2);  // this thread and `same`
   }
   sched_param normal{};
   EXPECT_EQ(pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal), 0);

@@ -93,6 +93,8 @@ class ProjectorNode : public runtime::Node {
       auto w = FitWorker::create({options_.mask_options().motion, options_.fit_nice});
       if (!w) return std::unexpected(w.error());
       fits_ = std::move(*w);
+      if (const std::string note = fits_->priority_note(); !note.empty())
+        STUDIO_LOG(warn, kLog) << note;
     }
     auto init = init_.get_future();
     if (auto ok = loop_.start(); !ok) return ok;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstring>
 #include <system_error>
 
 namespace studio::projector {
@@ -25,6 +26,8 @@ Expected<std::unique_ptr<FitWorker>> FitWorker::create(const FitWorkerOptions& o
   } catch (const std::system_error& e) {
     return fail(std::string("motion fit thread: ") + e.what());
   }
+  std::unique_lock lock(w->mutex_);  // until the thread has set its priority
+  w->idle_.wait(lock, [&] { return w->started_; });
   return w;
 }
 
@@ -77,6 +80,11 @@ void FitWorker::drain() {
   idle_.wait(lock, [this] { return (jobs_.empty() && !busy_) || stop_; });
 }
 
+std::string FitWorker::priority_note() const {
+  std::lock_guard lock(mutex_);
+  return priority_note_;
+}
+
 std::uint64_t FitWorker::fitted() const {
   std::lock_guard lock(mutex_);
   return fitted_;
@@ -88,23 +96,39 @@ std::uint64_t FitWorker::dropped() const {
 }
 
 void FitWorker::run() {
+  std::string note;
   if (options_.nice_increment > 0) {
     // Linux: the policy and the nice value are per-thread attributes; PRIO_PROCESS with this
-    // thread's id sets this thread's alone. A real-time caller (a projector at SCHED_FIFO below
-    // the pipeline) leaves the fit time-sharing: below every real-time thread, and out of the
-    // kernel's real-time budget. Failing to lower our own priority changes only the share, not
-    // the results.
+    // thread's id sets this thread's alone. Failing to lower our own priority changes only the
+    // share, not the results.
     const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
     if (const int policy = ::sched_getscheduler(0); policy == SCHED_FIFO || policy == SCHED_RR) {
-      sched_param time_sharing{};
-      (void)::sched_setscheduler(0, SCHED_OTHER, &time_sharing);
+      // A real-time caller (a projector at SCHED_FIFO below the pipeline): the fit goes to the
+      // lowest real-time priority, below the render thread and the rasteriser (as the increment
+      // would put it) but above every time-sharing thread. Made time-sharing instead, the fit
+      // starved beside the demo's real-time pipeline (~60 % of the meshes unfitted) and the
+      // velocities grew old enough that 3 of 6 demo runs lit the actor (BENCHMARKS.md, demo,
+      // session 17); at priority 1 none did.
+      sched_param lowest{};
+      lowest.sched_priority = 1;
+      if (::sched_setscheduler(0, policy, &lowest) != 0)
+        note = std::string("sched_setscheduler: ") + std::strerror(errno);
+    } else {
+      errno = 0;
+      const int current = ::getpriority(PRIO_PROCESS, tid);
+      if (errno != 0)
+        note = std::string("getpriority: ") + std::strerror(errno);
+      else if (::setpriority(PRIO_PROCESS, tid, std::min(19, current + options_.nice_increment)) != 0)
+        note = std::string("setpriority: ") + std::strerror(errno);
     }
-    errno = 0;
-    const int current = ::getpriority(PRIO_PROCESS, tid);
-    if (errno == 0)
-      (void)::setpriority(PRIO_PROCESS, tid, std::min(19, current + options_.nice_increment));
+    if (!note.empty())
+      note = "motion fit thread: its priority was not lowered (" + note +
+             "): it shares the CPU with the render thread as an equal";
   }
   std::unique_lock lock(mutex_);
+  priority_note_ = note;
+  started_ = true;
+  idle_.notify_all();
   while (true) {
     wake_.wait(lock, [this] { return stop_ || !jobs_.empty(); });
     if (stop_) break;

@@ -8,9 +8,9 @@
 // (stage_wait_ms) or is superseded. A FitWorker runs the fits instead: the render thread hands
 // each latched mesh over (submit), keeps drawing, and installs the fits that finished at its next
 // frame (take, then MaskPlanner::apply_fit). The worker's thread runs `nice_increment` below the
-// process (a per-thread nice value, Linux), so the render thread and llvmpipe's rasteriser keep
-// the CPU they need and the fit takes what they leave (on two cores: the second core while the
-// render thread waits for its frame).
+// process (a per-thread nice value, Linux), or at real-time priority 1 under a real-time process,
+// so the render thread and llvmpipe's rasteriser keep the CPU they need and the fit takes what
+// they leave (on two cores: the second core while the render thread waits for its frame).
 //
 // Newest wins: a mesh still waiting when a newer mesh of the same actor is submitted is dropped
 // (counted, dropped()); the next fit is then against the last mesh fitted, over two mesh
@@ -39,8 +39,9 @@ namespace studio::projector {
 
 struct FitWorkerOptions {
   MotionOptions motion;
-  // The fit thread's nice value above the process's (0..19; 0: the same priority and policy as
-  // the caller). Above 0 a real-time caller's fit thread is also made time-sharing.
+  // The fit thread's nice value above the process's (0..19; 0: the same priority as the caller).
+  // Above 0 under a real-time caller (SCHED_FIFO/RR) the fit thread takes the lowest real-time
+  // priority (1) instead: below the caller, above all time-sharing work.
   int nice_increment = 0;
   Expected<void> validate() const;
 };
@@ -63,6 +64,9 @@ class FitWorker {
   void drain();
   std::uint64_t fitted() const;
   std::uint64_t dropped() const;
+  // Empty when the thread lowered its priority as asked; else one line saying why not (e.g. a
+  // seccomp filter denying setpriority), for the caller to log.
+  std::string priority_note() const;
 
  private:
   explicit FitWorker(const FitWorkerOptions& options);
@@ -77,6 +81,8 @@ class FitWorker {
   std::condition_variable wake_, idle_;
   bool stop_ = false;
   bool busy_ = false;
+  bool started_ = false;  // the thread has set its priority (priority_note_)
+  std::string priority_note_;
   std::deque<Job> jobs_;  // at most one per actor
   std::map<std::string, std::uint64_t> epochs_;
   std::vector<FitResult> results_;
