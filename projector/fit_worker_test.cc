@@ -2,7 +2,8 @@
 // give the velocities the tracker gives on the caller's thread, in order; the newest mesh wins
 // while the thread is busy and the last mesh is always fitted; remove() starts an actor afresh;
 // a refused mesh is a result with its error, not a crash; the thread runs at its nice value,
-// real-time priority 1 under a real-time caller.
+// real-time priority 1 under a real-time caller; a priority it cannot lower (setpriority denied
+// by a seccomp filter, as a unit's hardening would) is said in one line and the fits go on.
 #include "projector/fit_worker.h"
 
 #include <gtest/gtest.h>
@@ -10,12 +11,12 @@
 #include <dirent.h>
 #include <linux/filter.h>
 #include <linux/seccomp.h>
-#include <sys/prctl.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
