@@ -235,8 +235,9 @@ std::string make_report(const ProbeOptions& o, const Collected& c) {
     for (const ServiceSeen& s : c.services) {
       bool any = false;
       for (const auto& [name, v] : s.counters) {
-        if (!name.starts_with("stage_") && !name.ends_with("_to_mesh_ms") &&
-            !name.ends_with("_to_frame_ms") && !name.ends_with("_to_mask_ms"))
+        if (!name.starts_with("stage_") && !name.starts_with("scene_image_") &&
+            !name.ends_with("_to_mesh_ms") && !name.ends_with("_to_frame_ms") &&
+            !name.ends_with("_to_mask_ms"))
           continue;
         if (!any) j.key(s.service + ":" + s.instance).begin_object();
         any = true;

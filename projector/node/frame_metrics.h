@@ -20,6 +20,8 @@ struct FrameMetrics {
         held(loop.counter("frames_held")),
         fits_deferred(loop.counter("motion_fits_deferred")),
         fits_relatched(loop.counter("motion_fits_relatched")),
+        images_drawn(loop.counter("scene_images_drawn")),
+        images_unshown(loop.counter("scene_images_unshown")),
         moving_nodes(loop.metrics().gauge("scene_moving_nodes")),
         cache_move_mm(loop.metrics().gauge("scene_cache_move_mm")),
         held_shift_px(loop.metrics().gauge("scene_held_shift_px")),
@@ -32,7 +34,8 @@ struct FrameMetrics {
     loop.count_as_output(rendered);
   }
   runtime::Counter &rendered, &eye_rejected, &head_stale, &scene_left_out, &assets_failed,
-      &superseded, &mesh_errors, &from_cache, &rerendered, &held, &fits_deferred, &fits_relatched;
+      &superseded, &mesh_errors, &from_cache, &rerendered, &held, &fits_deferred, &fits_relatched,
+      &images_drawn, &images_unshown;
   runtime::Gauge &moving_nodes, &cache_move_mm, &held_shift_px, &cpu_per_frame_ms, &margin_mm, &latency_p_ms,
       &render_ms, &overrun_p_ms, &mesh_triangles;
 };

@@ -4,6 +4,17 @@
 
 namespace studio::projector {
 
+projector_render::FrameRendererOptions frame_renderer_options(const ProjectorNodeOptions& options) {
+  projector_render::FrameRendererOptions fo;
+  fo.form = options.form;
+  fo.eye_texture_size = {options.eye_texture[0], options.eye_texture[1]};
+  fo.eye_texture_scale = options.eye_texture_scale;
+  fo.thumb_width = options.thumbnail[0];
+  fo.thumb_height = options.thumbnail[1];
+  fo.scene_cache = options.scene_cache;
+  return fo;
+}
+
 Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeOptions& options,
                                                             const ProjectorView& view,
                                                             const std::string& projector_id,
@@ -21,14 +32,7 @@ Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeO
     renderer = context->renderer() + ", headless";
     out.headless.emplace(std::move(*context));
   }
-  projector_render::FrameRendererOptions fo;
-  fo.form = options.form;
-  fo.eye_texture_size = {options.eye_texture[0], options.eye_texture[1]};
-  fo.eye_texture_scale = options.eye_texture_scale;
-  fo.thumb_width = options.thumbnail[0];
-  fo.thumb_height = options.thumbnail[1];
-  fo.scene_cache = options.scene_cache;
-  auto fr = projector_render::FrameRenderer::create(view, fo);
+  auto fr = projector_render::FrameRenderer::create(view, frame_renderer_options(options));
   if (!fr) return fr;
   STUDIO_LOG(info, "projector") << "rendering " << fr->width() << "x" << fr->height() << " on "
                                 << renderer;

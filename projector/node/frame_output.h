@@ -21,6 +21,9 @@ struct FrameOutput {
   std::optional<WindowOutput> window;  // set for output: window (show each frame there)
 };
 
+// The renderer's options from the node's (the frame's renderer and the scene thread's).
+projector_render::FrameRendererOptions frame_renderer_options(const ProjectorNodeOptions& options);
+
 // Opens the output (into `out`, which must outlive the renderer) and creates the renderer.
 // Errors: no EGL / no display / unknown monitor / renderer resources (one line each).
 Expected<projector_render::FrameRenderer> open_frame_output(const ProjectorNodeOptions& options,

@@ -24,7 +24,11 @@
 //   stage_publish_ms   per published frame: the studio/projector/frame sample written
 //   mesh_to_frame_ms   mesh arrival -> frame rendered (finished), frames with a new mesh
 //   stage_present_ms   per frame with output: window: blit to the window and swap
-// Render thread only (gauges are atomics; the status thread reads them).
+//   stage_load_ms      scene_thread: per frame, the newest scene image loaded into the frame
+//   scene_image_ms     scene_thread: an image drawn and read back (wall), on the scene thread
+//   scene_image_age_ms scene_thread: the image a frame used, from its read-back to the frame done
+// Each stage is added to from one thread only: scene_image_ms by the scene thread, the others
+// by the render thread (gauges are atomics; the status thread reads them).
 
 #include <array>
 #include <chrono>
@@ -50,6 +54,9 @@ class FrameStages {
     present,
     latch,
     ahead,
+    load,
+    scene_image,
+    scene_age,
     kCount
   };
 
@@ -57,7 +64,8 @@ class FrameStages {
     static constexpr const char* kNames[kCount] = {
         "stage_wait_ms",    "stage_motion_ms",  "stage_simplify_ms", "stage_mask_ms",
         "stage_draw_ms",    "stage_finish_ms",  "stage_readback_ms", "stage_publish_ms",
-        "mesh_to_frame_ms", "stage_present_ms", "stage_latch_ms",    "stage_ahead_ms"};
+        "mesh_to_frame_ms", "stage_present_ms", "stage_latch_ms",    "stage_ahead_ms",
+        "stage_load_ms",    "scene_image_ms",   "scene_image_age_ms"};
     for (int i = 0; i < kCount; ++i) gauges_[i] = &metrics.gauge(kNames[i]);
   }
   // One measurement of a stage, seconds.

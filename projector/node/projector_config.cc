@@ -23,6 +23,7 @@ Expected<void> ProjectorNodeOptions::validate() const {
   if (!(display_lag_s >= 0 && display_lag_s <= 1)) return fail("display_lag: 0..1 seconds");
   if (!(head_timeout_s > 0)) return fail("head_timeout: > 0 seconds");
   if (fit_nice < 0 || fit_nice > 19) return fail("fit_nice: 0..19");
+  if (scene_nice < 0 || scene_nice > 19) return fail("scene_nice: 0..19");
   if (auto ok = scene_cache.validate(); !ok) return ok;
   return mask_options().validate();
 }
@@ -100,6 +101,17 @@ runtime::ServiceDefinition projector_service_definition() {
       "                            1 instead: below the render thread, above time-sharing\n"
       "                            work); a fit that lands late only ages the velocities, which\n"
       "                            the margin counts\n"
+      "    scene_thread: true      the scene drawn on a thread of its own, into a renderer on\n"
+      "                            a display of its own (its own llvmpipe rasteriser threads),\n"
+      "                            from the eye expected when its image is shown; each frame\n"
+      "                            puts its masks over the newest image, so a new mesh never\n"
+      "                            waits for the scene (replaces late_latch's scene drawn\n"
+      "                            ahead; gauges scene_image_ms, scene_image_age_ms; counter\n"
+      "                            scene_images_unshown); false: the scene on the render thread\n"
+      "    scene_nice: 3           scene_thread: its nice value above the process's (0..19):\n"
+      "                            the masks' frames come first (a real-time projector's scene\n"
+      "                            thread runs time-sharing at this nice value: its rasteriser\n"
+      "                            threads' load is not added to the real-time pipeline's)\n"
       "    parallel_mesh_work: true  late_latch false: a new mesh's mask simplification runs on\n"
       "                            a second thread while its motion is fitted (the mesh waits\n"
       "                            for the longer of the two, not their sum; same result and\n"
@@ -163,13 +175,17 @@ runtime::ServiceDefinition projector_service_definition() {
       "  (of the last mesh received), motion_fits_deferred, motion_fits_relatched; where a mesh's\n"
       "  time goes, ms: stage_wait_ms, stage_motion_ms, stage_simplify_ms, stage_mask_ms,\n"
       "  stage_draw_ms, stage_finish_ms, stage_readback_ms, stage_publish_ms, stage_present_ms,\n"
-      "  stage_latch_ms, stage_ahead_ms,\n"
+      "  stage_latch_ms, stage_ahead_ms, stage_load_ms,\n"
       "  mesh_to_frame_ms: see projector/node/frame_stages.h; the scene cache: frames_from_cache,\n"
-      "  scene_rerendered (frames that drew the static scene), scene_moving_nodes,\n"
+      "  scene_rerendered (frames that drew the static scene; with scene_thread: the thread's\n"
+      "  images), scene_moving_nodes,\n"
       "  scene_cache_move_mm (eye move the cached layer allows), frames_held and\n"
       "  scene_held_shift_px (frames served by hold_frames beyond the bound, and the last such\n"
       "  frame's displacement bound, projector px); cpu_per_frame_ms: the process's\n"
-      "  CPU time, every thread (llvmpipe's too), per rendered frame over about a second).\n";
+      "  CPU time, every thread (llvmpipe's too), per rendered frame over about a second;\n"
+      "  scene_thread: scene_images_drawn, scene_images_unshown (drawn, replaced before a frame\n"
+      "  took them), scene_image_ms (an image drawn and read back, wall), scene_image_age_ms\n"
+      "  (the image a frame used: read back -> the frame done)).\n";
   d.create = [](yaml::MapReader& config,
                 runtime::NodeContext& ctx) -> Expected<std::unique_ptr<runtime::Node>> {
     auto section = config.required("projector");
@@ -223,6 +239,8 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("late_latch", &ProjectorNodeOptions::late_latch),
         yaml::field("fit_thread", &ProjectorNodeOptions::fit_thread),
         yaml::field("fit_nice", &ProjectorNodeOptions::fit_nice).range(0, 19),
+        yaml::field("scene_thread", &ProjectorNodeOptions::scene_thread),
+        yaml::field("scene_nice", &ProjectorNodeOptions::scene_nice).range(0, 19),
         yaml::field("parallel_mesh_work", &ProjectorNodeOptions::parallel_mesh_work),
         yaml::field("mask_presimplify", &ProjectorNodeOptions::mask_presimplify),
         yaml::enum_field("mask_growth", &ProjectorNodeOptions::mask_outline,

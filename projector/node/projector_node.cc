@@ -1,12 +1,20 @@
 #include "projector_node.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <condition_variable>
 #include <future>
 #include <mutex>
 #include <optional>
+#include <pthread.h>
+#include <sched.h>
 #include <set>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <thread>
+#include <unistd.h>
 
 #include "core/clock.h"
 #include "core/log.h"
@@ -16,6 +24,7 @@
 #include "projector/eye_source.h"
 #include "projector/fit_worker.h"
 #include "projector/mesh_inbox.h"
+#include "projector/scene_handoff.h"
 #include "projector_wire.h"
 #include "runtime/service_loop.h"
 #include "scene_mirror.h"
@@ -28,6 +37,28 @@ namespace {
 
 constexpr const char* kLog = "projector";
 using SteadyClock = std::chrono::steady_clock;
+
+// Lowers the calling thread's priority below the process's by `nice` (Linux: the policy and the
+// nice value are per thread). A real-time thread becomes time-sharing at its nice value +
+// `nice`: the scene thread's llvmpipe rasterisers would otherwise add whole cores of real-time
+// load beside the real-time pipeline (and run it into the kernel's real-time throttling).
+// Empty when done, else why not (the thread then runs at the process's priority).
+std::string lower_this_thread(int nice) {
+  const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
+  if (const int policy = ::sched_getscheduler(0); policy == SCHED_FIFO || policy == SCHED_RR) {
+    sched_param p{};
+    p.sched_priority = 0;
+    if (::sched_setscheduler(0, SCHED_OTHER, &p) != 0)
+      return std::string("sched_setscheduler: ") + std::strerror(errno);
+  }
+  if (nice <= 0) return {};
+  errno = 0;
+  const int current = ::getpriority(PRIO_PROCESS, tid);
+  if (errno != 0) return std::string("getpriority: ") + std::strerror(errno);
+  if (::setpriority(PRIO_PROCESS, tid, std::min(19, current + nice)) != 0)
+    return std::string("setpriority: ") + std::strerror(errno);
+  return {};
+}
 
 class ProjectorNode : public runtime::Node {
  public:
@@ -270,6 +301,22 @@ class ProjectorNode : public runtime::Node {
     auto fr = open_frame_output(options_, view_, projector_.camera.id, out);
     init_.set_value(fr ? Expected<void>{} : std::unexpected(fr.error()));
     if (!fr) return;
+    std::thread scene;
+    if (options_.scene_thread) scene = start_scene_thread();
+    struct Join {  // the scene thread stops with this one (before the handoff's images go)
+      ProjectorNode& node;
+      std::thread& t;
+      ~Join() {
+        {
+          std::lock_guard lock(node.scene_mutex_);
+          node.scene_stop_ = true;
+        }
+        node.scene_wake_.notify_all();
+        if (node.handoff_) node.handoff_->stop();
+        if (t.joinable()) t.join();
+        node.scene_on_ = false;
+      }
+    } join{*this, scene};
     Frame state;
     const auto period = std::chrono::duration_cast<SteadyClock::duration>(
         std::chrono::duration<double>(1.0 / options_.rate));
@@ -287,10 +334,12 @@ class ProjectorNode : public runtime::Node {
         if (wake_.wait_until(lock, next, [this] { return stop_ || inbox_.has_meshes(); }) && stop_)
           return;
       }
-      next = SteadyClock::now() + period;
-      render_one(*fr, state, out.window ? &*out.window : nullptr);
+      // After a mesh's frame the next frame without a mesh waits two periods: meshes come at
+      // about the rate, and a frame begun just before the next mesh arrives would make it wait.
+      const bool mesh = render_one(*fr, state, out.window ? &*out.window : nullptr);
+      next = SteadyClock::now() + (mesh ? 2 * period : period);
       if (options_.late_latch) {
-        prepare_ahead(*fr, state, seconds(next - SteadyClock::now()));
+        if (!scene_on_) prepare_ahead(*fr, state, seconds(next - SteadyClock::now()));
         if (fits_) continue;  // the fit thread fits the frame's meshes
         // A newer mesh already waiting (the thread is behind): its frame goes first and this
         // mesh's fit is dropped; the next fit is against the last mesh fitted, over two mesh
@@ -319,7 +368,7 @@ class ProjectorNode : public runtime::Node {
   void prepare_ahead(projector_render::FrameRenderer& fr, Frame& st, double until_next_s) {
     const auto t = SteadyClock::now();
     st.eye = eye_ahead(std::max(until_next_s, 0.0) + st.render_s + options_.display_lag_s);
-    st.drawn = draw_scene(fr, st, st.eye, {}, true);
+    st.drawn = draw_scene(fr, st.scene, st.eye, {}, true);
     st.prepared = true;
     stages_.add(FrameStages::ahead, seconds(SteadyClock::now() - t));
   }
@@ -327,8 +376,8 @@ class ProjectorNode : public runtime::Node {
   // The scene from `eye` (the last good eye when the projection refuses it: `eye` is replaced),
   // the masks over it (ahead: none, the scene only, FrameRenderer::prepare). The scene is rebuilt
   // first when the mirror changed.
-  Expected<projector_render::FrameInfo> draw_scene(projector_render::FrameRenderer& fr, Frame& st,
-                                                   Eigen::Vector3d& eye,
+  Expected<projector_render::FrameInfo> draw_scene(projector_render::FrameRenderer& fr,
+                                                   RenderScene& scene, Eigen::Vector3d& eye,
                                                    std::span<const ActorMesh> masks, bool ahead) {
     std::optional<std::map<scene::NodeId, scene::Node>> nodes;
     std::set<scene::NodeId> moving;
@@ -342,14 +391,14 @@ class ProjectorNode : public runtime::Node {
       }
     }
     if (nodes) {
-      auto r = st.scene.rebuild(*nodes, moving, fr.renderer());
+      auto r = scene.rebuild(*nodes, moving, fr.renderer());
       m_.scene_left_out.add(r.left_out);
       m_.assets_failed.add(r.assets_failed);
-      m_.moving_nodes.set(double(st.scene.layers.moving_nodes));
+      m_.moving_nodes.set(double(scene.layers.moving_nodes));
     }
     const bool cache = options_.scene_cache.enabled;
     auto draw = [&](const Eigen::Vector3d& e) {
-      return ahead ? st.scene.prepare(fr, e, cache) : st.scene.draw(fr, e, masks, cache);
+      return ahead ? scene.prepare(fr, e, cache) : scene.draw(fr, e, masks, cache);
     };
     auto drawn = draw(eye);
     if (!drawn) {  // an eye the projection refuses: the last good eye (checked at start)
@@ -367,11 +416,123 @@ class ProjectorNode : public runtime::Node {
     return drawn;
   }
 
-  void render_one(projector_render::FrameRenderer& fr, Frame& st, WindowOutput* window) {
+  // scene_thread: starts the scene thread and waits for its renderer and first image. On a
+  // failure (no second display, no renderer) the scene stays on the render thread (logged).
+  std::thread start_scene_thread() {
+    scene_ready_ = std::promise<Expected<void>>();
+    auto ready = scene_ready_.get_future();
+    handoff_ = std::make_unique<SceneHandoff>();
+    images_skipped_ = 0;
+    image_age_s_ = 0;
+    {
+      std::lock_guard lock(scene_mutex_);
+      scene_stop_ = false;
+    }
+    std::thread t([this] { scene_loop(); });
+    if (auto ok = ready.get(); !ok) {
+      STUDIO_LOG(warn, kLog) << "scene thread: " << ok.error().message
+                             << "; the scene is drawn on the render thread";
+      t.join();
+      return {};
+    }
+    scene_on_ = true;
+    if (!handoff_->wait_first(std::chrono::seconds(10)))
+      STUDIO_LOG(warn, kLog) << "scene thread: no scene image after 10 s";
+    return t;
+  }
+
+  // The scene thread: a renderer on a display of its own (its own llvmpipe rasteriser threads,
+  // created here below the process's priority), one scene image per period, drawn from the eye
+  // expected when the image is shown: its own draw and read-back, then the measured age of the
+  // images frames use (read-back -> frame done: the wait for a frame to take it, that frame),
+  // then the display lag.
+  void scene_loop() {
+    pthread_setname_np(pthread_self(), "scene");
+    const std::string note = lower_this_thread(options_.scene_nice);
+    auto context = scene_render::HeadlessContext::create(scene_render::EglScreen::own);
+    if (!context) {
+      scene_ready_.set_value(std::unexpected(context.error()));
+      return;
+    }
+    auto fr = projector_render::FrameRenderer::create(view_, frame_renderer_options(options_));
+    if (!fr) {
+      scene_ready_.set_value(std::unexpected(fr.error()));
+      return;
+    }
+    if (!note.empty())
+      STUDIO_LOG(warn, kLog) << "scene thread: its priority was not lowered (" << note
+                             << "): it shares the CPU with the masks' frames as an equal";
+    scene_ready_.set_value({});
+    RenderScene scene;
+    const double period_s = 1.0 / options_.rate;
+    const auto period = std::chrono::duration_cast<SteadyClock::duration>(
+        std::chrono::duration<double>(period_s));
+    double image_s = 0;  // smoothed: an image's draw and read-back
+    for (uint64_t n = 0;; ++n) {
+      {
+        std::lock_guard lock(scene_mutex_);
+        if (scene_stop_) return;
+      }
+      const auto t0 = SteadyClock::now();
+      const double age_s = image_age_s_.load();
+      Eigen::Vector3d eye = eye_ahead(image_s + (age_s > 0 ? age_s : 0.5 * period_s) +
+                                      options_.display_lag_s);
+      auto drawn = draw_scene(*fr, scene, eye, {}, true);
+      if (drawn) {
+        SceneImage& img = handoff_->back();
+        fr->read_image(img.rgba);
+        img.eye = eye;
+        img.ok = true;
+        img.from_cache = drawn->from_cache;
+        img.held = drawn->held;
+        img.shift_px = drawn->shift_px;
+        img.done = SteadyClock::now();
+        handoff_->publish();
+        m_.images_drawn.add();
+        const double took = seconds(img.done - t0);
+        image_s = n == 0 ? took : 0.9 * image_s + 0.1 * took;
+        stages_.add(FrameStages::scene_image, took);
+      }
+      std::unique_lock lock(scene_mutex_);
+      scene_wake_.wait_until(lock, t0 + period, [this] { return scene_stop_; });
+    }
+  }
+
+  // scene_thread: the newest scene image as the frame's scene (its eye into `eye`); before the
+  // first image, black (the masks are drawn over it all the same).
+  Expected<projector_render::FrameInfo> load_scene_image(
+      projector_render::FrameRenderer& fr, Eigen::Vector3d& eye,
+      std::optional<SteadyClock::time_point>& image_done) {
+    const auto t = SteadyClock::now();
+    const SceneImage* img = handoff_->take();
+    if (const uint64_t skipped = handoff_->skipped(); skipped > images_skipped_) {
+      m_.images_unshown.add(skipped - images_skipped_);
+      images_skipped_ = skipped;
+    }
+    projector_render::FrameInfo info;
+    if (img) {
+      fr.load_image(img->rgba);
+      eye = img->eye;
+      image_done = img->done;
+      info.from_cache = img->from_cache;
+      info.held = img->held;
+      info.shift_px = img->shift_px;
+    } else {
+      black_.assign(std::size_t(fr.width()) * fr.height() * 4, 0);
+      for (std::size_t i = 3; i < black_.size(); i += 4) black_[i] = 255;
+      fr.load_image(black_);
+    }
+    stages_.add(FrameStages::load, seconds(SteadyClock::now() - t));
+    return info;
+  }
+
+  // One frame; true when it drew a new mesh.
+  bool render_one(projector_render::FrameRenderer& fr, Frame& st, WindowOutput* window) {
     const bool late = options_.late_latch;
-    if (late && !st.prepared) prepare_ahead(fr, st, 0);  // the first frame, on the path
+    if (late && !scene_on_ && !st.prepared) prepare_ahead(fr, st, 0);  // the first frame
     const auto arrived = take_inputs();
     Eigen::Vector3d eye = late ? st.eye : eye_now();
+    std::optional<SteadyClock::time_point> image_done;  // scene_thread: the image's read-back
     const int64_t start_ns = realtime_ns();
     auto t = SteadyClock::now();
     auto stage = [&](FrameStages::Stage s) {
@@ -387,12 +548,16 @@ class ProjectorNode : public runtime::Node {
     const std::span<const ActorMesh> masks =
         plan ? std::span<const ActorMesh>(plan->masks) : std::span<const ActorMesh>();
     Expected<projector_render::FrameInfo> drawn = projector_render::FrameInfo{};
-    if (late) {  // the masks over the scene drawn ahead
+    if (scene_on_) {  // the masks over the scene thread's newest image
+      drawn = load_scene_image(fr, eye, image_done);
+      t = SteadyClock::now();
+      if (drawn) drawn->masks = fr.draw_masks(masks);
+    } else if (late) {  // the masks over the scene drawn ahead
       drawn = std::move(st.drawn);
       st.prepared = false;
       if (drawn) drawn->masks = fr.draw_masks(masks);
     } else {
-      drawn = draw_scene(fr, st, eye, masks, false);
+      drawn = draw_scene(fr, st.scene, eye, masks, false);
     }
     stage(FrameStages::draw);
     fr.finish();
@@ -403,6 +568,12 @@ class ProjectorNode : public runtime::Node {
       stage(FrameStages::present);
     }
     const int64_t done_ns = realtime_ns();
+    if (image_done) {
+      const double age = seconds(SteadyClock::now() - *image_done);
+      stages_.add(FrameStages::scene_age, age);
+      const double mean = image_age_s_.load();
+      image_age_s_ = mean > 0 ? 0.95 * mean + 0.05 * age : age;
+    }
     const double took = (done_ns - start_ns) * 1e-9;
     st.render_s = st.count++ == 0 ? took : 0.9 * st.render_s + 0.1 * took;
     m_.rendered.add();
@@ -424,6 +595,7 @@ class ProjectorNode : public runtime::Node {
                     {projector_.camera.id, plan ? &*plan : nullptr, eye,
                      options_.form == projector_render::Form::two_pass, st.count, done_ns},
                     *frames_, stages_);
+    return arrived.has_value();
   }
 
   ProjectorNodeOptions options_;
@@ -445,6 +617,16 @@ class ProjectorNode : public runtime::Node {
   runtime::Output<studio_ProjectorFrame>* frames_ = nullptr;
   MaskPlanner planner_;        // the render thread's alone
   std::unique_ptr<FitWorker> fits_;  // late_latch + fit_thread: the motion fits' thread
+  // scene_thread: the scene thread's images, its stop flag and wake-up, its start's result.
+  std::unique_ptr<SceneHandoff> handoff_;
+  std::mutex scene_mutex_;
+  std::condition_variable scene_wake_;
+  bool scene_stop_ = false;  // guarded by scene_mutex_
+  std::promise<Expected<void>> scene_ready_;
+  bool scene_on_ = false;                 // the render thread's: images come from the thread
+  uint64_t images_skipped_ = 0;           // the render thread's: handoff_.skipped() counted
+  std::vector<std::uint8_t> black_;       // the render thread's: before the first image
+  std::atomic<double> image_age_s_{0};    // the render thread's: images' mean age at use
   runtime::ServiceLoop loop_;  // stopped before the state above goes
   FrameStages stages_;         // the render thread's (gauges of loop_'s metrics)
   FrameMetrics m_;

@@ -70,6 +70,16 @@ struct ProjectorNodeOptions {
   // frame. The thread runs fit_nice below the process (0..19). false: fitted on the render thread.
   bool fit_thread = true;
   int fit_nice = 14;
+  // The scene drawn on a thread of its own, into a renderer on a display of its own
+  // (scene_render::EglScreen::own: its own llvmpipe rasteriser threads), from the eye expected
+  // when its image is shown; the render thread puts each frame's masks over the newest image
+  // (projector/scene_handoff.h), so a new mesh never waits for the scene to be drawn — not for
+  // its draw calls, nor behind its rasterisation. Replaces late latching's scene drawn ahead.
+  // The thread (and its rasteriser threads) runs scene_nice below the process (0..19); under a
+  // real-time process, time-sharing at nice scene_nice (its llvmpipe load stays out of the
+  // real-time budget). false: the scene drawn on the render thread (ahead with late_latch).
+  bool scene_thread = true;
+  int scene_nice = 3;
   // A mesh's simplification on a second thread beside its motion fit (MaskPlannerOptions; the
   // path without late latching).
   bool parallel_mesh_work = true;

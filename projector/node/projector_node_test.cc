@@ -328,6 +328,88 @@ TEST_F(ProjectorNodeTest, EyeBehindTheScreenAsDefaultIsRefusedAtStart) {
 namespace studio::projector {
 namespace {
 
+// scene_thread (the default): the scene drawn on a thread of its own, on a display of its own,
+// and the frame's masks put over its newest image; the same picture as the scene drawn on the
+// render thread (scene_thread: false): the thumbnails of a frame from the same head, with the
+// scene alone, are the same; the status says which path drew it.
+TEST_F(ProjectorNodeTest, SceneThreadShowsWhatTheRenderThreadDraws) {
+  const Projector projector = testing::half_back_projector();
+  auto description =
+      scene_config::read_scene_file(std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml").value();
+  scene_assets::AssetCache cache;
+  auto scene = scene_assets::build_scene(description, cache, 0).value();
+  const Eigen::Vector3d eye(0.1, 1.65, 1.2);
+  std::vector<std::vector<uint8_t>> thumbs;
+  for (const bool thread : {false, true}) {
+    auto& node = spawn("projector", "projector/studio-projector",
+                       {"--config", write_files(projector, thread ? "" : "  scene_thread: false\n")});
+    ASSERT_TRUE(node.wait_ready(30s)) << node.log();
+    auto p = wire::Participant::create().value();
+    auto frame_topic = wire::Topic<studio_ProjectorFrame>::create(p).value();
+    auto frames = wire::Reader<studio_ProjectorFrame>::create(p, frame_topic).value();
+    auto status_topic = wire::Topic<studio_ServiceStatus>::create(p).value();
+    auto status = wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
+    auto node_topic = wire::Topic<studio_SceneNode>::create(p).value();
+    auto nodes = wire::Writer<studio_SceneNode>::create(p, node_topic).value();
+    auto head_topic = wire::Topic<studio_HeadPose>::create(p).value();
+    auto heads = wire::Writer<studio_HeadPose>::create(p, head_topic).value();
+    ASSERT_TRUE(nodes.wait_for_readers(1, 10s));
+    for (const auto& [id, n] : scene.nodes()) {
+      wire::Owned<studio_SceneNode> s;
+      ASSERT_TRUE(wire::from_core(n, *s).has_value());
+      ASSERT_TRUE(nodes.write(*s).has_value());
+    }
+    // Frames from the head, once the whole scene is in (a later frame than the first such).
+    std::optional<wire::Owned<studio_ProjectorFrame>> got;
+    int from_eye = 0;
+    double images = -1, ahead = -1;
+    for (auto until = SteadyClock::now() + 25s; !(got && images >= 0) && SteadyClock::now() < until;) {
+      wire::Owned<studio_HeadPose> h;
+      wire::set(h->actor_id, "actor");
+      h->capture_ns = realtime_ns();
+      for (int i = 0; i < 3; ++i) h->position[i] = eye[i];
+      h->confidence = 1;
+      ASSERT_TRUE(heads.write(*h).has_value());
+      for (auto& s : frames.take())
+        if (s.meta.valid_data && s.data->eye[2] == eye.z() && ++from_eye == 5)
+          got = std::move(s.data);
+      for (auto& s : status.take())
+        if (got && s.meta.valid_data && std::string(s.data->service) == "projector") {
+          images = counter(*s.data, "scene_images_drawn");
+          ahead = counter(*s.data, "stage_ahead_ms");
+        }
+      std::this_thread::sleep_for(50ms);
+    }
+    ASSERT_TRUE(got) << node.log();
+    const studio_ProjectorFrame& f = **got;
+    EXPECT_EQ(f.actors, 0u);
+    ASSERT_EQ(f.thumb_width * f.thumb_height * 3, wire::view(f.thumbnail).size());
+    thumbs.emplace_back(wire::view(f.thumbnail).begin(), wire::view(f.thumbnail).end());
+    if (thread) {
+      EXPECT_GT(images, 0) << node.log();  // images from the scene thread
+      EXPECT_EQ(ahead, 0);                 // none drawn ahead on the render thread
+    } else {
+      EXPECT_EQ(images, 0);
+      EXPECT_GT(ahead, 0);
+    }
+    EXPECT_EQ(node.stop(), 0) << node.log();
+  }
+  ASSERT_EQ(thumbs.size(), 2u);
+  ASSERT_EQ(thumbs[0].size(), thumbs[1].size());
+  int differ = 0, most = 0;
+  double sum = 0;
+  for (std::size_t i = 0; i < thumbs[0].size(); ++i) {
+    const int d = std::abs(int(thumbs[0][i]) - int(thumbs[1][i]));
+    differ += d > 0;
+    most = std::max(most, d);
+    sum += thumbs[1][i];
+  }
+  std::printf("thumbnails, render thread vs scene thread: %d of %zu values differ, by %d at most\n",
+              differ, thumbs[0].size(), most);
+  EXPECT_EQ(most, 0);
+  EXPECT_GT(sum / double(thumbs[1].size()), 10.0);  // the lit museum, not a black frame
+}
+
 // The example configs (projector/node/ and the example studio's, deploy/examples/studio/) start
 // as they are and publish their projector's calibration.
 TEST_F(ProjectorNodeTest, ExampleConfigsStart) {

@@ -421,6 +421,27 @@ double FrameRenderer::cache_allowed_move_m(const Eigen::Vector3d& eye) const {
 
 void FrameRenderer::finish() { glFinish(); }
 
+void FrameRenderer::read_image(std::vector<std::uint8_t>& rgba) {
+  Impl& r = *impl_;
+  const int w = r.target.width(), h = r.target.height();
+  rgba.resize(std::size_t(w) * h * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, r.target.framebuffer());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+}
+
+bool FrameRenderer::load_image(std::span<const std::uint8_t> rgba) {
+  Impl& r = *impl_;
+  const int w = r.target.width(), h = r.target.height();
+  if (rgba.size() != std::size_t(w) * h * 4) return false;
+  glBindTexture(GL_TEXTURE_2D, r.target.colour_texture());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
+  r.target.bind();
+  return true;
+}
+
 void FrameRenderer::read(Readback& out, bool keep_rgba) {
   Impl& r = *impl_;
   const int w = r.target.width(), h = r.target.height();

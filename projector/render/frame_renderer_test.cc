@@ -471,6 +471,73 @@ TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
   }
 }
 
+// The projector node's scene thread: the scene drawn by a renderer on a display of its own
+// (EglScreen::own: its own llvmpipe screen and rasteriser threads), read out as memory, loaded
+// into the frame's renderer on the shared display, masks over it: byte for byte the frame one
+// renderer draws (both forms; the scene's frame read-back is bottom row first both ways).
+TEST(FrameRenderer, SceneFromAnotherScreenThenMasksIsTheRenderedFrame) {
+  (void)context();
+  const Projector p = projector::testing::studio_projectors()[0];
+  auto view = projector::ProjectorView::create(p).value();
+  auto d = scene_config::read_scene_file(std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml");
+  ASSERT_TRUE(d) << d.error().message;
+  scene_assets::AssetCache cache;
+  auto scene = scene_assets::build_scene(*d, cache, 0);
+  ASSERT_TRUE(scene) << scene.error().message;
+  projector::ActorMesh mask;
+  for (int k = 0; k < 8; ++k)
+    mask.vertices.push_back(
+        Eigen::Vector3f(k & 1 ? 0.3f : -0.3f, k & 2 ? 1.8f : 0.0f, k & 4 ? -0.4f : -0.8f));
+  const std::array<std::uint32_t, 3> tris[] = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5},
+                                               {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6},
+                                               {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
+  mask.triangles.assign(std::begin(tris), std::end(tris));
+  const std::vector<projector::ActorMesh> masks{mask};
+  const Eigen::Vector3d eye(0.1, 1.65, 1.2);
+  auto own = scene_render::HeadlessContext::create(scene_render::EglScreen::own);
+  ASSERT_TRUE(own) << own.error().message;
+  for (const Form form : {Form::single_pass, Form::two_pass}) {
+    FrameRendererOptions fo;
+    fo.form = form;
+    // The scene's renderer, on its own screen (each renderer is destroyed with its context
+    // current).
+    std::vector<std::uint8_t> image;
+    {
+      ASSERT_TRUE(own->make_current());
+      auto scene_fr = FrameRenderer::create(view, fo);
+      ASSERT_TRUE(scene_fr) << scene_fr.error().message;
+      for (const auto& [path, a] : cache.all()) ASSERT_TRUE(scene_fr->renderer().upload(*a));
+      ASSERT_TRUE(scene_fr->prepare(*scene, eye));
+      scene_fr->read_image(image);
+    }
+    // The frame's renderer, on the shared display: the reference frame, then the loaded one.
+    ASSERT_TRUE(context().make_current());
+    auto fr = FrameRenderer::create(view, fo);
+    ASSERT_TRUE(fr) << fr.error().message;
+    for (const auto& [path, a] : cache.all()) ASSERT_TRUE(fr->renderer().upload(*a));
+    Readback want, got;
+    ASSERT_TRUE(fr->render(*scene, eye, masks));
+    fr->finish();
+    fr->read(want, true);
+    EXPECT_FALSE(fr->load_image(std::span(image).first(image.size() - 4)));  // wrong size
+    ASSERT_TRUE(fr->load_image(image));
+    EXPECT_EQ(fr->draw_masks(masks), 1);
+    fr->finish();
+    fr->read(got, true);
+    const cv::Mat a(fr->height(), fr->width(), CV_8UC4, want.rgba.data()),
+        b(fr->height(), fr->width(), CV_8UC4, got.rgba.data());
+    cv::Mat diff;
+    cv::absdiff(a, b, diff);
+    const int differ = cv::countNonZero(diff.reshape(1));
+    std::printf("%s, scene from its own screen: %d values differ, blackout %lld px\n",
+                form == Form::single_pass ? "single pass" : "two pass", differ,
+                static_cast<long long>(got.blackout.area()));
+    EXPECT_EQ(differ, 0);
+    EXPECT_EQ(got.blackout, want.blackout);
+    EXPECT_GT(got.blackout.area(), 1000);
+  }
+}
+
 // The blackout runs (alpha 0) of random frames against a pixel-by-pixel reference: widths that
 // are and are not multiples of the 4-pixel scan, runs of every length at every offset, and alpha
 // values 1 and 128 (not zero) beside 255.

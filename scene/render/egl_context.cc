@@ -4,19 +4,48 @@
 #include <EGL/eglext.h>
 
 #include <cstring>
+#include <map>
+#include <mutex>
 
 #include "gl.h"
 
 namespace studio::scene_render {
 
+namespace {
+
+// Contexts per initialised display in this process: eglInitialize of an initialised display
+// does nothing and eglTerminate releases it whatever else still uses it, so the last context
+// of a display terminates it.
+std::mutex g_displays_mutex;
+std::map<EGLDisplay, int> g_displays;
+
+bool initialise(EGLDisplay display) {
+  std::lock_guard lock(g_displays_mutex);
+  EGLint major = 0, minor = 0;
+  if (!eglInitialize(display, &major, &minor)) return false;
+  ++g_displays[display];
+  return true;
+}
+
+void release(EGLDisplay display) {
+  std::lock_guard lock(g_displays_mutex);
+  auto it = g_displays.find(display);
+  if (it == g_displays.end() || --it->second > 0) return;
+  g_displays.erase(it);
+  eglTerminate(display);
+}
+
+}  // namespace
+
 struct HeadlessContext::Impl {
-  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLDisplay display = EGL_NO_DISPLAY;  // initialised (counted) when set
   EGLContext context = EGL_NO_CONTEXT;
   ~Impl() {
     if (display != EGL_NO_DISPLAY) {
-      eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+      if (eglGetCurrentContext() == context)
+        eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
       if (context != EGL_NO_CONTEXT) eglDestroyContext(display, context);
-      eglTerminate(display);
+      release(display);
     }
   }
 };
@@ -44,24 +73,41 @@ HeadlessContext::HeadlessContext(HeadlessContext&&) noexcept = default;
 HeadlessContext& HeadlessContext::operator=(HeadlessContext&&) noexcept = default;
 HeadlessContext::~HeadlessContext() = default;
 
-Expected<HeadlessContext> HeadlessContext::create() {
+Expected<HeadlessContext> HeadlessContext::create(EglScreen screen) {
   const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-  if (!has_extension(client, "EGL_MESA_platform_surfaceless"))
-    return fail(
-        "EGL: no surfaceless platform (EGL_MESA_platform_surfaceless missing; is Mesa's "
-        "libegl-mesa0 installed?)");
   auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
       eglGetProcAddress("eglGetPlatformDisplayEXT"));
   if (!get_platform_display) return fail("EGL: eglGetPlatformDisplayEXT missing");
-  auto impl = std::make_unique<Impl>();
-  impl->display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-  if (impl->display == EGL_NO_DISPLAY)
-    return fail(egl_error("eglGetPlatformDisplayEXT(surfaceless)"));
-  EGLint major = 0, minor = 0;
-  if (!eglInitialize(impl->display, &major, &minor)) {
-    impl->display = EGL_NO_DISPLAY;
-    return fail(egl_error("eglInitialize"));
+  EGLDisplay display = EGL_NO_DISPLAY;
+  if (screen == EglScreen::own) {
+    // Mesa's software device: a display (and llvmpipe screen) apart from the surfaceless one.
+    if (!has_extension(client, "EGL_EXT_platform_device") ||
+        !has_extension(client, "EGL_EXT_device_enumeration"))
+      return fail("EGL: no device platform (EGL_EXT_platform_device missing)");
+    auto query_devices =
+        reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+    auto device_string = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(
+        eglGetProcAddress("eglQueryDeviceStringEXT"));
+    if (!query_devices || !device_string) return fail("EGL: eglQueryDevicesEXT missing");
+    EGLDeviceEXT devices[16];
+    EGLint n = 0;
+    if (!query_devices(16, devices, &n)) return fail(egl_error("eglQueryDevicesEXT"));
+    for (EGLint i = 0; i < n && display == EGL_NO_DISPLAY; ++i)
+      if (has_extension(device_string(devices[i], EGL_EXTENSIONS), "EGL_MESA_device_software"))
+        display = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
+    if (display == EGL_NO_DISPLAY)
+      return fail("EGL: no software device (EGL_MESA_device_software) for a screen of its own");
+  } else {
+    if (!has_extension(client, "EGL_MESA_platform_surfaceless"))
+      return fail(
+          "EGL: no surfaceless platform (EGL_MESA_platform_surfaceless missing; is Mesa's "
+          "libegl-mesa0 installed?)");
+    display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    if (display == EGL_NO_DISPLAY) return fail(egl_error("eglGetPlatformDisplayEXT(surfaceless)"));
   }
+  if (!initialise(display)) return fail(egl_error("eglInitialize"));
+  auto impl = std::make_unique<Impl>();
+  impl->display = display;
   if (!has_extension(eglQueryString(impl->display, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context"))
     return fail("EGL: EGL_KHR_surfaceless_context missing");
   if (!eglBindAPI(EGL_OPENGL_API)) return fail(egl_error("eglBindAPI(OpenGL)"));

@@ -138,6 +138,14 @@ class FrameRenderer {
   // Every mask mesh black over the frame prepared (or rendered) last; returns the masks drawn
   // (an invalid mask is skipped).
   int draw_masks(std::span<const projector::ActorMesh> masks);
+  // A scene drawn by another renderer (the projector node's scene thread, on a display of its
+  // own: scene_render::EglScreen::own) goes between them as memory: read_image() copies this
+  // renderer's frame out (RGBA, GL's row order: bottom row first; waits for its rasterisation),
+  // load_image() makes such an image this renderer's frame — the scene of a frame whose masks
+  // draw_masks() then puts over it. Together: the frame the other renderer prepared, masked
+  // here. load_image() is false (nothing loaded) unless `rgba` holds width() x height() x 4.
+  void read_image(std::vector<std::uint8_t>& rgba);
+  bool load_image(std::span<const std::uint8_t> rgba);
   // The largest eye move (metres, any direction, first order) from `eye` under which the cached
   // static layer stays usable (StaticShiftBound::allowed_move_m over the heights it shows); 0
   // when nothing is cached or the cache is disabled.
