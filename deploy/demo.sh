@@ -35,19 +35,21 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
   --keep-take        keep the take's raw frames (6 x 1.2 MB per frame) in OUT/takes
   --scheduling S     realtime (default when permitted): the services run SCHED_FIFO at the
                      priorities of their systemd units, in pipeline order (capture 52, keyer
-                     54, hull 56, tracker 58, scene 50; the probe's receive path 45, its
-                     scoring SCHED_IDLE), as installed; the projector (see
-                     --projector-priority) and the preview time-sharing, as their units run
-                     them (the headless preview, the report's picture taker, at nice 10:
-                     below the projector, whose frames the actor sees);
-                     normal: time-sharing
+                     54, hull 56, tracker 58, scene 50; the projector 30 (its scene thread
+                     time-sharing, see --projector-priority); the probe's receive path 45,
+                     its scoring SCHED_IDLE), as installed; the preview time-sharing, as its
+                     unit runs it (the headless preview, the report's picture taker, at nice
+                     10: below the projector's scene, which the actor sees);
+                     normal: time-sharing (the projector at nice 5)
   --projector-priority P
-                     nice:N (default nice:5, the projector's systemd unit) or, with realtime
-                     scheduling, a SCHED_FIFO priority 1..40: below every pipeline stage and
-                     the probe, above all time-sharing work (other sessions' builds cannot
-                     take its CPU, but the real-time total can then reach the kernel's 95 %
-                     throttle, which pauses the whole pipeline: BENCHMARKS.md, demo; its
-                     motion-fit thread runs at FIFO 1)
+                     with realtime scheduling a SCHED_FIFO priority 1..40, optionally
+                     ",nice:N" for its time-sharing threads (default 30,nice:5, the
+                     projector's systemd unit): below every pipeline stage and the probe,
+                     above all time-sharing work; the real-time part is the masks' path
+                     (render thread, its rasteriser): the scene thread and its rasteriser
+                     run time-sharing at nice N + scene_nice and the motion fit at FIFO 1
+                     (BENCHMARKS.md, demo, session 18); or nice:N, time-sharing (the
+                     default under normal scheduling: nice:5)
   --sweep-frames N   frames of the projector mask's margin sweep (default 100; 0: none), run
                      after the services stopped, offline (studio-demo-probe sweep: the fast
                      arm swing through the hull library and the projector's MaskPlanner, at
@@ -62,7 +64,7 @@ TXT
 
 seconds=20 cameras=6 projectors=1 gui=0 out=out/demo keyer=inprocess offline_grid=256
 take_frames=50 keep_take=0 build=build/release scheduling=auto sweep_frames=100
-projector_priority=nice:5
+projector_priority=
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds=${2:?}; shift 2 ;;
@@ -96,11 +98,12 @@ case "$scheduling" in
   normal) ;;
   *) echo "demo: --scheduling: expected realtime or normal" >&2; exit 2 ;;
 esac
+[ -n "$projector_priority" ] || { [ "$scheduling" = realtime ] && projector_priority=30,nice:5 || projector_priority=nice:5; }
 if [[ "$projector_priority" =~ ^nice:-?[0-9]+$ ]]; then :
-elif [[ "$projector_priority" =~ ^[0-9]+$ ]] && [ "$projector_priority" -ge 1 ] && [ "$projector_priority" -le 40 ]; then
+elif [[ "$projector_priority" =~ ^([0-9]+)(,nice:-?[0-9]+)?$ ]] && [ "${BASH_REMATCH[1]}" -ge 1 ] && [ "${BASH_REMATCH[1]}" -le 40 ]; then
   [ "$scheduling" = realtime ] || { echo "demo: --projector-priority $projector_priority: a SCHED_FIFO priority needs --scheduling realtime" >&2; exit 2; }
 else
-  echo "demo: --projector-priority: expected nice:N or a SCHED_FIFO priority 1..40" >&2; exit 2
+  echo "demo: --projector-priority: expected nice:N or a SCHED_FIFO priority 1..40 (optionally ,nice:N)" >&2; exit 2
 fi
 case "$build" in /*) ;; *) build="$root/$build" ;; esac
 case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
@@ -175,6 +178,7 @@ names=() pids=()
 rt() {
   case "$1" in
     nice:*) echo nice -n "${1#nice:}" ;;
+    *,nice:*) if [ "$scheduling" = realtime ]; then echo nice -n "${1#*,nice:}" chrt -f "${1%%,*}"; fi ;;
     *) if [ "$scheduling" = realtime ]; then echo chrt -f "$1"; fi ;;
   esac
 }
@@ -234,7 +238,8 @@ if have $scene_bin scene.yaml; then
   say "starting the scene server"
   start scene 50 "$scene_bin" --config "$cfg/scene.yaml"
 fi
-# The projector: --projector-priority (default: nice 5, as its unit).
+# The projector: --projector-priority (default: FIFO 30 at nice 5, as its unit; time-sharing at
+# nice 5 under normal scheduling).
 for ((p = 1; p <= projectors; p++)); do  # the example studio's projectors are proj1, proj2, ...
   if have $projector_bin "projector-proj$p.yaml"; then
     say "starting projector proj$p (projector-proj$p.yaml)"
@@ -249,9 +254,10 @@ if have $preview_bin preview.yaml; then
     # 2 s, textured from the capture servers' image rings with only its own frame's images
     # requested; each picture replaces preview.png; SIGTERM at the end like the others (exit 0
     # when it drew a mesh; exit status checked with the others). At nice 10, below the
-    # projector (nice 5): on this one machine a picture (~130 ms of llvmpipe every 2 s) at nice 0
-    # took CPU from the projector's frames, i.e. from what the actor sees; in a studio the
-    # preview has a PC of its own. BENCHMARKS.md, demo, session 17: p99 115 -> 96 ms.
+    # projector's time-sharing scene thread (nice 5 + 3): on this one machine a picture (~130 ms
+    # of llvmpipe every 2 s) at nice 0 took CPU from the projector's frames, i.e. from what the
+    # actor sees; in a studio the preview has a PC of its own. BENCHMARKS.md, demo, session 17:
+    # p99 115 -> 96 ms (the projector time-sharing then).
     start preview nice:10 "$preview_bin" --config "$cfg/preview.yaml" --headless --every 2 \
       --screenshot "$out/preview.png"
   fi
@@ -330,5 +336,6 @@ fi
 
 # ---- the report ----------------------------------------------------------------------------------
 python3 "$root/deploy/demo/make_report.py" --out "$out" --cameras "$cameras" --keyer "$keyer" \
+  --projector-priority "$projector_priority" \
   --scheduling "$scheduling" --projectors "$projectors" \
   --offline-grid "$offline_grid" --probe-rc "$probe_rc" --take-rc "$take_rc" --offline-rc "$offline_rc"

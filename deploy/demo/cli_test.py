@@ -72,7 +72,11 @@ def main():
                          (["--keyer", "gpu"], "--keyer"), (["--bogus"], "unknown option"),
                          (["--projector-priority", "45"], "--projector-priority"),
                          (["--projector-priority", "nice:x"], "--projector-priority"),
+                         (["--projector-priority", "30,nice:x"], "--projector-priority"),
+                         (["--projector-priority", "41,nice:5"], "--projector-priority"),
                          (["--scheduling", "normal", "--projector-priority", "30"],
+                          "needs --scheduling realtime"),
+                         (["--scheduling", "normal", "--projector-priority", "30,nice:5"],
                           "needs --scheduling realtime")):
         expect([demo, "--build", a.build, "--out", os.path.join(tmp, "o")] + args, two, needle,
                one_line=True)

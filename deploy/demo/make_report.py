@@ -52,6 +52,7 @@ def main():
     ap.add_argument("--cameras", type=int, required=True)
     ap.add_argument("--keyer", default="inprocess")
     ap.add_argument("--scheduling", default="normal")
+    ap.add_argument("--projector-priority", default="nice:5")
     ap.add_argument("--offline-grid", type=int, required=True)
     ap.add_argument("--projectors", type=int, default=1)
     ap.add_argument("--probe-rc", type=int, default=0)
@@ -123,8 +124,8 @@ def main():
                       else "separate studio-keyer services",
             "configs": os.path.join(out, "config"),
             "scheduling": a.scheduling + (" (SCHED_FIFO at the systemd units' priorities: capture 52, "
-                                          "keyer 54, hull 56, tracker 58, scene 50, probe receive 45; projector nice 5 and "
-                                          "preview time-sharing, as their units)"
+                                          "keyer 54, hull 56, tracker 58, scene 50, probe receive 45; projector: "
+                                          + a.projector_priority + "; preview time-sharing, as their units)"
                                           if a.scheduling == "realtime" else " (time-sharing)"),
             "dds": {"profile": os.environ.get("CYCLONEDDS_URI"),
                     "domain": os.environ.get("STUDIO_DDS_DOMAIN")},

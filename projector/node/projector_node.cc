@@ -127,6 +127,10 @@ class ProjectorNode : public runtime::Node {
       if (const std::string note = fits_->priority_note(); !note.empty())
         STUDIO_LOG(warn, kLog) << note;
     }
+    if (const int policy = ::sched_getscheduler(0);
+        !options_.scene_thread && (policy == SCHED_FIFO || policy == SCHED_RR))
+      STUDIO_LOG(warn, kLog) << "scene_thread: false in a real-time process: the scene is "
+                                "rasterised at real-time priority beside the pipeline";
     auto init = init_.get_future();
     if (auto ok = loop_.start(); !ok) return ok;
     if (auto ok = init.get(); !ok) {  // GL context or renderer failed
