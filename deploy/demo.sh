@@ -35,20 +35,21 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
   --keep-take        keep the take's raw frames (6 x 1.2 MB per frame) in OUT/takes
   --scheduling S     realtime (default when permitted): the services run SCHED_FIFO at the
                      priorities of their systemd units, in pipeline order (capture 52, keyer
-                     54, hull 56, tracker 58, scene 50; the projector 30 (its scene thread
+                     54, hull 56, tracker 58, scene 50; the projector 55 (its scene thread
                      time-sharing, see --projector-priority); the probe's receive path 45,
                      its scoring SCHED_IDLE), as installed; the preview time-sharing, as its
                      unit runs it (the headless preview, the report's picture taker, at nice
                      10: below the projector's scene, which the actor sees);
                      normal: time-sharing (the projector at nice 5)
   --projector-priority P
-                     with realtime scheduling a SCHED_FIFO priority 1..40, optionally
-                     ",nice:N" for its time-sharing threads (default 30,nice:5, the
-                     projector's systemd unit): below every pipeline stage and the probe,
-                     above all time-sharing work; the real-time part is the masks' path
-                     (render thread, its rasteriser): the scene thread and its rasteriser
-                     run time-sharing at nice N + scene_nice and the motion fit at FIFO 1
-                     (BENCHMARKS.md, demo, session 18); or nice:N, time-sharing (the
+                     with realtime scheduling a SCHED_FIFO priority 1..59, optionally
+                     ",nice:N" for its time-sharing threads (default 55,nice:5, the
+                     projector's systemd unit: above capture 52 and keyer 54, which then
+                     work for the next frame, below hull 56 and tracker 58, whose mesh and
+                     head its frame waits for); the real-time part is the masks' path only
+                     (render thread, its rasteriser: ~5 ms a mesh): the scene thread and its
+                     rasteriser run time-sharing at nice N + scene_nice and the motion fit at
+                     FIFO 1 (BENCHMARKS.md, demo, session 18); or nice:N, time-sharing (the
                      default under normal scheduling: nice:5)
   --sweep-frames N   frames of the projector mask's margin sweep (default 100; 0: none), run
                      after the services stopped, offline (studio-demo-probe sweep: the fast
@@ -98,12 +99,12 @@ case "$scheduling" in
   normal) ;;
   *) echo "demo: --scheduling: expected realtime or normal" >&2; exit 2 ;;
 esac
-[ -n "$projector_priority" ] || { [ "$scheduling" = realtime ] && projector_priority=30,nice:5 || projector_priority=nice:5; }
+[ -n "$projector_priority" ] || { [ "$scheduling" = realtime ] && projector_priority=55,nice:5 || projector_priority=nice:5; }
 if [[ "$projector_priority" =~ ^nice:-?[0-9]+$ ]]; then :
-elif [[ "$projector_priority" =~ ^([0-9]+)(,nice:-?[0-9]+)?$ ]] && [ "${BASH_REMATCH[1]}" -ge 1 ] && [ "${BASH_REMATCH[1]}" -le 40 ]; then
+elif [[ "$projector_priority" =~ ^([0-9]+)(,nice:-?[0-9]+)?$ ]] && [ "${BASH_REMATCH[1]}" -ge 1 ] && [ "${BASH_REMATCH[1]}" -le 59 ]; then
   [ "$scheduling" = realtime ] || { echo "demo: --projector-priority $projector_priority: a SCHED_FIFO priority needs --scheduling realtime" >&2; exit 2; }
 else
-  echo "demo: --projector-priority: expected nice:N or a SCHED_FIFO priority 1..40 (optionally ,nice:N)" >&2; exit 2
+  echo "demo: --projector-priority: expected nice:N or a SCHED_FIFO priority 1..59 (optionally ,nice:N)" >&2; exit 2
 fi
 case "$build" in /*) ;; *) build="$root/$build" ;; esac
 case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
@@ -238,7 +239,7 @@ if have $scene_bin scene.yaml; then
   say "starting the scene server"
   start scene 50 "$scene_bin" --config "$cfg/scene.yaml"
 fi
-# The projector: --projector-priority (default: FIFO 30 at nice 5, as its unit; time-sharing at
+# The projector: --projector-priority (default: FIFO 55 at nice 5, as its unit; time-sharing at
 # nice 5 under normal scheduling).
 for ((p = 1; p <= projectors; p++)); do  # the example studio's projectors are proj1, proj2, ...
   if have $projector_bin "projector-proj$p.yaml"; then

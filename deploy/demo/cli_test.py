@@ -70,10 +70,10 @@ def main():
            "clock differs", one_line=True)
     for args, needle in ((["--cameras", "9"], "--cameras"), (["--seconds", "abc"], "--seconds"),
                          (["--keyer", "gpu"], "--keyer"), (["--bogus"], "unknown option"),
-                         (["--projector-priority", "45"], "--projector-priority"),
+                         (["--projector-priority", "60"], "--projector-priority"),
                          (["--projector-priority", "nice:x"], "--projector-priority"),
                          (["--projector-priority", "30,nice:x"], "--projector-priority"),
-                         (["--projector-priority", "41,nice:5"], "--projector-priority"),
+                         (["--projector-priority", "60,nice:5"], "--projector-priority"),
                          (["--scheduling", "normal", "--projector-priority", "30"],
                           "needs --scheduling realtime"),
                          (["--scheduling", "normal", "--projector-priority", "30,nice:5"],

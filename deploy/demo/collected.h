@@ -41,6 +41,9 @@ struct ProjectorSample {
   double margin_m = 0;
   bool predicted = false;
   bool scored = false;  // false: the scorer fell behind (or the calibration was missing)
+  // Rendered after the window, with a mesh captured in it: counts for that mesh's rate and
+  // motion to photon only (not a frame of the window: not rendered, scored or lit).
+  bool after_window = false;
   uint64_t actor_px = 0, lit_actor_px = 0, blackout_px = 0, wasted_px = 0;
 };
 

@@ -426,8 +426,12 @@ class Recorder {
     io_->proj_frames->visit([&](const studio_ProjectorFrame& s, const wire::SampleMeta& meta) {
       if (!meta.valid_data) return;
       std::lock_guard lock(mutex_);
-      if (!c_.window_start_ns || s.render_done_ns < c_.window_start_ns ||
-          s.render_done_ns >= c_.window_end_ns)
+      // Frames rendered in the window, and the late frames of meshes captured in it (the probe
+      // listens 0.5 s beyond it), so that a mesh captured at the window's end still counts.
+      if (!c_.window_start_ns || s.render_done_ns < c_.window_start_ns) return;
+      const bool after = s.render_done_ns >= c_.window_end_ns;
+      if (after && !(s.frame && s.capture_ns >= c_.window_start_ns &&
+                     s.capture_ns < c_.window_end_ns))
         return;
       ProjectorSample p;
       p.projector_id = s.projector_id;
@@ -438,6 +442,11 @@ class Recorder {
       p.latency_ms = s.latency_ms;
       p.margin_m = s.margin_m;
       p.predicted = s.predicted;
+      p.after_window = after;
+      if (after) {  // its mesh's figures only
+        c_.projector.push_back(std::move(p));
+        return;
+      }
       auto blackout = wire::to_core(s);
       if (!blackout || !truth_ || projector_jobs_.size() >= o_.projector_queue) {
         if (!blackout) note_projector_error(blackout.error().message);

@@ -38,9 +38,21 @@ ProjectorFigures projector_figures(const Collected& c, double window_s) {
   double actor = 0, wasted = 0, blackout = 0, margin = 0;
   f.margin_min_m = std::numeric_limits<double>::infinity();
   f.margin_max_m = 0;
+  // A mesh of the window: captured in it (its first frame may come after it: after_window).
+  auto mesh_of_window = [&](const ProjectorSample& p) {
+    return p.mesh_frame && p.capture_ns >= c.window_start_ns && p.capture_ns < c.window_end_ns;
+  };
   for (const ProjectorSample& p : c.projector) {
-    ++f.rendered;
     auto& pp = per[p.projector_id];
+    if (p.after_window) {
+      if (mesh_of_window(p)) {
+        pp.second.insert(p.mesh_frame);
+        auto& slot = first[{p.projector_id, p.mesh_frame}];
+        if (!slot || p.render_done_ns < slot->render_done_ns) slot = &p;
+      }
+      continue;
+    }
+    ++f.rendered;
     ++pp.first;
     margin += p.margin_m;
     f.margin_min_m = std::min(f.margin_min_m, p.margin_m);
@@ -49,7 +61,7 @@ ProjectorFigures projector_figures(const Collected& c, double window_s) {
     if (p.mesh_frame && p.capture_ns) {
       f.mask_age_ms.push_back(p.latency_ms);
       // Only meshes captured in the window: an older one may have been first rendered before it.
-      if (p.capture_ns >= c.window_start_ns) {
+      if (mesh_of_window(p)) {
         pp.second.insert(p.mesh_frame);
         auto& slot = first[{p.projector_id, p.mesh_frame}];
         if (!slot || p.render_done_ns < slot->render_done_ns) slot = &p;
