@@ -47,9 +47,9 @@ Runs the studio end to end from deploy/examples/studio/ (usually through ./studi
                      projector's systemd unit: above capture 52 and keyer 54, which then
                      work for the next frame, below hull 56 and tracker 58, whose mesh and
                      head its frame waits for); the real-time part is the masks' path only
-                     (render thread, its rasteriser: ~5 ms a mesh): the scene thread and its
-                     rasteriser run time-sharing at nice N + scene_nice and the motion fit at
-                     FIFO 1 (BENCHMARKS.md, demo, session 18); or nice:N, time-sharing (the
+                     (render thread, its rasteriser: ~5 ms a mesh): the scene thread, its
+                     rasteriser and the motion fit run time-sharing at nice N + 3 (scene_nice,
+                     fit_nice; BENCHMARKS.md, demo, session 18); or nice:N, time-sharing (the
                      default under normal scheduling: nice:5)
   --sweep-frames N   frames of the projector mask's margin sweep (default 100; 0: none), run
                      after the services stopped, offline (studio-demo-probe sweep: the fast

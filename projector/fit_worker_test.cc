@@ -42,8 +42,8 @@ ActorMesh moving(int k) {
   return m;
 }
 
-std::unique_ptr<FitWorker> worker(int nice = 0) {
-  auto w = FitWorker::create({MotionOptions{}, nice});
+std::unique_ptr<FitWorker> worker(int nice = 0, bool realtime = false) {
+  auto w = FitWorker::create({MotionOptions{}, nice, realtime});
   EXPECT_TRUE(w) << (w ? "" : w.error().message);
   return w ? std::move(*w) : nullptr;
 }
@@ -236,24 +236,26 @@ TEST(FitWorker, PriorityNotLoweredIsReportedAndTheFitsGoOn) {
   // The control, ThreadRunsAtItsNiceValue: unfiltered, the note is empty.
 }
 
-// A real-time caller (the projector at SCHED_FIFO below the pipeline): the fit thread goes to
-// real-time priority 1, below the caller and above all time-sharing work; with no increment it
-// keeps the caller's priority (the control).
-TEST(FitWorker, RealTimeCallersFitThreadTakesTheLowestRealTimePriority) {
+// A real-time caller (the projector's masks' path at SCHED_FIFO): by default the fit thread goes
+// time-sharing at the caller's nice value + the increment; `realtime`, to real-time priority 1,
+// below the caller and above all time-sharing work; with no increment it keeps the caller's
+// priority (the control).
+TEST(FitWorker, RealTimeCallersFitThreadGoesTimeSharingOrToTheLowestRealTimePriority) {
   sched_param rt{};
   rt.sched_priority = 2;
   ASSERT_EQ(pthread_setschedparam(pthread_self(), SCHED_FIFO, &rt), 0)
       << "SCHED_FIFO not permitted: this test needs CAP_SYS_NICE (root, as ./studio test runs)";
   const int base = getpriority(PRIO_PROCESS, 0);
   {
-    auto lowered = worker(5);
+    auto shared = worker(5);
+    auto lowered = worker(5, true);
     auto same = worker(0);
-    ASSERT_TRUE(lowered && same);
-    lowered->submit("a", moving(0));
-    same->submit("a", moving(0));
-    lowered->drain();
-    same->drain();
+    ASSERT_TRUE(shared && lowered && same);
+    for (auto* w : {shared.get(), lowered.get(), same.get()}) w->submit("a", moving(0));
+    for (auto* w : {shared.get(), lowered.get(), same.get()}) w->drain();
+    EXPECT_EQ(shared->priority_note(), "");
     const auto threads = threads_sched();
+    EXPECT_EQ(count(threads, {std::min(19, base + 5), 0, SCHED_OTHER}), 1) << "base " << base;
     EXPECT_EQ(count(threads, {base, 1, SCHED_FIFO}), 1);
     EXPECT_GE(count(threads, {base, 2, SCHED_FIFO}), 2);  // this thread and `same`
   }

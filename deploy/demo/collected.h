@@ -1,6 +1,7 @@
 #pragma once
 // What the probe recorded (probe.cc) and what the report is computed from (report.cc).
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -45,6 +46,10 @@ struct ProjectorSample {
   // motion to photon only (not a frame of the window: not rendered, scored or lit).
   bool after_window = false;
   uint64_t actor_px = 0, lit_actor_px = 0, blackout_px = 0, wasted_px = 0;
+  // The eye the frame's scene was drawn from, and its distance to the true head centre at the
+  // frame's display (scored frames): what the actor sees is off by this much parallax.
+  Eigen::Vector3d eye = Eigen::Vector3d::Zero();
+  double eye_error_m = -1;
 };
 
 // The picture of one scored projector frame (OUT/projector.png): the thumbnail it published,

@@ -243,6 +243,12 @@ def write_markdown(r, path):
                  f"p50 {fmt(age.get('p50'))} / p99 {fmt(age.get('p99'))} ms. Security margin "
                  f"{fmt(mg.get('min'), 3)}..{fmt(mg.get('max'), 3)} m (mean {fmt(mg.get('mean'), 3)}), "
                  f"prediction on {p.get('predicted_frames')} frames.\n")
+        ee = p.get("eye_error_m") or {}
+        if ee.get("n"):
+            L.append(f"The scene's eye (the tracked head, moved on to the image's expected display) against the "
+                     f"true head centre at each frame's display: p50 {fmt(ee.get('p50'), 3)} m, p95 "
+                     f"{fmt(ee.get('p95'), 3)} m, max {fmt(ee.get('max'), 3)} m over {ee.get('n')} scored frames "
+                     f"(the parallax error of what the actor sees).\n")
         L.append(f"Lit actor pixels (true actor at display time, +{fmt(d.get('display_lag_s'), 3)} s after "
                  f"rendering, not blacked out): sum {d.get('sum')}, max {d.get('max_per_frame')} per frame "
                  f"({d.get('worst_at')}), {d.get('frames_with_lit')} of {d.get('frames_scored')} scored frames "

@@ -442,6 +442,7 @@ class Recorder {
       p.latency_ms = s.latency_ms;
       p.margin_m = s.margin_m;
       p.predicted = s.predicted;
+      p.eye = Eigen::Vector3d(s.eye[0], s.eye[1], s.eye[2]);
       p.after_window = after;
       if (after) {  // its mesh's figures only
         c_.projector.push_back(std::move(p));
@@ -502,6 +503,10 @@ class Recorder {
         note_projector_error(lit.error().message);
       } else {
         p.scored = true;
+        p.eye_error_m =
+            (p.eye - truth->true_head_at(studio_frame + o_.display_lag_s * 1e9 /
+                                                            double(o_.studio.clock.period_ns)))
+                .norm();
         p.actor_px = lit->actor;
         p.lit_actor_px = lit->lit_actor;
         p.blackout_px = lit->blackout;

@@ -72,6 +72,7 @@ ProjectorFigures projector_figures(const Collected& c, double window_s) {
       continue;
     }
     ++f.scored;
+    if (p.eye_error_m >= 0) f.eye_error_m.push_back(p.eye_error_m);
     actor += double(p.actor_px);
     wasted += double(p.wasted_px);
     blackout += double(p.blackout_px);
@@ -88,7 +89,7 @@ ProjectorFigures projector_figures(const Collected& c, double window_s) {
     if (it != c.frames.end() && it->second.mesh_ns)
       f.mesh_to_projector_ms.push_back(double(p->render_done_ns - it->second.mesh_ns) * 1e-6);
   }
-  for (auto* v : {&f.motion_to_photon_ms, &f.mask_age_ms, &f.mesh_to_projector_ms})
+  for (auto* v : {&f.motion_to_photon_ms, &f.mask_age_ms, &f.mesh_to_projector_ms, &f.eye_error_m})
     std::sort(v->begin(), v->end());
   f.mesh_fps = f.rendered_fps = std::numeric_limits<double>::infinity();
   for (const auto& [id, pp] : per) {
@@ -144,6 +145,9 @@ void write_projector(JsonWriter& j, const ProjectorFigures& f, const Collected& 
   write_stats(j, f.mask_age_ms);
   j.key("mesh_to_projector_ms");
   write_stats(j, f.mesh_to_projector_ms);
+  // The eye the scene was drawn from against the true head centre at the frame's display.
+  j.key("eye_error_m");
+  write_stats(j, f.eye_error_m);
   j.key("margin_m").begin_object();
   j.field("min", f.ran ? f.margin_min_m : kNaN).field("mean", f.ran ? f.margin_mean_m : kNaN);
   j.field("max", f.ran ? f.margin_max_m : kNaN);

@@ -24,6 +24,7 @@ namespace studio::demo {
 struct ProjectorFigures {
   bool ran = false;  // projector frames rendered in the window reached the probe
   std::vector<double> motion_to_photon_ms, mask_age_ms, mesh_to_projector_ms;  // sorted
+  std::vector<double> eye_error_m;  // scored frames' eye against the true head at display, sorted
   double mesh_fps = 0;      // the slowest projector's distinct meshes per second
   double rendered_fps = 0;  // the slowest projector's rendered frames per second
   std::map<std::string, std::pair<double, double>> per_projector;  // id -> (rendered, mesh) fps

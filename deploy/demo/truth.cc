@@ -64,6 +64,14 @@ Eigen::Vector3d TruthScorer::true_head(uint64_t frame) const {
   return impl_->studio.truth(int64_t(frame)).head_centre();
 }
 
+Eigen::Vector3d TruthScorer::true_head_at(double studio_frame) const {
+  const double f = std::max(studio_frame, 0.0);
+  const auto f0 = uint64_t(std::floor(f));
+  const double t = f - double(f0);
+  const Eigen::Vector3d a = true_head(f0);
+  return t > 0 ? Eigen::Vector3d(a + t * (true_head(f0 + 1) - a)) : a;
+}
+
 double TruthScorer::head_error(uint64_t frame, const Eigen::Vector3d& position) const {
   return (position - true_head(frame)).norm();
 }

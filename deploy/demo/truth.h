@@ -49,6 +49,8 @@ class TruthScorer {
   // |position - true head centre of frame|, metres.
   double head_error(uint64_t frame, const Eigen::Vector3d& position) const;
   Eigen::Vector3d true_head(uint64_t frame) const;
+  // The true head centre at a fractional frame of the simulator's clock (linear between frames).
+  Eigen::Vector3d true_head_at(double studio_frame) const;
 
   // Projector light on the true actor. `studio_frame` is a fractional frame number of the
   // simulator's clock (frame f is the actor at f / fps, sim/studio.h) for the frame's render

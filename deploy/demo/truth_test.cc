@@ -73,3 +73,19 @@ TEST(DemoTruth, ScoresTheHullOfTheTrueMasksAndAnEmptyMesh) {
 
 }  // namespace
 }  // namespace studio::demo
+
+namespace studio::demo {
+namespace {
+
+// The true head between frames (the projector frames' display instants fall between them).
+TEST(DemoTruth, TrueHeadBetweenFramesIsOnTheSegment) {
+  auto scorer = TruthScorer::create(sim::ring_cameras());
+  ASSERT_TRUE(scorer.has_value());
+  const Eigen::Vector3d a = scorer->true_head(40), b = scorer->true_head(41);
+  EXPECT_LT((scorer->true_head_at(40.0) - a).norm(), 1e-12);
+  EXPECT_LT((scorer->true_head_at(40.25) - (a + 0.25 * (b - a))).norm(), 1e-12);
+  EXPECT_LT((scorer->true_head_at(41.0) - b).norm(), 1e-12);
+}
+
+}  // namespace
+}  // namespace studio::demo

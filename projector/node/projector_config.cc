@@ -94,13 +94,16 @@ runtime::ServiceDefinition projector_service_definition() {
       "                            motion_fits_relatched); a mesh waiting for the thread when a\n"
       "                            newer one comes is not fitted (motion_fits_deferred);\n"
       "                            false: fitted on the render thread after each frame\n"
-      "    fit_nice: 14            fit_thread: its nice value above the process's (0..19): the\n"
+      "    fit_nice: 3             fit_thread: its nice value above the process's (0..19): the\n"
       "                            render thread and the rasteriser come first and the fit takes\n"
-      "                            what they leave (a time-sharing projector at nice 5: 5 + 14,\n"
-      "                            the lowest; a real-time projector's, as its systemd unit\n"
-      "                            runs it, takes real-time priority 1 instead: below the render\n"
-      "                            thread, above time-sharing work); a fit that lands late only\n"
-      "                            ages the velocities, which the margin counts\n"
+      "                            what they leave; a real-time projector's (its systemd unit)\n"
+      "                            runs time-sharing at the process's nice + this, beside the\n"
+      "                            scene thread (the same by default); a fit that lands late\n"
+      "                            only ages the velocities, which the margin counts\n"
+      "    fit_realtime: false     a real-time projector's fit thread at real-time priority 1\n"
+      "                            instead: every mesh fitted (a smaller margin) but the scene\n"
+      "                            thread gets only what the fits leave (on a shared 2-core PC\n"
+      "                            the scene then lags: BENCHMARKS.md, demo, session 18)\n"
       "    scene_thread: true      the scene drawn on a thread of its own, into a renderer on\n"
       "                            a display of its own (its own llvmpipe rasteriser threads),\n"
       "                            from the eye expected when its image is shown; each frame\n"
@@ -239,6 +242,7 @@ runtime::ServiceDefinition projector_service_definition() {
         yaml::field("late_latch", &ProjectorNodeOptions::late_latch),
         yaml::field("fit_thread", &ProjectorNodeOptions::fit_thread),
         yaml::field("fit_nice", &ProjectorNodeOptions::fit_nice).range(0, 19),
+        yaml::field("fit_realtime", &ProjectorNodeOptions::fit_realtime),
         yaml::field("scene_thread", &ProjectorNodeOptions::scene_thread),
         yaml::field("scene_nice", &ProjectorNodeOptions::scene_nice).range(0, 19),
         yaml::field("parallel_mesh_work", &ProjectorNodeOptions::parallel_mesh_work),

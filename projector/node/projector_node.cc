@@ -121,7 +121,8 @@ class ProjectorNode : public runtime::Node {
       init_ = std::promise<Expected<void>>();
     }
     if (options_.late_latch && options_.fit_thread && !fits_) {
-      auto w = FitWorker::create({options_.mask_options().motion, options_.fit_nice});
+      auto w = FitWorker::create(
+          {options_.mask_options().motion, options_.fit_nice, options_.fit_realtime});
       if (!w) return std::unexpected(w.error());
       fits_ = std::move(*w);
       if (const std::string note = fits_->priority_note(); !note.empty())

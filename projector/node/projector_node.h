@@ -69,7 +69,8 @@ struct ProjectorNodeOptions {
   // the render thread after each frame; the render thread installs each finished fit at its next
   // frame. The thread runs fit_nice below the process (0..19). false: fitted on the render thread.
   bool fit_thread = true;
-  int fit_nice = 14;
+  int fit_nice = 3;
+  bool fit_realtime = false;  // under a real-time process: the fit at real-time priority 1
   // The scene drawn on a thread of its own, into a renderer on a display of its own
   // (scene_render::EglScreen::own: its own llvmpipe rasteriser threads), from the eye expected
   // when its image is shown; the render thread puts each frame's masks over the newest image

@@ -102,18 +102,25 @@ void FitWorker::run() {
     // thread's id sets this thread's alone. Failing to lower our own priority changes only the
     // share, not the results.
     const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
-    if (const int policy = ::sched_getscheduler(0); policy == SCHED_FIFO || policy == SCHED_RR) {
-      // A real-time caller (a projector at SCHED_FIFO below the pipeline): the fit goes to the
-      // lowest real-time priority, below the render thread and the rasteriser (as the increment
-      // would put it) but above every time-sharing thread. Made time-sharing instead, the fit
-      // starved beside the demo's real-time pipeline (~60 % of the meshes unfitted) and the
-      // velocities grew old enough that 3 of 6 demo runs lit the actor (BENCHMARKS.md, demo,
-      // session 17); at priority 1 none did.
+    const int policy = ::sched_getscheduler(0);
+    const bool realtime_caller = policy == SCHED_FIFO || policy == SCHED_RR;
+    if (realtime_caller && !options_.realtime) {
+      // A real-time caller (the projector's masks' path): the fit goes time-sharing, then below
+      // the caller's nice value as for a time-sharing caller. Beside a real-time render thread
+      // that drew the whole scene (session 17) the fit starved this way; with the scene on its
+      // own time-sharing thread (session 18) the fit shares the rest with it.
+      sched_param none{};
+      if (::sched_setscheduler(0, SCHED_OTHER, &none) != 0)
+        note = std::string("sched_setscheduler: ") + std::strerror(errno);
+    }
+    if (realtime_caller && options_.realtime) {
+      // The lowest real-time priority, below the render thread and the rasteriser (as the
+      // increment would put it) but above every time-sharing thread: every mesh fitted.
       sched_param lowest{};
       lowest.sched_priority = 1;
       if (::sched_setscheduler(0, policy, &lowest) != 0)
         note = std::string("sched_setscheduler: ") + std::strerror(errno);
-    } else {
+    } else if (note.empty()) {
       errno = 0;
       const int current = ::getpriority(PRIO_PROCESS, tid);
       if (errno != 0)

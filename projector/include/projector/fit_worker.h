@@ -8,9 +8,9 @@
 // (stage_wait_ms) or is superseded. A FitWorker runs the fits instead: the render thread hands
 // each latched mesh over (submit), keeps drawing, and installs the fits that finished at its next
 // frame (take, then MaskPlanner::apply_fit). The worker's thread runs `nice_increment` below the
-// process (a per-thread nice value, Linux), or at real-time priority 1 under a real-time process,
-// so the render thread and llvmpipe's rasteriser keep the CPU they need and the fit takes what
-// they leave (on two cores: the second core while the render thread waits for its frame).
+// process (a per-thread nice value, Linux); under a real-time process it runs time-sharing at the
+// process's nice value + nice_increment (or, `realtime`, at real-time priority 1), so the render
+// thread and llvmpipe's rasteriser keep the CPU they need and the fit takes what they leave.
 //
 // Newest wins: a mesh still waiting when a newer mesh of the same actor is submitted is dropped
 // (counted, dropped()); the next fit is then against the last mesh fitted, over two mesh
@@ -40,9 +40,13 @@ namespace studio::projector {
 struct FitWorkerOptions {
   MotionOptions motion;
   // The fit thread's nice value above the process's (0..19; 0: the same priority as the caller).
-  // Above 0 under a real-time caller (SCHED_FIFO/RR) the fit thread takes the lowest real-time
-  // priority (1) instead: below the caller, above all time-sharing work.
   int nice_increment = 0;
+  // Above 0 under a real-time caller (SCHED_FIFO/RR): false, the fit thread runs time-sharing at
+  // the caller's nice value + nice_increment, sharing what the real-time threads leave with the
+  // process's other time-sharing threads (the projector's scene thread); true, at the lowest
+  // real-time priority (1): below the caller, above all time-sharing work — every mesh fitted,
+  // but the scene thread then gets what the fits leave (BENCHMARKS.md, demo, session 18).
+  bool realtime = false;
   Expected<void> validate() const;
 };
 
