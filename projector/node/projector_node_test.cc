@@ -83,6 +83,44 @@ double counter(const studio_ServiceStatus& s, const std::string& name) {
   return -1;
 }
 
+// This test's end of the wire: the projector's outputs read, its inputs written.
+struct Wires {
+  wire::Participant p = wire::Participant::create().value();
+  wire::Reader<studio_ProjectorCalibration> cal = reader<studio_ProjectorCalibration>();
+  wire::Reader<studio_ProjectorFrame> frames = reader<studio_ProjectorFrame>();
+  wire::Reader<studio_ServiceStatus> status = reader<studio_ServiceStatus>();
+  wire::Writer<studio_SceneNode> nodes = writer<studio_SceneNode>();
+  wire::Writer<studio_ActorMesh> meshes = writer<studio_ActorMesh>();
+  wire::Writer<studio_HeadPose> heads = writer<studio_HeadPose>();
+
+  template <class T>
+  wire::Reader<T> reader() {
+    return wire::Reader<T>::create(p, wire::Topic<T>::create(p).value()).value();
+  }
+  template <class T>
+  wire::Writer<T> writer() {
+    return wire::Writer<T>::create(p, wire::Topic<T>::create(p).value()).value();
+  }
+  // Every node of `scene`, as the scene server publishes them.
+  void publish_scene(const scene::Scene& scene) {
+    ASSERT_TRUE(nodes.wait_for_readers(1, 10s));
+    for (const auto& [id, n] : scene.nodes()) {
+      wire::Owned<studio_SceneNode> s;
+      ASSERT_TRUE(wire::from_core(n, *s).has_value());
+      ASSERT_TRUE(nodes.write(*s).has_value());
+    }
+  }
+  // The followed actor's head at `at`, captured now.
+  void publish_head(const Eigen::Vector3d& at) {
+    wire::Owned<studio_HeadPose> h;
+    wire::set(h->actor_id, "actor");
+    h->capture_ns = realtime_ns();
+    for (int i = 0; i < 3; ++i) h->position[i] = at[i];
+    h->confidence = 1;
+    ASSERT_TRUE(heads.write(*h).has_value());
+  }
+};
+
 class ProjectorNodeTest : public studio::testing::ProcessTest {
  protected:
   std::string write_files(const Projector& p, const std::string& extra = "") {
@@ -104,19 +142,11 @@ TEST_F(ProjectorNodeTest, RendersTheSceneMasksTheActorAndReportsOverDds) {
       spawn("projector", "projector/studio-projector", {"--config", write_files(projector)});
   ASSERT_TRUE(node.wait_ready(30s)) << node.log();
 
-  auto p = wire::Participant::create().value();
-  auto cal_topic = wire::Topic<studio_ProjectorCalibration>::create(p).value();
-  auto cal = wire::Reader<studio_ProjectorCalibration>::create(p, cal_topic).value();
-  auto frame_topic = wire::Topic<studio_ProjectorFrame>::create(p).value();
-  auto frames = wire::Reader<studio_ProjectorFrame>::create(p, frame_topic).value();
-  auto status_topic = wire::Topic<studio_ServiceStatus>::create(p).value();
-  auto status = wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
-  auto node_topic = wire::Topic<studio_SceneNode>::create(p).value();
-  auto nodes = wire::Writer<studio_SceneNode>::create(p, node_topic).value();
-  auto mesh_topic = wire::Topic<studio_ActorMesh>::create(p).value();
-  auto meshes = wire::Writer<studio_ActorMesh>::create(p, mesh_topic).value();
-  auto head_topic = wire::Topic<studio_HeadPose>::create(p).value();
-  auto heads = wire::Writer<studio_HeadPose>::create(p, head_topic).value();
+  Wires w;
+  auto& cal = w.cal;
+  auto& frames = w.frames;
+  auto& status = w.status;
+  auto& meshes = w.meshes;
 
   // The calibration, from the rig file (transient-local: arrives although written before).
   std::optional<Projector> published;
@@ -137,12 +167,7 @@ TEST_F(ProjectorNodeTest, RendersTheSceneMasksTheActorAndReportsOverDds) {
       scene_config::read_scene_file(std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml").value();
   scene_assets::AssetCache cache;
   auto scene = scene_assets::build_scene(description, cache, 0).value();
-  ASSERT_TRUE(nodes.wait_for_readers(1, 10s));
-  for (const auto& [id, n] : scene.nodes()) {
-    wire::Owned<studio_SceneNode> s;
-    ASSERT_TRUE(wire::from_core(n, *s).has_value());
-    ASSERT_TRUE(nodes.write(*s).has_value());
-  }
+  w.publish_scene(scene);
 
   // The actor: a 0.5 m box in front of the back wall, and its head.
   ASSERT_TRUE(meshes.wait_for_readers(1, 10s));
@@ -151,14 +176,7 @@ TEST_F(ProjectorNodeTest, RendersTheSceneMasksTheActorAndReportsOverDds) {
   wire::Owned<studio_ActorMesh> m;
   to_wire(actor, "actor0", 1234, *m);
   ASSERT_TRUE(meshes.write(*m).has_value());
-  auto publish_head = [&](const Eigen::Vector3d& at) {
-    wire::Owned<studio_HeadPose> h;
-    wire::set(h->actor_id, "actor");
-    h->capture_ns = realtime_ns();
-    for (int i = 0; i < 3; ++i) h->position[i] = at[i];
-    h->confidence = 1;
-    ASSERT_TRUE(heads.write(*h).has_value());
-  };
+  auto publish_head = [&](const Eigen::Vector3d& at) { w.publish_head(at); };
   const Eigen::Vector3d eye(0.1, 1.65, 1.2);
 
   // A frame with the mesh: stamped with its frame and capture time, the mask where the
@@ -344,36 +362,18 @@ TEST_F(ProjectorNodeTest, SceneThreadShowsWhatTheRenderThreadDraws) {
     auto& node = spawn("projector", "projector/studio-projector",
                        {"--config", write_files(projector, thread ? "" : "  scene_thread: false\n")});
     ASSERT_TRUE(node.wait_ready(30s)) << node.log();
-    auto p = wire::Participant::create().value();
-    auto frame_topic = wire::Topic<studio_ProjectorFrame>::create(p).value();
-    auto frames = wire::Reader<studio_ProjectorFrame>::create(p, frame_topic).value();
-    auto status_topic = wire::Topic<studio_ServiceStatus>::create(p).value();
-    auto status = wire::Reader<studio_ServiceStatus>::create(p, status_topic).value();
-    auto node_topic = wire::Topic<studio_SceneNode>::create(p).value();
-    auto nodes = wire::Writer<studio_SceneNode>::create(p, node_topic).value();
-    auto head_topic = wire::Topic<studio_HeadPose>::create(p).value();
-    auto heads = wire::Writer<studio_HeadPose>::create(p, head_topic).value();
-    ASSERT_TRUE(nodes.wait_for_readers(1, 10s));
-    for (const auto& [id, n] : scene.nodes()) {
-      wire::Owned<studio_SceneNode> s;
-      ASSERT_TRUE(wire::from_core(n, *s).has_value());
-      ASSERT_TRUE(nodes.write(*s).has_value());
-    }
+    Wires w;
+    w.publish_scene(scene);
     // Frames from the head, once the whole scene is in (a later frame than the first such).
     std::optional<wire::Owned<studio_ProjectorFrame>> got;
     int from_eye = 0;
     double images = -1, ahead = -1;
     for (auto until = SteadyClock::now() + 25s; !(got && images >= 0) && SteadyClock::now() < until;) {
-      wire::Owned<studio_HeadPose> h;
-      wire::set(h->actor_id, "actor");
-      h->capture_ns = realtime_ns();
-      for (int i = 0; i < 3; ++i) h->position[i] = eye[i];
-      h->confidence = 1;
-      ASSERT_TRUE(heads.write(*h).has_value());
-      for (auto& s : frames.take())
+      w.publish_head(eye);
+      for (auto& s : w.frames.take())
         if (s.meta.valid_data && s.data->eye[2] == eye.z() && ++from_eye == 5)
           got = std::move(s.data);
-      for (auto& s : status.take())
+      for (auto& s : w.status.take())
         if (got && s.meta.valid_data && std::string(s.data->service) == "projector") {
           images = counter(*s.data, "scene_images_drawn");
           ahead = counter(*s.data, "stage_ahead_ms");

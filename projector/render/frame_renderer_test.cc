@@ -411,18 +411,17 @@ TEST(FrameRenderer, TwoPassWarpOverTheScreenOnlyKeepsTheFrame) {
   }
 }
 
-// Late latching (FrameRenderer::prepare + draw_masks): the scene drawn ahead and the masks put
-// over it later give the frame render() gives, in both forms, value for value, with the scene
-// cache's layered path too. Control: the mask is in the frame.
-TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
-  (void)context();
-  const Projector p = projector::testing::studio_projectors()[0];
-  auto view = projector::ProjectorView::create(p).value();
+namespace {
+
+// The demo's default scene (its assets in `cache`).
+Expected<scene::Scene> default_scene(scene_assets::AssetCache& cache) {
   auto d = scene_config::read_scene_file(std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml");
-  ASSERT_TRUE(d) << d.error().message;
-  scene_assets::AssetCache cache;
-  auto scene = scene_assets::build_scene(*d, cache, 0);
-  ASSERT_TRUE(scene) << scene.error().message;
+  if (!d) return std::unexpected(d.error());
+  return scene_assets::build_scene(*d, cache, 0);
+}
+
+// An actor's mask: a 0.6 x 1.8 x 0.4 m box in front of the back wall (outward faces).
+projector::ActorMesh box_mask() {
   projector::ActorMesh mask;
   for (int k = 0; k < 8; ++k)
     mask.vertices.push_back(
@@ -431,7 +430,31 @@ TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
                                                {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6},
                                                {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
   mask.triangles.assign(std::begin(tris), std::end(tris));
-  const std::vector<projector::ActorMesh> masks{mask};
+  return mask;
+}
+
+// Values that differ between two read-backs of one renderer's frame size.
+int values_differing(const FrameRenderer& fr, Readback& a, Readback& b) {
+  const cv::Mat ma(fr.height(), fr.width(), CV_8UC4, a.rgba.data()),
+      mb(fr.height(), fr.width(), CV_8UC4, b.rgba.data());
+  cv::Mat diff;
+  cv::absdiff(ma, mb, diff);
+  return cv::countNonZero(diff.reshape(1));
+}
+
+}  // namespace
+
+// Late latching (FrameRenderer::prepare + draw_masks): the scene drawn ahead and the masks put
+// over it later give the frame render() gives, in both forms, value for value, with the scene
+// cache's layered path too. Control: the mask is in the frame.
+TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
+  (void)context();
+  const Projector p = projector::testing::studio_projectors()[0];
+  auto view = projector::ProjectorView::create(p).value();
+  scene_assets::AssetCache cache;
+  auto scene = default_scene(cache);
+  ASSERT_TRUE(scene) << scene.error().message;
+  const std::vector<projector::ActorMesh> masks{box_mask()};
   const scene::Scene empty(scene->options());
   for (const Form form : {Form::single_pass, Form::two_pass}) {
     FrameRendererOptions fo;
@@ -456,11 +479,7 @@ TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
       EXPECT_EQ(fr->draw_masks(masks), 1);
       fr->finish();
       fr->read(got, true);
-      const cv::Mat a(fr->height(), fr->width(), CV_8UC4, want.rgba.data()),
-          b(fr->height(), fr->width(), CV_8UC4, got.rgba.data());
-      cv::Mat diff;
-      cv::absdiff(a, b, diff);
-      const int differ = cv::countNonZero(diff.reshape(1));
+      const int differ = values_differing(*fr, want, got);
       std::printf("%s%s: %d values differ, blackout %lld px\n",
                   form == Form::single_pass ? "single pass" : "two pass",
                   layered ? ", layered" : "", differ, static_cast<long long>(got.blackout.area()));
@@ -479,20 +498,10 @@ TEST(FrameRenderer, SceneFromAnotherScreenThenMasksIsTheRenderedFrame) {
   (void)context();
   const Projector p = projector::testing::studio_projectors()[0];
   auto view = projector::ProjectorView::create(p).value();
-  auto d = scene_config::read_scene_file(std::string(STUDIO_SCENE_DEFAULT_DIR) + "/scene.yaml");
-  ASSERT_TRUE(d) << d.error().message;
   scene_assets::AssetCache cache;
-  auto scene = scene_assets::build_scene(*d, cache, 0);
+  auto scene = default_scene(cache);
   ASSERT_TRUE(scene) << scene.error().message;
-  projector::ActorMesh mask;
-  for (int k = 0; k < 8; ++k)
-    mask.vertices.push_back(
-        Eigen::Vector3f(k & 1 ? 0.3f : -0.3f, k & 2 ? 1.8f : 0.0f, k & 4 ? -0.4f : -0.8f));
-  const std::array<std::uint32_t, 3> tris[] = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5},
-                                               {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6},
-                                               {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
-  mask.triangles.assign(std::begin(tris), std::end(tris));
-  const std::vector<projector::ActorMesh> masks{mask};
+  const std::vector<projector::ActorMesh> masks{box_mask()};
   const Eigen::Vector3d eye(0.1, 1.65, 1.2);
   auto own = scene_render::HeadlessContext::create(scene_render::EglScreen::own);
   ASSERT_TRUE(own) << own.error().message;
@@ -524,11 +533,7 @@ TEST(FrameRenderer, SceneFromAnotherScreenThenMasksIsTheRenderedFrame) {
     EXPECT_EQ(fr->draw_masks(masks), 1);
     fr->finish();
     fr->read(got, true);
-    const cv::Mat a(fr->height(), fr->width(), CV_8UC4, want.rgba.data()),
-        b(fr->height(), fr->width(), CV_8UC4, got.rgba.data());
-    cv::Mat diff;
-    cv::absdiff(a, b, diff);
-    const int differ = cv::countNonZero(diff.reshape(1));
+    const int differ = values_differing(*fr, want, got);
     std::printf("%s, scene from its own screen: %d values differ, blackout %lld px\n",
                 form == Form::single_pass ? "single pass" : "two pass", differ,
                 static_cast<long long>(got.blackout.area()));
