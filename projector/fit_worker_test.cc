@@ -5,6 +5,7 @@
 // real-time priority 1 under a real-time caller; a priority it cannot lower (setpriority denied
 // by a seccomp filter, as a unit's hardening would) is said in one line and the fits go on.
 #include "projector/fit_worker.h"
+#include "projector/thread_priority.h"
 
 #include <gtest/gtest.h>
 
@@ -261,6 +262,29 @@ TEST(FitWorker, RealTimeCallersFitThreadGoesTimeSharingOrToTheLowestRealTimePrio
   }
   sched_param normal{};
   EXPECT_EQ(pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal), 0);
+}
+
+// The helper itself, as the scene thread calls it: a real-time thread goes time-sharing even
+// with no nice increment; asked to keep real time, it goes to priority 1 of its policy.
+TEST(LowerThisThread, RealTimeThreadGoesTimeSharingOrToPriorityOne) {
+  int shared = -1, kept = -1, kept_priority = -1;
+  std::string shared_note = "unset", kept_note = "unset";
+  for (const bool keep : {false, true})
+    std::thread([&] {
+      sched_param rt{};
+      rt.sched_priority = 2;
+      if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &rt) != 0) return;
+      const std::string note = lower_this_thread(0, keep);
+      sched_param now{};
+      (keep ? kept : shared) = sched_getscheduler(0);
+      (keep ? kept_note : shared_note) = note;
+      if (keep && sched_getparam(0, &now) == 0) kept_priority = now.sched_priority;
+    }).join();
+  EXPECT_EQ(shared_note, "");
+  EXPECT_EQ(shared, SCHED_OTHER);
+  EXPECT_EQ(kept_note, "");
+  EXPECT_EQ(kept, SCHED_FIFO);
+  EXPECT_EQ(kept_priority, 1);
 }
 
 }  // namespace

@@ -16,7 +16,6 @@ void write(SceneHandoff& h, std::uint8_t value) {
   SceneImage& img = h.back();
   img.rgba.assign(16, value);
   img.eye = Eigen::Vector3d(value, 0, 0);
-  img.ok = true;
   h.publish();
 }
 

@@ -1,9 +1,7 @@
 #include "projector_node.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <condition_variable>
 #include <future>
 #include <mutex>
@@ -11,10 +9,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <set>
-#include <sys/resource.h>
-#include <sys/syscall.h>
 #include <thread>
-#include <unistd.h>
 
 #include "core/clock.h"
 #include "core/log.h"
@@ -25,6 +20,7 @@
 #include "projector/fit_worker.h"
 #include "projector/mesh_inbox.h"
 #include "projector/scene_handoff.h"
+#include "projector/thread_priority.h"
 #include "projector_wire.h"
 #include "runtime/service_loop.h"
 #include "scene_mirror.h"
@@ -37,28 +33,6 @@ namespace {
 
 constexpr const char* kLog = "projector";
 using SteadyClock = std::chrono::steady_clock;
-
-// Lowers the calling thread's priority below the process's by `nice` (Linux: the policy and the
-// nice value are per thread). A real-time thread becomes time-sharing at its nice value +
-// `nice`: the scene thread's llvmpipe rasterisers would otherwise add whole cores of real-time
-// load beside the real-time pipeline (and run it into the kernel's real-time throttling).
-// Empty when done, else why not (the thread then runs at the process's priority).
-std::string lower_this_thread(int nice) {
-  const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
-  if (const int policy = ::sched_getscheduler(0); policy == SCHED_FIFO || policy == SCHED_RR) {
-    sched_param p{};
-    p.sched_priority = 0;
-    if (::sched_setscheduler(0, SCHED_OTHER, &p) != 0)
-      return std::string("sched_setscheduler: ") + std::strerror(errno);
-  }
-  if (nice <= 0) return {};
-  errno = 0;
-  const int current = ::getpriority(PRIO_PROCESS, tid);
-  if (errno != 0) return std::string("getpriority: ") + std::strerror(errno);
-  if (::setpriority(PRIO_PROCESS, tid, std::min(19, current + nice)) != 0)
-    return std::string("setpriority: ") + std::strerror(errno);
-  return {};
-}
 
 class ProjectorNode : public runtime::Node {
  public:
@@ -453,6 +427,9 @@ class ProjectorNode : public runtime::Node {
   // then the display lag.
   void scene_loop() {
     pthread_setname_np(pthread_self(), "scene");
+    // Time-sharing even in a real-time process: the scene's rasteriser threads (created below,
+    // with this thread's priority) would otherwise add whole cores of real-time load beside the
+    // real-time pipeline and run it into the kernel's real-time throttling.
     const std::string note = lower_this_thread(options_.scene_nice);
     auto context = scene_render::HeadlessContext::create(scene_render::EglScreen::own);
     if (!context) {
@@ -487,7 +464,6 @@ class ProjectorNode : public runtime::Node {
         SceneImage& img = handoff_->back();
         fr->read_image(img.rgba);
         img.eye = eye;
-        img.ok = true;
         img.from_cache = drawn->from_cache;
         img.held = drawn->held;
         img.shift_px = drawn->shift_px;

@@ -1,14 +1,9 @@
 #include "projector/fit_worker.h"
 
-#include <sched.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
 #include <system_error>
+
+#include "projector/thread_priority.h"
 
 namespace studio::projector {
 
@@ -98,36 +93,12 @@ std::uint64_t FitWorker::dropped() const {
 void FitWorker::run() {
   std::string note;
   if (options_.nice_increment > 0) {
-    // Linux: the policy and the nice value are per-thread attributes; PRIO_PROCESS with this
-    // thread's id sets this thread's alone. Failing to lower our own priority changes only the
-    // share, not the results.
-    const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
-    const int policy = ::sched_getscheduler(0);
-    const bool realtime_caller = policy == SCHED_FIFO || policy == SCHED_RR;
-    if (realtime_caller && !options_.realtime) {
-      // A real-time caller (the projector's masks' path): the fit goes time-sharing, then below
-      // the caller's nice value as for a time-sharing caller. Beside a real-time render thread
-      // that drew the whole scene (session 17) the fit starved this way; with the scene on its
-      // own time-sharing thread (session 18) the fit shares the rest with it.
-      sched_param none{};
-      if (::sched_setscheduler(0, SCHED_OTHER, &none) != 0)
-        note = std::string("sched_setscheduler: ") + std::strerror(errno);
-    }
-    if (realtime_caller && options_.realtime) {
-      // The lowest real-time priority, below the render thread and the rasteriser (as the
-      // increment would put it) but above every time-sharing thread: every mesh fitted.
-      sched_param lowest{};
-      lowest.sched_priority = 1;
-      if (::sched_setscheduler(0, policy, &lowest) != 0)
-        note = std::string("sched_setscheduler: ") + std::strerror(errno);
-    } else if (note.empty()) {
-      errno = 0;
-      const int current = ::getpriority(PRIO_PROCESS, tid);
-      if (errno != 0)
-        note = std::string("getpriority: ") + std::strerror(errno);
-      else if (::setpriority(PRIO_PROCESS, tid, std::min(19, current + options_.nice_increment)) != 0)
-        note = std::string("setpriority: ") + std::strerror(errno);
-    }
+    // Failing to lower our own priority changes only the share, not the results. A real-time
+    // caller (the projector's masks' path): time-sharing by default — beside a real-time render
+    // thread that drew the whole scene (session 17) the fit starved this way; with the scene on
+    // its own time-sharing thread (session 18) it shares the rest with it — or (`realtime`) the
+    // lowest real-time priority, below the render thread, above every time-sharing thread.
+    note = lower_this_thread(options_.nice_increment, options_.realtime);
     if (!note.empty())
       note = "motion fit thread: its priority was not lowered (" + note +
              "): it shares the CPU with the render thread as an equal";

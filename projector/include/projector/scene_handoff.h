@@ -23,7 +23,6 @@ struct SceneImage {
   std::vector<std::uint8_t> rgba;  // the projector frame's scene, RGBA, bottom row first
   Eigen::Vector3d eye = Eigen::Vector3d::Zero();  // drawn from (studio frame)
   std::chrono::steady_clock::time_point done;     // read back (complete) at
-  bool ok = false;          // drawn (false: the projection refused every eye; rgba untouched)
   bool from_cache = false;  // the static layer restored, not drawn
   bool held = false;        // restored beyond the bound (SceneCacheOptions::hold_frames)
   double shift_px = 0;      // the cached layer's displacement bound at `eye`
