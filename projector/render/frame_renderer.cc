@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string_view>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -145,6 +146,7 @@ struct FrameRenderer::Impl {
   std::vector<std::uint8_t> rgba;
   std::optional<StaticLayer> layer;         // scene_cache enabled
   std::optional<Eigen::Vector3d> last_eye;  // of the previous layered frame
+  bool clear_texture = false;               // glClearTexSubImage (GL 4.4 or ARB_clear_texture)
 
   Expected<FrameInfo> render(const scene::Scene& still, std::uint64_t version,
                              const scene::Scene* moving, const Eigen::Vector3d& eye,
@@ -156,6 +158,24 @@ FrameRenderer::FrameRenderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 FrameRenderer::FrameRenderer(FrameRenderer&&) noexcept = default;
 FrameRenderer& FrameRenderer::operator=(FrameRenderer&&) noexcept = default;
 FrameRenderer::~FrameRenderer() = default;
+
+namespace {
+// Whether the current context has glClearTexSubImage (GL 4.4 core, or ARB_clear_texture; Mesa's
+// llvmpipe gives 4.5 for the 3.3 core context asked for).
+bool has_clear_texture() {
+  GLint major = 0, minor = 0;
+  glGetIntegerv(GL_MAJOR_VERSION, &major);
+  glGetIntegerv(GL_MINOR_VERSION, &minor);
+  if (major > 4 || (major == 4 && minor >= 4)) return true;
+  GLint n = 0;
+  glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+  for (GLint i = 0; i < n; ++i) {
+    const auto* e = reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, GLuint(i)));
+    if (e && std::string_view(e) == "GL_ARB_clear_texture") return true;
+  }
+  return false;
+}
+}  // namespace
 
 scene::ActorMesh screen_surround(const projector::Screen& screen, const std::string& actor_id) {
   const auto c = screen.corners();
@@ -255,7 +275,8 @@ Expected<FrameRenderer> FrameRenderer::create(const projector::ProjectorView& vi
                                                       {},
                                                       {},
                                                       std::move(layer),
-                                                      std::nullopt}));
+                                                      std::nullopt,
+                                                      has_clear_texture()}));
 }
 
 scene_render::Renderer& FrameRenderer::renderer() { return impl_->renderer; }
@@ -401,13 +422,30 @@ int FrameRenderer::Impl::draw_masks(std::span<const projector::ActorMesh> masks)
   for (std::size_t i = 0; i < masks.size(); ++i) {
     const projector::ActorMesh& m = masks[i];
     if (!m.validate()) continue;
+    const auto& rects = m.image_rects;
+    if (rects && r.clear_texture && rects->width == r.target.width() &&
+        rects->height == r.target.height()) {
+      // Made in this frame's image (grow_outline): its pixels cleared to transparent black,
+      // the very pixels its quads would cover (GL's rows bottom first). llvmpipe fills them
+      // with memset after the frame's pending drawing: 0.07 ms for 132k px against ~1.2 ms to
+      // rasterise the quads (projector_bench SceneImageFrame_720p).
+      static constexpr GLubyte kClear[4] = {0, 0, 0, 0};
+      const GLuint texture = r.target.colour_texture();
+      const int h = r.target.height();
+      for (const auto& [x0, y0, x1, y1] : rects->rects)
+        glClearTexSubImage(texture, 0, x0, h - y1, 0, x1 - x0, y1 - y0, 1, GL_RGBA,
+                           GL_UNSIGNED_BYTE, kClear);
+      ++drawn;
+      continue;
+    }
     if (r.mask_ids.size() <= i) r.mask_ids.push_back("\x01mask" + std::to_string(i));
     r.scratch.actor_id = r.mask_ids[i];
     r.scratch.vertices = m.vertices;
     r.scratch.triangles = m.triangles;
     r.scratch.normals.assign(m.vertices.size(), Eigen::Vector3f::UnitZ());  // unused: unlit
     if (!r.renderer.set_actor_mesh(r.scratch)) continue;
-    r.renderer.draw_actor_flat(r.mask_ids[i], r.mask_view, 0.0f, Eigen::Vector4f::Zero());
+    r.renderer.draw_actor_flat(r.mask_ids[i], r.mask_view, 0.0f, Eigen::Vector4f::Zero(),
+                               rects.has_value());
     ++drawn;
   }
   return drawn;

@@ -18,12 +18,14 @@
 #include <random>
 
 #include "projector/camera_clip.h"
+#include "projector/mask_geometry.h"
 #include "scene/view.h"
 #include "scene_assets/scene_description.h"
 #include "scene_config/scene_yaml.h"
 #include "scene_render/egl_context.h"
 #include "scene_render/render_target.h"
 #include "testing/projectors.h"
+#include "testing/shapes.h"
 
 using namespace studio;
 using namespace studio::projector_render;
@@ -540,6 +542,67 @@ TEST(FrameRenderer, SceneFromAnotherScreenThenMasksIsTheRenderedFrame) {
     EXPECT_EQ(differ, 0);
     EXPECT_EQ(got.blackout, want.blackout);
     EXPECT_GT(got.blackout.area(), 1000);
+  }
+}
+
+// The outline mask (projector::grow_outline) as the frame gets it: its pixel rectangles cleared
+// (ActorMesh::image_rects, glClearTexSubImage) give, value for value, the frame its quads give
+// rasterised with the renderer's once-per-pixel depth pass (the way before), and its quads
+// drawn without that pass (rectangles made for another image size) too; bands of rows and
+// every row alone (band_px 0) the same. Both forms, three margins, a box and a sphere (curved
+// outlines: bands with a rest at either end). Control: the mask blacks out pixels that the
+// scene lit.
+TEST(FrameRenderer, OutlineRectanglesClearedAreTheQuadsRasterised) {
+  (void)context();
+  const Projector p = projector::testing::studio_projectors()[0];
+  auto view = projector::ProjectorView::create(p).value();
+  scene_assets::AssetCache cache;
+  auto scene = default_scene(cache);
+  ASSERT_TRUE(scene) << scene.error().message;
+  const projector::ActorMesh actor = projector::testing::merge(
+      box_mask(), projector::testing::sphere({0.6, 1.2, -0.5}, 0.25, Eigen::Matrix3d::Identity()));
+  const Eigen::Vector3d eye(0.1, 1.65, 1.2);
+  for (const Form form : {Form::single_pass, Form::two_pass}) {
+    FrameRendererOptions fo;
+    fo.form = form;
+    auto fr = FrameRenderer::create(view, fo);
+    ASSERT_TRUE(fr) << fr.error().message;
+    for (const auto& [path, a] : cache.all()) ASSERT_TRUE(fr->renderer().upload(*a));
+    Readback bare;
+    ASSERT_TRUE(fr->render(*scene, eye, {}));
+    fr->finish();
+    fr->read(bare, true);
+    for (const double margin : {0.03, 0.13, 0.2}) {
+      for (const int band : {16, 0}) {
+        auto outline = projector::grow_outline(actor, margin, view.camera(), 2, band);
+        ASSERT_TRUE(outline) << outline.error().message;
+        ASSERT_TRUE(outline->image_rects);
+        std::vector<projector::ActorMesh> cleared{*outline}, quads{*outline}, flat{*outline};
+        quads[0].image_rects.reset();
+        flat[0].image_rects->width += 1;  // made for another image: drawn, without depth pass
+        Readback want, got, drawn;
+        for (auto [masks, into] : {std::pair{&quads, &want}, std::pair{&cleared, &got},
+                                   std::pair{&flat, &drawn}}) {
+          ASSERT_TRUE(fr->prepare(*scene, eye));
+          EXPECT_EQ(fr->draw_masks(*masks), 1);
+          fr->finish();
+          fr->read(*into, true);
+        }
+        const int differ = values_differing(*fr, want, got);
+        const int differ_flat = values_differing(*fr, want, drawn);
+        const int masked = values_differing(*fr, want, bare);
+        std::printf("%s, margin %.2f m, band %d px: %zu rectangles, %d / %d values differ, "
+                    "blackout %lld px, %d values masked\n",
+                    form == Form::single_pass ? "single pass" : "two pass", margin, band,
+                    outline->image_rects->rects.size(), differ, differ_flat,
+                    static_cast<long long>(got.blackout.area()), masked);
+        EXPECT_EQ(differ, 0);
+        EXPECT_EQ(differ_flat, 0);
+        EXPECT_EQ(got.blackout, want.blackout);
+        EXPECT_GT(got.blackout.area(), 10000);
+        EXPECT_GT(masked, 10000);
+      }
+    }
   }
 }
 

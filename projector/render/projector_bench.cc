@@ -334,6 +334,58 @@ void BM_HullMask_720p(benchmark::State& state) {
   state.counters["blackout_px"] = double(rb.blackout.area());
 }
 
+// The frame the node renders by default (scene_thread: the scene drawn by another thread into an
+// image): the newest scene image loaded, the hull's mask (the arm swing's whole mesh, the outline
+// form) grown by arg 0 mm and drawn over it, finished — what a new mesh waits for at 1280x720.
+// Arg 1: 1 the outline's pixel rectangles cleared (ActorMesh::image_rects: the node's way), 0
+// its quads rasterised with the renderer's once-per-pixel depth pass (the baseline, before).
+// Counters (ms per frame, wall): grow_ms (grow_mask), load_ms (load_image), draw_finish_ms
+// (draw_masks + finish); blackout_px of the last frame (read back outside the timing).
+void BM_SceneImageFrame_720p(benchmark::State& state) {
+  Fixture& f = fixture();
+  static const projector::ActorMesh hull =
+      projector::testing::hull_meshes(sim::Motion::arm_swing, 60, 1).front();
+  auto view = projector::ProjectorView::create(at_720p(f.projector));
+  auto fr = FrameRenderer::create(*view, {});
+  if (!fr) {
+    state.SkipWithError(fr.error().message.c_str());
+    return;
+  }
+  for (const auto& [p, a] : f.cache.all()) (void)fr->renderer().upload(*a);
+  if (!fr->render(f.scene, kEye, {})) state.SkipWithError("render failed");
+  fr->finish();
+  std::vector<std::uint8_t> image;
+  fr->read_image(image);
+  projector::GrowOptions o;
+  o.projector = view->camera();
+  const projector::MaskBase base = projector::simplify_for_mask(hull, o).value();
+  std::vector<projector::ActorMesh> masks(1);
+  using Clock = std::chrono::steady_clock;
+  double grow = 0, load = 0, draw = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    masks[0] = projector::grow_mask(base, 1e-3 * double(state.range(0)), o).value();
+    if (state.range(1) == 0) masks[0].image_rects.reset();  // the baseline: quads
+    const auto t1 = Clock::now();
+    fr->load_image(image);
+    const auto t2 = Clock::now();
+    fr->draw_masks(masks);
+    fr->finish();
+    const auto t3 = Clock::now();
+    grow += std::chrono::duration<double, std::milli>(t1 - t0).count();
+    load += std::chrono::duration<double, std::milli>(t2 - t1).count();
+    draw += std::chrono::duration<double, std::milli>(t3 - t2).count();
+  }
+  const double n = double(std::max<benchmark::IterationCount>(state.iterations(), 1));
+  state.counters["grow_ms"] = grow / n;
+  state.counters["load_ms"] = load / n;
+  state.counters["draw_finish_ms"] = draw / n;
+  Readback rb;
+  fr->read(rb);
+  state.counters["blackout_px"] = double(rb.blackout.area());
+}
+BENCHMARK(BM_SceneImageFrame_720p)->Args({30, 0})->Args({30, 1})->Args({130, 0})->Args({130, 1})->Args({200, 0})->Args({200, 1})->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime()->MeasureProcessCPUTime();
+
 // The blackout runs of a read-back 1280x720 frame (blackout_of; the node does this per frame):
 // an elliptical mask of ~200k pixels (the demo's at the margin's cap) over a lit frame.
 void BM_BlackoutRuns_720p(benchmark::State& state) {

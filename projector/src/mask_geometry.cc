@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <span>
 #include <utility>
 
 namespace studio::projector {
@@ -197,7 +198,7 @@ void edt_1d(const double* f, double* d, int n, int* v, double* z) {
 }  // namespace
 
 Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const Camera& projector,
-                                 int cell) {  // cell: the smallest cell size
+                                 int cell, int band_px) {  // cell: the smallest cell size
   if (auto v = mesh.validate(); !v) return std::unexpected(v.error());
   if (!(margin_m >= 0) || !std::isfinite(margin_m)) return fail("grow mask: margin must be >= 0");
   const Intrinsics& in = projector.intrinsics;
@@ -264,6 +265,7 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
   const double y1 = std::min(hi.y() + reach, projector.height - 0.5 + reach);
   ActorMesh out;
   out.capture_ns = mesh.capture_ns;
+  out.image_rects = ActorMesh::ImageRects{projector.width, projector.height, {}};
   if (!(x1 > x0 && y1 > y0)) return out;  // the mesh's image and the projector's do not meet
   const int W = int(std::ceil((x1 - x0) / cell)), H = int(std::ceil((y1 - y0) / cell));
   if (double(W) * H > 16e6) return fail("grow mask: the outline grid would be too large");
@@ -333,7 +335,7 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
     std::copy(row, row + W, line.begin());
     edt_1d(line.data(), row, W, vv.data(), z.data());
   }
-  // 3-4. The mask's cells, each row's runs as quads 1 m in front of the projector.
+  // 3-4. The mask's cells as quads 1 m in front of the projector.
   const Eigen::Matrix3d K_inv = in.K().inverse();
   const Eigen::Matrix3d R_t = R.transpose();
   auto at_pixel = [&](double u, double v) {
@@ -344,38 +346,94 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
   const double slack = std::sqrt(2.0) * cell;
   const double inner2 = (f_max * tan_a + slack) * (f_max * tan_a + slack);
   const double outer2 = (rho_max + slack) * (rho_max + slack);
+  // 3. Each row's runs of mask cells [begin, end) (rows outside the image have none).
+  std::vector<std::array<int, 2>> runs;
+  std::vector<std::size_t> row_start(std::size_t(H) + 1, 0);
   for (int j = 0; j < H; ++j) {
+    row_start[std::size_t(j)] = runs.size();
     const double vc = y0 + (j + 0.5) * cell;
     if (vc + half < -0.5 || vc - half > projector.height - 0.5) continue;  // outside the image
     const double* row = f.data() + std::size_t(j) * W;
+    // rho_at >= f_max tan(a_max) (its 1 / cos^2 >= 1): a cell within that of the mesh's image
+    // needs no rho_at, one beyond rho_max is out.
+    auto in_mask = [&](int k) {
+      const double d2 = row[k] * cell * cell;
+      if (d2 <= inner2) return true;
+      if (!(d2 <= outer2)) return false;
+      const double r = rho_at(x0 + (k + 0.5) * cell, vc) + slack;
+      return d2 <= r * r;
+    };
     int i = 0;
     while (i < W) {
-      // rho_at >= f_max tan(a_max) (its 1 / cos^2 >= 1): a cell within that of the mesh's
-      // image needs no rho_at, one beyond rho_max is out.
-      auto in_mask = [&](int k) {
-        const double d2 = row[k] * cell * cell;
-        if (d2 <= inner2) return true;
-        if (!(d2 <= outer2)) return false;
-        const double r = rho_at(x0 + (k + 0.5) * cell, vc) + slack;
-        return d2 <= r * r;
-      };
       if (!in_mask(i)) {
         ++i;
         continue;
       }
       int k = i;
       while (k < W && in_mask(k)) ++k;
-      const double u0 = std::max(x0 + i * cell - 0.5, -1.0);
-      const double u1 = std::min(x0 + k * cell + 0.5, projector.width + 0.0);
-      const double v0 = std::max(y0 + j * cell - 0.5, -1.0);
-      const double v1 = std::min(y0 + (j + 1) * cell + 0.5, projector.height + 0.0);
-      if (u1 > u0 && v1 > v0) {
-        const uint32_t q0 = at_pixel(u0, v0), q1 = at_pixel(u1, v0), q2 = at_pixel(u1, v1),
-                       q3 = at_pixel(u0, v1);
-        out.triangles.push_back({q0, q1, q2});
-        out.triangles.push_back({q0, q2, q3});
-      }
+      runs.push_back({i, k});
       i = k;
+    }
+  }
+  row_start[std::size_t(H)] = runs.size();
+  const auto row_runs = [&](int j) {
+    return std::span<const std::array<int, 2>>(runs.data() + row_start[std::size_t(j)],
+                                               runs.data() + row_start[std::size_t(j) + 1]);
+  };
+  // 4. Quads: cells [i0, i1) x [j0, j1), 0.5 px wider each side, 1 m in front of the projector.
+  const int ix0 = int(x0), iy0 = int(y0);  // integers (floored above)
+  auto quad = [&](int i0, int i1, int j0, int j1) {
+    const double u0 = std::max(x0 + i0 * cell - 0.5, -1.0);
+    const double u1 = std::min(x0 + i1 * cell + 0.5, projector.width + 0.0);
+    const double v0 = std::max(y0 + j0 * cell - 0.5, -1.0);
+    const double v1 = std::min(y0 + j1 * cell + 0.5, projector.height + 0.0);
+    if (!(u1 > u0 && v1 > v0)) return;
+    const uint32_t q0 = at_pixel(u0, v0), q1 = at_pixel(u1, v0), q2 = at_pixel(u1, v1),
+                   q3 = at_pixel(u0, v1);
+    out.triangles.push_back({q0, q1, q2});
+    out.triangles.push_back({q0, q2, q3});
+    // The pixel centres inside [u0, u1) x [v0, v1) (its edges lie half-way between centres).
+    const int xa = std::max(0, ix0 + i0 * cell), xb = std::min(projector.width, ix0 + i1 * cell + 1);
+    const int ya = std::max(0, iy0 + j0 * cell), yb = std::min(projector.height, iy0 + j1 * cell + 1);
+    if (xb > xa && yb > ya) out.image_rects->rects.push_back({xa, ya, xb, yb});
+  };
+  // Bands of rows: the columns every row of a band covers as one tall quad, each row's rest as
+  // its own (the same cells: a padded rectangle of cells is the union of its padded cells).
+  const int band = std::max(1, band_px / cell);
+  std::vector<std::array<int, 2>> common, next, rest;
+  // a \ b or a n b of two sorted, disjoint run lists.
+  const auto combine = [](std::span<const std::array<int, 2>> a,
+                          std::span<const std::array<int, 2>> b, bool intersect,
+                          std::vector<std::array<int, 2>>& into) {
+    into.clear();
+    std::size_t q = 0;
+    for (const auto& r : a) {
+      int from = r[0];
+      while (q < b.size() && b[q][1] <= from) ++q;
+      for (std::size_t p = q; p < b.size() && b[p][0] < r[1]; ++p) {
+        const int lo = std::max(from, b[p][0]), hi = std::min(r[1], b[p][1]);
+        if (intersect) {
+          into.push_back({lo, hi});
+        } else {
+          if (lo > from) into.push_back({from, lo});
+          from = hi;
+        }
+      }
+      if (!intersect && from < r[1]) into.push_back({from, r[1]});
+    }
+  };
+  for (int j0 = 0; j0 < H; j0 += band) {
+    const int j1 = std::min(H, j0 + band);
+    common.assign(row_runs(j0).begin(), row_runs(j0).end());
+    for (int j = j0 + 1; j < j1 && !common.empty(); ++j) {
+      combine(common, row_runs(j), true, next);
+      std::swap(common, next);
+    }
+    if (j1 - j0 < 2) common.clear();
+    for (const auto& r : common) quad(r[0], r[1], j0, j1);
+    for (int j = j0; j < j1; ++j) {
+      combine(row_runs(j), common, false, rest);
+      for (const auto& r : rest) quad(r[0], r[1], j, j + 1);
     }
   }
   return out;

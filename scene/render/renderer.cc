@@ -615,10 +615,16 @@ void Renderer::draw(const scene::Scene& scene, const View& view) {
 }
 
 void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, float inflate_m,
-                               const Eigen::Vector4f& colour) {
+                               const Eigen::Vector4f& colour, bool disjoint) {
   Impl& r = *impl_;
   auto it = r.actors.find(actor_id);
   if (it == r.actors.end() || it->second.index_count == 0) return;
+  if (disjoint) {  // no fold to shade twice: no depth pass (see renderer.h)
+    glDisable(GL_DEPTH_TEST);
+    r.draw_flat(it->second, view, inflate_m, colour);
+    glEnable(GL_DEPTH_TEST);
+    return;
+  }
   // Each covered pixel is shaded once, however often the mesh overlaps itself there: a grown
   // mask folds over itself many times (vertices pushed out along their normals), and with the
   // depth test off llvmpipe shades and writes every layer (a 0.3 m margin on a hull mesh: ~40x
