@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <span>
 #include <utility>
 
@@ -269,15 +270,28 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
   if (!(x1 > x0 && y1 > y0)) return out;  // the mesh's image and the projector's do not meet
   const int W = int(std::ceil((x1 - x0) / cell)), H = int(std::ceil((y1 - y0) / cell));
   if (double(W) * H > 16e6) return fail("grow mask: the outline grid would be too large");
-  std::vector<double> f(std::size_t(W) * H, INFINITY);  // 0: set (the mesh's image)
+  // The raster's cells, a byte each (1: set, the mesh's image): the triangles visit them in
+  // mesh order, all over the grid, so the smaller the grid the fewer cache misses.
+  std::vector<std::uint8_t> set(std::size_t(W) * H, 0);
   const double half = 0.5 * cell;
   auto set_point = [&](const Eigen::Vector2d& p) {
     const int i = int(std::floor((p.x() - x0) / cell)), j = int(std::floor((p.y() - y0) / cell));
-    if (i >= 0 && j >= 0 && i < W && j < H) f[std::size_t(j) * W + i] = 0;
+    if (i >= 0 && j >= 0 && i < W && j < H) set[std::size_t(j) * W + i] = 1;
   };
   // 1. Conservative raster of every triangle.
   for (const auto& tri : mesh.triangles) {
     const Eigen::Vector2d &a = px[tri[0]], &b = px[tri[1]], &c = px[tri[2]];
+    // Its cells' range; nothing to do when every cell of it is set already (most triangles of
+    // a closed mesh: the far side's lie under the near side's cells).
+    const Eigen::Vector2d tlo = a.cwiseMin(b).cwiseMin(c), thi = a.cwiseMax(b).cwiseMax(c);
+    const int i0 = std::max(0, int(std::floor((tlo.x() - x0) / cell)));
+    const int i1 = std::min(W - 1, int(std::floor((thi.x() - x0) / cell)));
+    const int j0 = std::max(0, int(std::floor((tlo.y() - y0) / cell)));
+    const int j1 = std::min(H - 1, int(std::floor((thi.y() - y0) / cell)));
+    bool open = false;
+    for (int j = j0; j <= j1 && !open; ++j)
+      for (int i = i0; i <= i1 && !open; ++i) open = set[std::size_t(j) * W + i] == 0;
+    if (!open) continue;
     const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
     const double scale = (b - a).squaredNorm() + (c - a).squaredNorm() + 1e-300;
     if (std::abs(area) <= 1e-9 * scale) {  // edge-on: its image is its edges
@@ -298,11 +312,6 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
       const Eigen::Vector2d n = sign * Eigen::Vector2d(p.y() - q.y(), q.x() - p.x());
       e[k] = {n.x(), n.y(), -n.dot(p)};
     }
-    const Eigen::Vector2d tlo = a.cwiseMin(b).cwiseMin(c), thi = a.cwiseMax(b).cwiseMax(c);
-    const int i0 = std::max(0, int(std::floor((tlo.x() - x0) / cell)));
-    const int i1 = std::min(W - 1, int(std::floor((thi.x() - x0) / cell)));
-    const int j0 = std::max(0, int(std::floor((tlo.y() - y0) / cell)));
-    const int j1 = std::min(H - 1, int(std::floor((thi.y() - y0) / cell)));
     // (The cell's slack half (|n.x| + |n.y|) folded into each edge's constant; a cell already
     // set by another triangle is not tested again: the same cells either way.)
     std::array<double, 3> slack;
@@ -310,18 +319,20 @@ Expected<ActorMesh> grow_outline(const ActorMesh& mesh, double margin_m, const C
       slack[k] = e[k].z() + half * (std::abs(e[k].x()) + std::abs(e[k].y()));
     for (int j = j0; j <= j1; ++j) {
       const double w = y0 + (j + 0.5) * cell;
-      double* row = f.data() + std::size_t(j) * W;
+      std::uint8_t* row = set.data() + std::size_t(j) * W;
       for (int i = i0; i <= i1; ++i) {
-        if (row[i] == 0) continue;
+        if (row[i]) continue;
         const double u = x0 + (i + 0.5) * cell;
         bool inside = true;
         for (int k = 0; k < 3 && inside; ++k)
           inside = e[k].x() * u + e[k].y() * w + slack[k] >= 0;
-        if (inside) row[i] = 0;
+        if (inside) row[i] = 1;
       }
     }
   }
   // 2. Squared distances (in cells) to the nearest set cell: columns, then rows.
+  std::vector<double> f(set.size());
+  for (std::size_t k = 0; k < set.size(); ++k) f[k] = set[k] ? 0.0 : INFINITY;
   const int n = std::max(W, H);
   std::vector<double> line(n), dist(n), z(n + 1);
   std::vector<int> vv(n);
