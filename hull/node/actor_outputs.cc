@@ -59,16 +59,17 @@ void ActorOutputs::actor(const SegmentSet& set, const std::string& actor_id, Fra
   m->frame = frame.frame;
   m->capture_ns = frame.capture_ns;
   m->source_frame = frame.frame;
-  // With exact crossings the normals come after the vertices moved (refine_crossings). On the
-  // node's threads, as the cut and the crossings.
-  Mesh mesh =
-      segment_marching_cubes(set, {.normals = !options_.refine, .threads = options_.threads});
+  // Normals only when published (mesh_normals); with exact crossings they come after the
+  // vertices moved (refine_crossings). On the node's threads, as the cut and the crossings.
+  const bool normals = options_.mesh_normals;
+  Mesh mesh = segment_marching_cubes(
+      set, {.normals = normals && !options_.refine, .threads = options_.threads});
   lap(d.mesh);
   if (options_.refine) {
     // Only fails on a mask of the wrong size, which the frame's cut already rejected.
-    if (auto ok = refine_crossings(mesh, set, views, cut); !ok) {
+    if (auto ok = refine_crossings(mesh, set, views, cut, normals); !ok) {
       STUDIO_LOG(warn, kLog) << "frame " << frame.frame << ": " << ok.error().message;
-      compute_normals(mesh);
+      if (normals) compute_normals(mesh);
     }
     lap(d.refine);
   }

@@ -46,6 +46,8 @@ runtime::ServiceDefinition hull_service_definition() {
       "    threads: 2              threads of the cut and of the exact crossings\n"
       "    mesh: true              publish studio/actor/mesh\n"
       "    refine: true            exact crossings on the mesh (else half-cell vertices)\n"
+      "    mesh_normals: false     publish vertex normals with the mesh (receivers that need\n"
+      "                            them compute them: the preview; the projector never does)\n"
       "    min_actor_volume: 0.01  smaller components (m^3) are noise\n"
       "    actor_prefix: actor     actor ids <prefix>0, <prefix>1, ... largest first\n"
       "    projector_masks: false  publish studio/projector/mask: for every projector of the\n"
@@ -75,6 +77,7 @@ runtime::ServiceDefinition hull_service_definition() {
         yaml::field("threads", &HullNodeOptions::threads).range(1, 64),
         yaml::field("mesh", &HullNodeOptions::mesh),
         yaml::field("refine", &HullNodeOptions::refine),
+        yaml::field("mesh_normals", &HullNodeOptions::mesh_normals),
         yaml::field("min_actor_volume", &HullNodeOptions::min_actor_volume).min(0),
         yaml::field("actor_prefix", &HullNodeOptions::actor_prefix),
         yaml::field("projector_masks", &HullNodeOptions::projector_masks),

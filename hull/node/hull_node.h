@@ -25,6 +25,9 @@
 //   refine: true              exact crossings on the mesh (hull/crossing_refine.h): vertices
 //                             between an inside and an outside column move to where the hull
 //                             really ends instead of half a cell
+//   mesh_normals: false       publish vertex normals with the mesh (the wire allows none; the
+//                             preview computes them, the projector never uses them): 25 % of
+//                             the sample and their computation off the mesh's path
 //   min_actor_volume: 0.01    components smaller than this (m^3) are noise, not actors
 //   actor_prefix: actor       actor ids are <prefix>0, <prefix>1, ... largest first
 //   projector_masks: false    per frame, for every projector of the rig, its actor mask by the
@@ -54,6 +57,7 @@ struct HullNodeOptions {
   int threads = 2;
   bool mesh = true;
   bool refine = true;
+  bool mesh_normals = false;
   double min_actor_volume = 0.01;
   std::string actor_prefix = "actor";
   bool projector_masks = false;

@@ -143,7 +143,7 @@ void HullNodeTest::masks_in_segments_and_mesh_out(bool refine) {
       "hull", "hull/studio-hull",
       {"--config",
        write_config("  box: [-1.5, 0, -1.5, 1.5, 2.2, 1.5]\n  grid: 96\n  deadline_ms: 200\n" +
-                    std::string(refine ? "" : "  refine: false\n"))});
+                    std::string(refine ? "" : "  refine: false\n  mesh_normals: true\n"))});
   ASSERT_TRUE(hull.wait_ready(20s)) << hull.log();
   ASSERT_TRUE(masks.wait_for_readers(1, 10s));
 
@@ -197,6 +197,15 @@ void HullNodeTest::masks_in_segments_and_mesh_out(bool refine) {
   EXPECT_TRUE(topo.watertight());
   EXPECT_TRUE(topo.oriented());
   EXPECT_EQ((*mesh)->source_frame, (*mesh)->frame);
+  // Normals only with mesh_normals (the refine: false run sets it): one unit vector per vertex.
+  const auto normals = wire::view((*mesh)->normals);
+  if (refine) {
+    EXPECT_TRUE(normals.empty());
+  } else {
+    ASSERT_EQ(normals.size(), v.size());
+    for (std::size_t i = 0; i + 2 < normals.size(); i += 3)
+      ASSERT_NEAR(Eigen::Vector3f(normals[i], normals[i + 1], normals[i + 2]).norm(), 1.0f, 1e-3f);
+  }
 
   // refine: true (the default): the published mesh is the actor's segment marching cubes mesh
   // with exact crossings; refine: false: the half-cell one.

@@ -73,7 +73,7 @@ bool inside_runs(const Eigen::Vector3d& h0, const Eigen::Vector3d& h1, const Run
 }  // namespace
 
 Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<const View> views,
-                                const CutOptions& options) {
+                                const CutOptions& options, bool normals) {
   if (auto ok = options.validate(); !ok) return ok;
   const GridSpec& g = set.grid();
   const int ua = g.u(), va = g.v(), aa = g.a();
@@ -171,7 +171,10 @@ Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<con
       pool.emplace_back(refine_range, n * w / workers, n * (w + 1) / workers);
     refine_range(0, n / workers);
   }
-  compute_normals(mesh);
+  if (normals)
+    compute_normals(mesh);
+  else
+    mesh.normals.clear();
   return {};
 }
 

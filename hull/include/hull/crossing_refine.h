@@ -33,7 +33,9 @@ namespace studio::hull {
 // `mesh` must come from segment_marching_cubes(set); `views` are the silhouettes that cut `set`.
 // Fails (mesh untouched) on a mask whose size differs from its camera. Vertices are independent:
 // options.threads workers share them (the result does not depend on the thread count).
+// `normals`: the vertex normals recomputed for the moved vertices; false: mesh.normals cleared
+// (a caller that does not publish them).
 Expected<void> refine_crossings(Mesh& mesh, const SegmentSet& set, std::span<const View> views,
-                                const CutOptions& options = {});
+                                const CutOptions& options = {}, bool normals = true);
 
 }  // namespace studio::hull
