@@ -92,7 +92,7 @@ TEST(SimFrameSource, ALateConsumerGetsEveryFrameTheBuffersHold) {
     EXPECT_EQ(last - (**first).frame, 12 + st.drops);  // every frame delivered or counted
     return st.drops;
   };
-  EXPECT_GE(SimSourceOptions{}.buffer_frames, 8);  // the default rides out 7 periods
+  EXPECT_GE(SimSourceOptions{}.buffer_frames, 16);  // the default rides out 15 periods
   // 5 periods (100 ms at 50 fps) behind: 8 buffers hold them (one period of slack for a loaded
   // machine's late wake-up).
   EXPECT_EQ(run(8, 100ms), 0u);

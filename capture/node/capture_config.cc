@@ -40,7 +40,7 @@ const char kConfigHelp[] =
     "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true,\n"
     "               frame_code: false, stamp: false, offset_us: 0, jitter_us: 0, drop_every: 0,\n"
     "               readout_us: -1, motion: sequence, swing_peak_speed: 1.5,\n"
-    "               costume: plain, buffers: 8}\n"
+    "               costume: plain, buffers: 16}\n"
     "                                    readout_us: exposure instant -> frame on the host (the\n"
     "                                    rest of the exposure, read-out, transfer); -1 (default):\n"
     "                                    a GigE camera's, half the exposure + 8 bits a pixel at\n"
@@ -53,7 +53,7 @@ const char kConfigHelp[] =
     "                                    offset/jitter/drop_every: a real camera's imperfections\n"
     "                                    buffers: frames the camera holds for a late consumer\n"
     "                                    (older ones are lost, counted as drops), as an aravis\n"
-    "                                    source's buffers (default 8: a 280 ms stall at 25 fps)\n"
+    "                                    source's buffers (default 16: a 600 ms stall at 25 fps)\n"
     "                                    frame_code: the actor wears the frame number (preview tests)\n"
     "                                    costume: plain (evenly coloured clothing) or patterned\n"
     "                                    (a fixed pattern on the clothing's surface, the same from\n"
@@ -61,7 +61,7 @@ const char kConfigHelp[] =
     "                                    every camera of a studio must give the same\n"
     "      source: {type: files, path: DIR, fps: 25, loop: false, paced: true}\n"
     "      source: {type: aravis, device: ID, pixel_format: BayerRG8, width: W, height: H,\n"
-    "               fps: 25, trigger: free_run|software|line, line: Line0, buffers: 8,\n"
+    "               fps: 25, trigger: free_run|software|line, line: Line0, buffers: 16,\n"
     "               interfaces: [GigEVision, USB3Vision], clock_trigger: true,\n"
     "               camera_time: true}\n";
 

@@ -53,9 +53,11 @@ struct SimSourceOptions {
   sim::StudioOptions studio;  // the scene (actor motion, realism knobs); threads forced to 1
   FrameClock clock;
   bool paced = true;
-  // 1 .. 64. 8, as an Aravis stream's default pool (aravis_source.h `buffers`): a consumer held up
-  // for up to 7 frame periods (280 ms at 25 fps: a host stall) catches up with every frame.
-  int buffer_frames = 8;
+  // 1 .. 64. 16, as an Aravis stream's default pool (aravis_source.h `buffers`): a consumer held
+  // up for up to 15 frame periods (600 ms at 25 fps: a host stall) catches up with every frame.
+  // 8 lost 31 masks of a 0.5 s stall of the six capture servers in the demo (BENCHMARKS.md,
+  // demo, session 19); a take recorded through such a stall keeps every frame.
+  int buffer_frames = 16;
   double gain_db = 0;
   double exposure_us = 10000;
   double nominal_exposure_us = 10000;  // exposure at which the image has its natural brightness
