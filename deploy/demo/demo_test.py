@@ -35,7 +35,7 @@ import time
 # screen of its own, and the projector real-time at its unit's FIFO 55 (the scene thread
 # time-sharing), the studio keeps the rate and the latency bound with it. 60 s runs of session 19
 # (BENCHMARKS.md, demo, 2026-11-29): 25.0 meshes/s reach the projector, motion to photon
-# p50 / p99 22-25 / 29-36 ms, lit_actor_px 0; this test's 15 s run: 25.0, p50 / p99 23.3 / 30.5 ms.
+# p50 / p99 22-25 / 29-36 ms, lit_actor_px 0; this test's 15 s run: 25.0, p50 / p99 24.1 / 33.3 ms.
 # STUDIO_DEMO_TEST_PROJECTORS=0 (or --projectors 0) runs it without, the headline latency then
 # capture -> mesh and head delivered.
 PROJECTORS = 1
