@@ -444,6 +444,25 @@ int values_differing(const FrameRenderer& fr, Readback& a, Readback& b) {
   return cv::countNonZero(diff.reshape(1));
 }
 
+// The studio's back-wall projector and the demo's default scene (its assets in `cache`).
+struct BackWall {
+  projector::ProjectorView view =
+      projector::ProjectorView::create(projector::testing::studio_projectors()[0]).value();
+  scene_assets::AssetCache cache;
+  Expected<scene::Scene> scene = default_scene(cache);
+};
+
+// A renderer of `form` for the back wall, the scene's assets uploaded.
+Expected<FrameRenderer> back_wall_renderer(const BackWall& b, Form form) {
+  FrameRendererOptions fo;
+  fo.form = form;
+  auto fr = FrameRenderer::create(b.view, fo);
+  if (!fr) return fr;
+  for (const auto& [path, a] : b.cache.all())
+    if (auto ok = fr->renderer().upload(*a); !ok) return std::unexpected(ok.error());
+  return fr;
+}
+
 }  // namespace
 
 // Late latching (FrameRenderer::prepare + draw_masks): the scene drawn ahead and the masks put
@@ -451,19 +470,14 @@ int values_differing(const FrameRenderer& fr, Readback& a, Readback& b) {
 // cache's layered path too. Control: the mask is in the frame.
 TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
   (void)context();
-  const Projector p = projector::testing::studio_projectors()[0];
-  auto view = projector::ProjectorView::create(p).value();
-  scene_assets::AssetCache cache;
-  auto scene = default_scene(cache);
+  const BackWall b;
+  const auto& scene = b.scene;
   ASSERT_TRUE(scene) << scene.error().message;
   const std::vector<projector::ActorMesh> masks{box_mask()};
   const scene::Scene empty(scene->options());
   for (const Form form : {Form::single_pass, Form::two_pass}) {
-    FrameRendererOptions fo;
-    fo.form = form;
-    auto fr = FrameRenderer::create(view, fo);
+    auto fr = back_wall_renderer(b, form);
     ASSERT_TRUE(fr) << fr.error().message;
-    for (const auto& [path, a] : cache.all()) ASSERT_TRUE(fr->renderer().upload(*a));
     for (const bool layered : {false, true}) {
       const Eigen::Vector3d eye(0.1, 1.65, 1.2);
       const LayeredScene layers{*scene, 7, &empty};
@@ -498,34 +512,28 @@ TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
 // renderer draws (both forms; the scene's frame read-back is bottom row first both ways).
 TEST(FrameRenderer, SceneFromAnotherScreenThenMasksIsTheRenderedFrame) {
   (void)context();
-  const Projector p = projector::testing::studio_projectors()[0];
-  auto view = projector::ProjectorView::create(p).value();
-  scene_assets::AssetCache cache;
-  auto scene = default_scene(cache);
+  const BackWall b;
+  const auto& scene = b.scene;
   ASSERT_TRUE(scene) << scene.error().message;
   const std::vector<projector::ActorMesh> masks{box_mask()};
   const Eigen::Vector3d eye(0.1, 1.65, 1.2);
   auto own = scene_render::HeadlessContext::create(scene_render::EglScreen::own);
   ASSERT_TRUE(own) << own.error().message;
   for (const Form form : {Form::single_pass, Form::two_pass}) {
-    FrameRendererOptions fo;
-    fo.form = form;
     // The scene's renderer, on its own screen (each renderer is destroyed with its context
     // current).
     std::vector<std::uint8_t> image;
     {
       ASSERT_TRUE(own->make_current());
-      auto scene_fr = FrameRenderer::create(view, fo);
+      auto scene_fr = back_wall_renderer(b, form);
       ASSERT_TRUE(scene_fr) << scene_fr.error().message;
-      for (const auto& [path, a] : cache.all()) ASSERT_TRUE(scene_fr->renderer().upload(*a));
       ASSERT_TRUE(scene_fr->prepare(*scene, eye));
       scene_fr->read_image(image);
     }
     // The frame's renderer, on the shared display: the reference frame, then the loaded one.
     ASSERT_TRUE(context().make_current());
-    auto fr = FrameRenderer::create(view, fo);
+    auto fr = back_wall_renderer(b, form);
     ASSERT_TRUE(fr) << fr.error().message;
-    for (const auto& [path, a] : cache.all()) ASSERT_TRUE(fr->renderer().upload(*a));
     Readback want, got;
     ASSERT_TRUE(fr->render(*scene, eye, masks));
     fr->finish();
@@ -554,27 +562,22 @@ TEST(FrameRenderer, SceneFromAnotherScreenThenMasksIsTheRenderedFrame) {
 // scene lit.
 TEST(FrameRenderer, OutlineRectanglesClearedAreTheQuadsRasterised) {
   (void)context();
-  const Projector p = projector::testing::studio_projectors()[0];
-  auto view = projector::ProjectorView::create(p).value();
-  scene_assets::AssetCache cache;
-  auto scene = default_scene(cache);
+  const BackWall b;
+  const auto& scene = b.scene;
   ASSERT_TRUE(scene) << scene.error().message;
   const projector::ActorMesh actor = projector::testing::merge(
       box_mask(), projector::testing::sphere({0.6, 1.2, -0.5}, 0.25, Eigen::Matrix3d::Identity()));
   const Eigen::Vector3d eye(0.1, 1.65, 1.2);
   for (const Form form : {Form::single_pass, Form::two_pass}) {
-    FrameRendererOptions fo;
-    fo.form = form;
-    auto fr = FrameRenderer::create(view, fo);
+    auto fr = back_wall_renderer(b, form);
     ASSERT_TRUE(fr) << fr.error().message;
-    for (const auto& [path, a] : cache.all()) ASSERT_TRUE(fr->renderer().upload(*a));
     Readback bare;
     ASSERT_TRUE(fr->render(*scene, eye, {}));
     fr->finish();
     fr->read(bare, true);
     for (const double margin : {0.03, 0.13, 0.2}) {
       for (const int band : {16, 0}) {
-        auto outline = projector::grow_outline(actor, margin, view.camera(), 2, band);
+        auto outline = projector::grow_outline(actor, margin, b.view.camera(), 2, band);
         ASSERT_TRUE(outline) << outline.error().message;
         ASSERT_TRUE(outline->image_rects);
         std::vector<projector::ActorMesh> cleared{*outline}, quads{*outline}, flat{*outline};

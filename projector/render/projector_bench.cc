@@ -39,6 +39,7 @@
 #include <benchmark/benchmark.h>
 
 #include <numbers>
+#include <optional>
 #include <opencv2/imgproc.hpp>
 #include <set>
 
@@ -291,6 +292,26 @@ void BM_SinglePassCacheMiss_720p(benchmark::State& s) {
 void BM_SinglePassHold(benchmark::State& s) { run(s, Work::single_pass_hold); }
 void BM_TwoPassHold(benchmark::State& s) { run(s, Work::two_pass_hold); }
 void BM_SinglePassHold_720p(benchmark::State& s) { run(s, Work::single_pass_hold, true); }
+// The hull's arm-swing mesh (testing/hull_meshes.h), made once.
+const projector::ActorMesh& arm_swing_hull() {
+  static const projector::ActorMesh hull =
+      projector::testing::hull_meshes(sim::Motion::arm_swing, 60, 1).front();
+  return hull;
+}
+
+// A frame renderer for `view` with the default scene's assets uploaded; nullopt (the benchmark
+// skipped with the error) when it cannot be made.
+std::optional<FrameRenderer> renderer_720p(benchmark::State& state, Fixture& f,
+                                           const projector::ProjectorView& view) {
+  auto fr = FrameRenderer::create(view, {});
+  if (!fr) {
+    state.SkipWithError(fr.error().message.c_str());
+    return std::nullopt;
+  }
+  for (const auto& [p, a] : f.cache.all()) (void)fr->renderer().upload(*a);
+  return std::move(*fr);
+}
+
 // The mask of a live-like hull mesh (the arm swing's, testing/hull_meshes.h, ~38k triangles)
 // simplified by GrowOptions max_triangles (arg 0) and cluster_factor (arg 1), as the late-latched
 // node draws it per frame at 720p: grown by arg 2 mm (+ the simplification's error; 200: the
@@ -302,15 +323,10 @@ void BM_SinglePassHold_720p(benchmark::State& s) { run(s, Work::single_pass_hold
 // the simplification's error (added to the margin) and the pixels blacked out.
 void BM_HullMask_720p(benchmark::State& state) {
   Fixture& f = fixture();
-  static const projector::ActorMesh hull =
-      projector::testing::hull_meshes(sim::Motion::arm_swing, 60, 1).front();
+  const projector::ActorMesh& hull = arm_swing_hull();
   auto view = projector::ProjectorView::create(at_720p(f.projector));
-  auto fr = FrameRenderer::create(*view, {});
-  if (!fr) {
-    state.SkipWithError(fr.error().message.c_str());
-    return;
-  }
-  for (const auto& [p, a] : f.cache.all()) (void)fr->renderer().upload(*a);
+  auto fr = renderer_720p(state, f, *view);
+  if (!fr) return;
   projector::GrowOptions o;
   o.max_triangles = std::size_t(state.range(0));
   o.cluster_factor = std::size_t(state.range(1));
@@ -343,15 +359,10 @@ void BM_HullMask_720p(benchmark::State& state) {
 // (draw_masks + finish); blackout_px of the last frame (read back outside the timing).
 void BM_SceneImageFrame_720p(benchmark::State& state) {
   Fixture& f = fixture();
-  static const projector::ActorMesh hull =
-      projector::testing::hull_meshes(sim::Motion::arm_swing, 60, 1).front();
+  const projector::ActorMesh& hull = arm_swing_hull();
   auto view = projector::ProjectorView::create(at_720p(f.projector));
-  auto fr = FrameRenderer::create(*view, {});
-  if (!fr) {
-    state.SkipWithError(fr.error().message.c_str());
-    return;
-  }
-  for (const auto& [p, a] : f.cache.all()) (void)fr->renderer().upload(*a);
+  auto fr = renderer_720p(state, f, *view);
+  if (!fr) return;
   if (!fr->render(f.scene, kEye, {})) state.SkipWithError("render failed");
   fr->finish();
   std::vector<std::uint8_t> image;
