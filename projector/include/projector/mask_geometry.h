@@ -107,10 +107,11 @@ Expected<ActorMesh> grow_mask(const MaskBase& base, double margin_m,
 //   4. the mask cells become quads (0.5 px wider each side), placed 1 m in front of the
 //      projector on the rays of their corners, so drawn from the projector they cover exactly
 //      those pixels: in bands of about `band_px` pixel rows, the columns every row of the band
-//      covers as one tall quad and each row's rest as its own (0: every row's runs alone). The
-//      quads overlap at most along 1-px seams (ActorMesh::disjoint). A row of 2-4 px cuts
-//      every 4 x 4 block it touches, the rasteriser's slow path: bands fill the inside in whole
-//      blocks (projector_bench SceneImageFrame_720p; the same pixels either way).
+//      covers as one tall quad and each row's rest as its own (0: every row's runs alone); the
+//      quads overlap at most along 1-px seams. The pixels they cover, as rectangles, are
+//      ActorMesh::image_rects: FrameRenderer clears those instead of rasterising the quads
+//      (quads 2-4 px tall put every 4 x 4 block they touch on llvmpipe's slow path; bands
+//      halve their number). The same pixels either way (projector_bench SceneImageFrame_720p).
 // Every pixel within rho of the mesh's projection is covered, so the actor grown by the margin
 // is; the black reaches at most rho + ~2 cells beyond the outline where the vertex push reaches
 // margin / cosine along averaged normals (up to 3.3 x the margin: spikes). Errors: invalid

@@ -111,10 +111,11 @@ class Renderer {
   // moved `inflate_m` metres along its normal (the security margin). The colour's alpha is
   // written too (draw() writes alpha 1): a mask drawn with alpha 0 can be told from black scene
   // pixels in the read-back. `disjoint`: the caller knows the mesh's triangles do not overlap
-  // in the view (the projector's outline mask: a row's runs as quads), so each pixel is shaded
-  // once without the depth pass: depth is neither cleared, tested nor written (the clear alone,
-  // ~1 ms of a 1280x720 frame on llvmpipe, cost more than the ~57k px of a mask;
-  // projector_bench SceneImageFrame_720p).
+  // in the view beyond seams (the projector's outline mask: runs of pixels as quads), so each
+  // pixel is shaded about once without the depth pass, and with one flat colour and no
+  // blending a seam shaded twice looks the same: depth is neither cleared, tested nor written
+  // (the clear alone, ~1 ms of a 1280x720 frame on llvmpipe, cost more than the ~57k px of a
+  // mask; projector_bench SceneImageFrame_720p).
   void draw_actor_flat(const std::string& actor_id, const View& view, float inflate_m = 0.0f,
                        const Eigen::Vector4f& colour = Eigen::Vector4f(0, 0, 0, 1),
                        bool disjoint = false);
