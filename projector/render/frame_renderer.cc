@@ -152,6 +152,8 @@ struct FrameRenderer::Impl {
                              const scene::Scene* moving, const Eigen::Vector3d& eye,
                              std::span<const projector::ActorMesh> masks, bool cache);
   int draw_masks(std::span<const projector::ActorMesh> masks);
+  // The target's RGBA as GL gives it (bottom row first), into `out` (resized).
+  void read_pixels(std::vector<std::uint8_t>& out);
 };
 
 FrameRenderer::FrameRenderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -459,14 +461,15 @@ double FrameRenderer::cache_allowed_move_m(const Eigen::Vector3d& eye) const {
 
 void FrameRenderer::finish() { glFinish(); }
 
-void FrameRenderer::read_image(std::vector<std::uint8_t>& rgba) {
-  Impl& r = *impl_;
-  const int w = r.target.width(), h = r.target.height();
-  rgba.resize(std::size_t(w) * h * 4);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, r.target.framebuffer());
+void FrameRenderer::Impl::read_pixels(std::vector<std::uint8_t>& out) {
+  const int w = target.width(), h = target.height();
+  out.resize(std::size_t(w) * h * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, target.framebuffer());
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, out.data());
 }
+
+void FrameRenderer::read_image(std::vector<std::uint8_t>& rgba) { impl_->read_pixels(rgba); }
 
 bool FrameRenderer::load_image(std::span<const std::uint8_t> rgba) {
   Impl& r = *impl_;
@@ -486,10 +489,7 @@ void FrameRenderer::read(Readback& out, bool keep_rgba) {
   // GL's rows as they come (bottom first): the blackout runs are taken bottom-up and only the
   // thumbnail (and a kept frame) is flipped, instead of swapping 2 x 3.7 MB of rows of a 720p
   // frame into image order first (RenderTarget::read_rgba).
-  r.rgba.resize(std::size_t(w) * h * 4);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, r.target.framebuffer());
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, r.rgba.data());
+  r.read_pixels(r.rgba);
   out.blackout = blackout_rows(r.rgba, w, h, true);
   out.thumb_width = r.options.thumb_width;
   out.thumb_height = r.options.thumb_height;
