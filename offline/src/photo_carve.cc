@@ -1,6 +1,7 @@
 #include "offline/photo_carve.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -148,6 +149,10 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
   std::vector<Surface> surface;
   std::vector<uint8_t> carve_flag;
   std::vector<DepthBuffer> buffers(cams.size());
+  // Each voxel's unnormalised outward normal (below), kept between iterations: it changes only
+  // when a voxel of its 5x5x5 neighbourhood was carved (|component| <= 75).
+  std::vector<std::array<int8_t, 3>> normal_cache(L.size());
+  std::vector<uint8_t> normal_valid(L.size(), 0);
   const double tol = options.depth_tolerance * L.dt;
   for (int iter = 0; iter < options.max_iterations; ++iter) {
     surface.clear();
@@ -178,16 +183,22 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         const Surface& s = surface[n];
         if (depth[s.x] > max_depth) continue;
         // Outward normal: away from the occupied voxels of the 5x5x5 neighbourhood.
-        Eigen::Vector3d normal_l = Eigen::Vector3d::Zero();
-        for (int dj = -2; dj <= 2; ++dj)
-          for (int di = -2; di <= 2; ++di)
-            for (int dk = -2; dk <= 2; ++dk) {
-              const int ii = s.ii + di, jj = s.jj + dj, k = s.k + dk;
-              if (ii < 0 || jj < 0 || k < 0 || ii >= L.ni || jj >= L.nj || k >= L.nk ||
-                  !occ[L.index(ii, jj, k)]) {
-                normal_l += Eigen::Vector3d(di, dj, dk);
+        if (!normal_valid[s.x]) {
+          int sum[3] = {0, 0, 0};
+          for (int dj = -2; dj <= 2; ++dj)
+            for (int di = -2; di <= 2; ++di)
+              for (int dk = -2; dk <= 2; ++dk) {
+                const int ii = s.ii + di, jj = s.jj + dj, k = s.k + dk;
+                if (ii < 0 || jj < 0 || k < 0 || ii >= L.ni || jj >= L.nj || k >= L.nk ||
+                    !occ[L.index(ii, jj, k)]) {
+                  sum[0] += di, sum[1] += dj, sum[2] += dk;
+                }
               }
-            }
+          normal_cache[s.x] = {int8_t(sum[0]), int8_t(sum[1]), int8_t(sum[2])};
+          normal_valid[s.x] = 1;
+        }
+        const auto& nc = normal_cache[s.x];
+        const Eigen::Vector3d normal_l(nc[0], nc[1], nc[2]);
         if (normal_l.squaredNorm() == 0) continue;
         Eigen::Vector3d normal = Eigen::Vector3d::Zero();
         normal[g.u()] = normal_l.x(), normal[g.v()] = normal_l.y(), normal[g.a()] = normal_l.z();
@@ -254,8 +265,13 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
     std::size_t carved = 0;
     for (std::size_t n = 0; n < surface.size(); ++n) {
       if (carve_flag[n]) {
-        occ[surface[n].x] = kEmpty;
+        const Surface& s = surface[n];
+        occ[s.x] = kEmpty;
         ++carved;
+        for (int jj = std::max(0, s.jj - 2); jj <= std::min(L.nj - 1, s.jj + 2); ++jj)
+          for (int ii = std::max(0, s.ii - 2); ii <= std::min(L.ni - 1, s.ii + 2); ++ii)
+            for (int k = std::max(0, s.k - 2); k <= std::min(L.nk - 1, s.k + 2); ++k)
+              normal_valid[L.index(ii, jj, k)] = 0;
       }
     }
     result.iterations = iter + 1;

@@ -288,7 +288,8 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
             const Camera& cam = *views[c].camera;
             if (std::abs(normals[n].dot((cams[c].centre - x).normalized())) > o.rim_cos) continue;
             Eigen::Vector2d p;
-            if (!cam.project(x, &p)) continue;
+            Eigen::Vector3d xc;
+            if (!cams[c].project(x, &p, &xc)) continue;
             const int px = int(std::lround(p.x())), py = int(std::lround(p.y()));
             if (px < 1 || py < 1 || px + 1 >= cam.width || py + 1 >= cam.height) continue;
             int inside = 0;
@@ -297,8 +298,7 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
             if (inside > 0 && inside < 9) {
               anchored[n] = 1;
               if (o.rim_band_cells > 0) {
-                facet[n] = {uint32_t(c), int32_t(px), int32_t(py),
-                            float((cams[c].R * x + cams[c].t).z())};
+                facet[n] = {uint32_t(c), int32_t(px), int32_t(py), float(xc.z())};
               }
             }
           }
@@ -330,19 +330,14 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
     }
     // For inside_hull: the cameras (bit c) whose silhouette contains x's projection (nearest
     // pixel), and whether x is inside all of the silhouettes `bits` (stops at the first miss).
-    // (Camera::project with the view's rotation matrix, and the masks as dense bytes: the test
-    // runs ~20 times per vertex and step.)
+    // (SampledView::project, and the masks as dense bytes: the test runs ~20 times per vertex
+    // and step.)
     std::vector<Mask> dense(o.inside_hull ? views.size() : 0);
     for (std::size_t c = 0; c < dense.size(); ++c) dense[c] = views[c].mask->to_mask();
     const auto in_silhouette = [&](std::size_t c, const Eigen::Vector3f& x) {
-      const Eigen::Vector3d xc = cams[c].R * x.cast<double>() + cams[c].t;
-      if (!(xc.z() > 0)) return false;
-      const Camera& cam = *views[c].camera;
-      const Eigen::Vector2d n =
-          distort(cam.distortion, Eigen::Vector2d(xc.x() / xc.z(), xc.y() / xc.z()));
-      const Intrinsics& k = cam.intrinsics;
-      const long px = std::lround(k.fx * n.x() + k.skew * n.y() + k.cx);
-      const long py = std::lround(k.fy * n.y() + k.cy);
+      Eigen::Vector2d p;
+      if (!cams[c].project(x.cast<double>(), &p)) return false;
+      const long px = std::lround(p.x()), py = std::lround(p.y());
       return px >= 0 && py >= 0 && px < dense[c].width() && py < dense[c].height() &&
              dense[c](int(px), int(py)) != 0;
     };

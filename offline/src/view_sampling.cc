@@ -26,6 +26,8 @@ Expected<std::vector<SampledView>> prepare_views(std::span<const ColourView> vie
     v.R = cam.cam_from_world.R();
     v.t = cam.cam_from_world.translation;
     v.centre = cam.centre_in_world();
+    v.k = cam.intrinsics;
+    v.pinhole = cam.distortion.is_identity();
     v.image = cv.image;
     const int W = cam.width, H = cam.height, m = edge_margin_px;
     std::vector<uint8_t> in(std::size_t(W) * H, 0), tmp(std::size_t(W) * H, 0);
@@ -34,10 +36,10 @@ Expected<std::vector<SampledView>> prepare_views(std::span<const ColourView> vie
         std::fill(in.begin() + std::size_t(y) * W + r.begin,
                   in.begin() + std::size_t(y) * W + r.end, 1);
     // Erosion by a (2m+1)^2 square, separable: rows, then columns.
+    std::vector<int> left(W), up(H);
     for (int y = 0; y < H; ++y) {
       const uint8_t* row = &in[std::size_t(y) * W];
       int run = 0;  // inside pixels ending at x
-      std::vector<int> left(W);
       for (int x = 0; x < W; ++x) left[x] = run = row[x] ? run + 1 : 0;
       int right = 0;
       for (int x = W - 1; x >= 0; --x) {
@@ -48,7 +50,6 @@ Expected<std::vector<SampledView>> prepare_views(std::span<const ColourView> vie
     v.interior.assign(std::size_t(W) * H, 0);
     for (int x = 0; x < W; ++x) {
       int run = 0;
-      std::vector<int> up(H);
       for (int y = 0; y < H; ++y) up[y] = run = tmp[std::size_t(y) * W + x] ? run + 1 : 0;
       int down = 0;
       for (int y = H - 1; y >= 0; --y) {
@@ -62,21 +63,36 @@ Expected<std::vector<SampledView>> prepare_views(std::span<const ColourView> vie
 }
 
 void DepthBuffer::reset(const SampledView& v) {
-  width_ = v.camera->width, height_ = v.camera->height;
-  depth_.assign(std::size_t(width_) * height_, std::numeric_limits<float>::infinity());
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  if (width_ == v.camera->width && height_ == v.camera->height &&
+      depth_.size() == std::size_t(width_) * std::size_t(height_)) {
+    // Only the rows and columns drawn since the last reset (the carve resets every iteration).
+    for (int y = dirty_y0_; y <= dirty_y1_; ++y)
+      std::fill_n(&depth_[std::size_t(y) * width_ + dirty_x0_], dirty_x1_ - dirty_x0_ + 1, inf);
+  } else {
+    width_ = v.camera->width, height_ = v.camera->height;
+    depth_.assign(std::size_t(width_) * height_, inf);
+  }
+  dirty_x0_ = width_, dirty_y0_ = height_, dirty_x1_ = -1, dirty_y1_ = -1;
+}
+
+void DepthBuffer::mark(int x0, int y0, int x1, int y1) {
+  dirty_x0_ = std::min(dirty_x0_, x0), dirty_y0_ = std::min(dirty_y0_, y0);
+  dirty_x1_ = std::max(dirty_x1_, x1), dirty_y1_ = std::max(dirty_y1_, y1);
 }
 
 void DepthBuffer::splat(const SampledView& v, const Eigen::Vector3d& x, double size) {
-  const Eigen::Vector3d xc = v.R * x + v.t;
-  if (!(xc.z() > 0)) return;
+  Eigen::Vector3d xc;
   Eigen::Vector2d p;
-  if (!v.camera->project(x, &p)) return;
-  const double r = 0.5 * size * std::max(v.camera->intrinsics.fx, v.camera->intrinsics.fy) / xc.z();
+  if (!v.project(x, &p, &xc)) return;
+  const double r = 0.5 * size * std::max(v.k.fx, v.k.fy) / xc.z();
   const int x0 = std::max(0, int(std::ceil(p.x() - r))),
             x1 = std::min(width_ - 1, int(std::floor(p.x() + r)));
   const int y0 = std::max(0, int(std::ceil(p.y() - r))),
             y1 = std::min(height_ - 1, int(std::floor(p.y() + r)));
   const float z = float(xc.z());
+  if (x0 > x1 || y0 > y1) return;
+  mark(x0, y0, x1, y1);
   for (int y = y0; y <= y1; ++y) {
     float* row = &depth_[std::size_t(y) * width_];
     for (int xx = x0; xx <= x1; ++xx) row[xx] = std::min(row[xx], z);
@@ -89,8 +105,9 @@ void DepthBuffer::triangle(const SampledView& v, const Eigen::Vector3d& a, const
   double z[3];
   const Eigen::Vector3d* w[3] = {&a, &b, &c};
   for (int k = 0; k < 3; ++k) {
-    z[k] = (v.R * *w[k] + v.t).z();
-    if (!(z[k] > 0) || !v.camera->project(*w[k], &p[k])) return;
+    Eigen::Vector3d xc;
+    if (!v.project(*w[k], &p[k], &xc)) return;
+    z[k] = xc.z();
   }
   const double area = (p[1] - p[0]).x() * (p[2] - p[0]).y() - (p[1] - p[0]).y() * (p[2] - p[0]).x();
   if (std::abs(area) < 1e-12) return;
@@ -98,6 +115,8 @@ void DepthBuffer::triangle(const SampledView& v, const Eigen::Vector3d& a, const
   const int x1 = std::min(width_ - 1, int(std::floor(std::max({p[0].x(), p[1].x(), p[2].x()}))));
   const int y0 = std::max(0, int(std::ceil(std::min({p[0].y(), p[1].y(), p[2].y()}))));
   const int y1 = std::min(height_ - 1, int(std::floor(std::max({p[0].y(), p[1].y(), p[2].y()}))));
+  if (x0 > x1 || y0 > y1) return;
+  mark(x0, y0, x1, y1);
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
       const Eigen::Vector2d q(x, y);
@@ -118,10 +137,9 @@ std::optional<Observation> observe(const SampledView& v, const DepthBuffer& dept
   const Eigen::Vector3d to_cam = (v.centre - x).normalized();
   const double cos = n.dot(to_cam);
   if (cos < min_cos) return std::nullopt;
-  const Eigen::Vector3d xc = v.R * x + v.t;
-  if (!(xc.z() > 0)) return std::nullopt;
+  Eigen::Vector3d xc;
   Eigen::Vector2d p;
-  if (!v.camera->project(x, &p)) return std::nullopt;
+  if (!v.project(x, &p, &xc)) return std::nullopt;
   const int W = v.camera->width, H = v.camera->height;
   const int xn = int(std::lround(p.x())), yn = int(std::lround(p.y()));
   if (xn < 0 || yn < 0 || xn >= W || yn >= H) return std::nullopt;
@@ -164,10 +182,20 @@ std::vector<float> observe_patch(const SampledView& v, const DepthBuffer& depth,
   const Eigen::Vector3d t2 = n.cross(t1);
   const int W = v.camera->width, H = v.camera->height;
   out.reserve(std::size_t((2 * h + 1) * (2 * h + 1)));
+  // The lattice in the camera frame is affine in (i, j): its centre and two steps, rotated once
+  // (without distortion; else each point through the full projection).
+  const Eigen::Vector3d c0 = v.R * x + v.t, ci = v.R * (spacing * t1), cj = v.R * (spacing * t2);
   for (int j = -h; j <= h; ++j) {
     for (int i = -h; i <= h; ++i) {
       Eigen::Vector2d p;
-      if (!v.camera->project(x + spacing * (i * t1 + j * t2), &p)) return {};
+      if (v.pinhole) {
+        const Eigen::Vector3d xc = c0 + double(i) * ci + double(j) * cj;
+        if (!(xc.z() > 0)) return {};
+        const double u = xc.x() / xc.z(), w = xc.y() / xc.z();
+        p = Eigen::Vector2d(v.k.fx * u + v.k.skew * w + v.k.cx, v.k.fy * w + v.k.cy);
+      } else if (!v.project(x + spacing * (i * t1 + j * t2), &p)) {
+        return {};
+      }
       const int x0 = int(std::floor(p.x())), y0 = int(std::floor(p.y()));
       if (x0 < 0 || y0 < 0 || x0 + 1 >= W || y0 + 1 >= H) return {};
       if (!v.inside(x0, y0) || !v.inside(x0 + 1, y0) || !v.inside(x0, y0 + 1) ||
