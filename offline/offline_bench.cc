@@ -70,7 +70,7 @@ void BM_Frame(benchmark::State& state) {
   const Scene& s = Scene::get();
   const int mode = int(state.range(1));
   double t_hull = 0, t_carve = 0, t_mesh = 0, t_surface = 0, t_texture = 0, t_encode = 0;
-  double carve_iterations = 0;
+  double carve_iterations = 0, carve_judged = 0;
   const bool textured = mode == 2 || mode == 4;
   // Thread CPU time (every stage runs on this thread with the default threads = 1): figures
   // under the shared machine's load stay comparable.
@@ -91,6 +91,7 @@ void BM_Frame(benchmark::State& state) {
       const CarveResult carved = photo_carve(set, s.views).value();
       t_carve += ms(t0);
       carve_iterations += carved.iterations;
+      carve_judged += double(carved.judged);
       t0 = ThreadClock::now();
       mesh = refined_mesh(carved.set, set, s.views).value();
       t_mesh += ms(t0);
@@ -117,7 +118,10 @@ void BM_Frame(benchmark::State& state) {
   const double n = double(state.iterations());
   state.counters["cut_ms"] = t_hull / n;
   state.counters["carve_ms"] = t_carve / n;
-  if (mode != 0) state.counters["carve_iterations"] = carve_iterations / n;
+  if (mode != 0) {
+    state.counters["carve_iterations"] = carve_iterations / n;
+    state.counters["carve_judged"] = carve_judged / n;  // surface voxels judged, all iterations
+  }
   state.counters["mesh_ms"] = t_mesh / n;
   state.counters["surface_ms"] = t_surface / n;
   state.counters["texture_ms"] = t_texture / n;

@@ -32,6 +32,29 @@ enum : uint8_t { kEmpty = 0, kFull = 1 };
 
 using detail::parallel_for;
 
+// Where one camera's depth buffer changed between two iterations, over the rectangle either
+// buffer drew in (elsewhere both are empty).
+class ChangeMap {
+ public:
+  void build(const DepthBuffer& now, const DepthBuffer& before) {
+    const DepthBuffer::Rect a = now.drawn(), b = before.drawn();
+    x0_ = std::min(a.x0, b.x0), y0_ = std::min(a.y0, b.y0);
+    w_ = std::max(0, std::max(a.x1, b.x1) - x0_ + 1), h_ = std::max(0, std::max(a.y1, b.y1) - y0_ + 1);
+    changed_.resize(std::size_t(w_) * std::size_t(h_));
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x)
+        changed_[std::size_t(y) * w_ + x] = now.at(x0_ + x, y0_ + y) != before.at(x0_ + x, y0_ + y);
+  }
+  bool at(long x, long y) const {
+    x -= x0_, y -= y0_;
+    return x >= 0 && y >= 0 && x < w_ && y < h_ && changed_[std::size_t(y) * w_ + std::size_t(x)];
+  }
+
+ private:
+  int x0_ = 0, y0_ = 0, w_ = 0, h_ = 0;
+  std::vector<uint8_t> changed_;
+};
+
 }  // namespace
 
 Expected<void> CarveOptions::validate() const {
@@ -148,12 +171,18 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
   };
   std::vector<Surface> surface;
   std::vector<uint8_t> carve_flag;
-  std::vector<DepthBuffer> buffers(cams.size());
+  std::vector<DepthBuffer> buffers(cams.size()), before(cams.size());
   // Each voxel's unnormalised outward normal (below), kept between iterations: it changes only
   // when a voxel of its 5x5x5 neighbourhood was carved (|component| <= 75).
   std::vector<std::array<int8_t, 3>> normal_cache(L.size());
   std::vector<uint8_t> normal_valid(L.size(), 0);
   const double tol = options.depth_tolerance * L.dt;
+  // Incremental judging: judged[x] = judged (and kept) with its current normal; changes[c] =
+  // the pixels of camera c's depth buffer that changed since the previous iteration.
+  std::vector<uint8_t> judged(options.incremental ? L.size() : 0, 0);
+  std::vector<uint8_t> deeper_read(options.incremental ? L.size() : 0, 0);  // ... at its last
+  // judgement, the patch test looked deeper along the normal
+  std::vector<ChangeMap> changes(cams.size());
   for (int iter = 0; iter < options.max_iterations; ++iter) {
     surface.clear();
     for (int jj = 1; jj + 1 < L.nj; ++jj)
@@ -167,21 +196,45 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         }
     // 1. Visibility: every camera's depth buffer of the surface voxels (a splat of the voxel's
     // projected size around its centre).
+    const bool incremental = options.incremental && iter > 0;
+    if (incremental) std::swap(buffers, before);
     parallel_for(cams.size(), options.threads, [&](std::size_t a, std::size_t b) {
       for (std::size_t c = a; c < b; ++c) {
         buffers[c].reset(cams[c]);
         for (const Surface& s : surface) buffers[c].splat(cams[c], centre(s.ii, s.jj, s.k), L.dt);
+        if (incremental) changes[c].build(buffers[c], before[c]);
       }
     });
+    // A voxel judged before, with the same normal, whose consulted depth pixels are unchanged in
+    // every camera gets the same verdict (kept): everything else its judgement reads is fixed.
+    // The pixels are those observe() reads, projected as it projects them: the voxel's own in
+    // the cameras facing it (cos >= min_cos) and, where its last judgement ran the patch test
+    // deeper, those of the points 1..3 cells deeper along its normal.
+    const auto unchanged = [&](const Surface& s, const Eigen::Vector3d& x,
+                               const Eigen::Vector3d& normal) {
+      if (!incremental || !judged[s.x]) return false;
+      const int depths = deeper_read[s.x] ? 3 : 0;
+      for (std::size_t c = 0; c < cams.size(); ++c) {
+        if (normal.dot((cams[c].centre - x).normalized()) < options.min_cos - 1e-9) continue;
+        for (int k = 0; k <= depths; ++k) {
+          Eigen::Vector2d p;
+          if (!cams[c].project(k == 0 ? x : Eigen::Vector3d(x - k * L.dt * normal), &p)) continue;
+          if (changes[c].at(nearest_pixel(p.x()), nearest_pixel(p.y()))) return false;
+        }
+      }
+      return true;
+    };
     // 2-3. Photo-consistency of every carvable surface voxel.
     carve_flag.assign(surface.size(), 0);
+    std::vector<uint8_t> judged_now(surface.size(), 0);
     parallel_for(surface.size(), options.threads, [&](std::size_t a, std::size_t b) {
-      std::vector<Observation> obs, judged;
-      std::vector<std::size_t> seen, judged_seen, order;
+      std::vector<Observation> obs, judges;
+      std::vector<std::size_t> seen, judges_seen, order;
       std::vector<std::vector<float>> patches;
       for (std::size_t n = a; n < b; ++n) {
         const Surface& s = surface[n];
         if (depth[s.x] > max_depth) continue;
+        const bool normal_kept = normal_valid[s.x] != 0;
         // Outward normal: away from the occupied voxels of the 5x5x5 neighbourhood.
         if (!normal_valid[s.x]) {
           int sum[3] = {0, 0, 0};
@@ -204,6 +257,9 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         normal[g.u()] = normal_l.x(), normal[g.v()] = normal_l.y(), normal[g.a()] = normal_l.z();
         normal.normalize();
         const Eigen::Vector3d x = centre(s.ii, s.jj, s.k);
+        if (normal_kept && unchanged(s, x, normal)) continue;
+        judged_now[n] = 1;
+        if (options.incremental) deeper_read[s.x] = 0;
         obs.clear();
         seen.clear();
         for (std::size_t c = 0; c < cams.size(); ++c) {
@@ -222,11 +278,11 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
                             [&](std::size_t i, std::size_t j) { return obs[i].cos > obs[j].cos; });
           order.resize(std::size_t(options.max_judges));
           std::sort(order.begin(), order.end());  // camera order kept
-          judged.clear();
-          judged_seen.clear();
-          for (std::size_t i : order) judged.push_back(obs[i]), judged_seen.push_back(seen[i]);
-          obs.swap(judged);
-          seen.swap(judged_seen);
+          judges.clear();
+          judges_seen.clear();
+          for (std::size_t i : order) judges.push_back(obs[i]), judges_seen.push_back(seen[i]);
+          obs.swap(judges);
+          seen.swap(judges_seen);
         }
         const double spread = colour_spread(obs);
         if (spread > options.threshold) {
@@ -256,6 +312,7 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         // Carve only towards consistency: some point 1..3 cells deeper along the normal must
         // match clearly better (a phantom voxel has the true surface behind it; a voxel on the
         // true surface has the body's inside, which matches no better).
+        if (options.incremental) deeper_read[s.x] = 1;
         for (int k = 1; k <= 3 && !carve_flag[n]; ++k) {
           const auto deeper = patch_score(x - k * L.dt * normal, k * L.dt);
           if (deeper && *deeper > *here + options.ncc_gain) carve_flag[n] = 1;
@@ -263,6 +320,10 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
       }
     });
     std::size_t carved = 0;
+    for (std::size_t n = 0; n < surface.size(); ++n) {
+      result.judged += judged_now[n];
+      if (options.incremental && judged_now[n]) judged[surface[n].x] = 1;
+    }
     for (std::size_t n = 0; n < surface.size(); ++n) {
       if (carve_flag[n]) {
         const Surface& s = surface[n];

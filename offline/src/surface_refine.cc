@@ -290,7 +290,7 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
             Eigen::Vector2d p;
             Eigen::Vector3d xc;
             if (!cams[c].project(x, &p, &xc)) continue;
-            const int px = int(std::lround(p.x())), py = int(std::lround(p.y()));
+            const int px = int(nearest_pixel(p.x())), py = int(nearest_pixel(p.y()));
             if (px < 1 || py < 1 || px + 1 >= cam.width || py + 1 >= cam.height) continue;
             int inside = 0;
             for (int dy = -1; dy <= 1; ++dy)
@@ -337,7 +337,7 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
     const auto in_silhouette = [&](std::size_t c, const Eigen::Vector3f& x) {
       Eigen::Vector2d p;
       if (!cams[c].project(x.cast<double>(), &p)) return false;
-      const long px = std::lround(p.x()), py = std::lround(p.y());
+      const long px = nearest_pixel(p.x()), py = nearest_pixel(p.y());
       return px >= 0 && py >= 0 && px < dense[c].width() && py < dense[c].height() &&
              dense[c](int(px), int(py)) != 0;
     };

@@ -141,7 +141,7 @@ std::optional<Observation> observe(const SampledView& v, const DepthBuffer& dept
   Eigen::Vector2d p;
   if (!v.project(x, &p, &xc)) return std::nullopt;
   const int W = v.camera->width, H = v.camera->height;
-  const int xn = int(std::lround(p.x())), yn = int(std::lround(p.y()));
+  const long xn = nearest_pixel(p.x()), yn = nearest_pixel(p.y());
   if (xn < 0 || yn < 0 || xn >= W || yn >= H) return std::nullopt;
   if (xc.z() > depth.at(xn, yn) + tolerance) return std::nullopt;
   Eigen::Vector3f c = Eigen::Vector3f::Zero();

@@ -15,6 +15,13 @@
 
 namespace studio::offline {
 
+// The nearest pixel of an image coordinate: std::lround's rounding (halves away from zero) without
+// its library call (millions a frame); far off (beyond 1e9) or NaN: -1e9 or 1e9, outside any image.
+inline long nearest_pixel(double v) {
+  if (!(v > -1e9 && v < 1e9)) return v > 0 ? 1000000000L : -1000000000L;
+  return long(v >= 0 ? v + 0.5 : v - 0.5);
+}
+
 struct SampledView {
   const Camera* camera = nullptr;
   Eigen::Matrix3d R;  // cam_from_world
@@ -60,6 +67,13 @@ class DepthBuffer {
   void triangle(const SampledView& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                 const Eigen::Vector3d& c);
   float at(int x, int y) const { return depth_[std::size_t(y) * std::size_t(width_) + x]; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  // The pixels drawn since reset() lie in [x0, x1] x [y0, y1] (empty: x1 < x0); infinity elsewhere.
+  struct Rect {
+    int x0, y0, x1, y1;
+  };
+  Rect drawn() const { return {dirty_x0_, dirty_y0_, dirty_x1_, dirty_y1_}; }
 
  private:
   void mark(int x0, int y0, int x1, int y1);  // grows the drawn rectangle
