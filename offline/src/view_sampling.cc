@@ -36,7 +36,7 @@ Expected<std::vector<SampledView>> prepare_views(std::span<const ColourView> vie
         std::fill(in.begin() + std::size_t(y) * W + r.begin,
                   in.begin() + std::size_t(y) * W + r.end, 1);
     // Erosion by a (2m+1)^2 square, separable: rows, then columns.
-    std::vector<int> left(W), up(H);
+    std::vector<int> left(W);
     for (int y = 0; y < H; ++y) {
       const uint8_t* row = &in[std::size_t(y) * W];
       int run = 0;  // inside pixels ending at x
@@ -47,16 +47,20 @@ Expected<std::vector<SampledView>> prepare_views(std::span<const ColourView> vie
         tmp[std::size_t(y) * W + x] = left[x] > m && right > m;
       }
     }
+    // Columns, row by row (memory order): inside pixels ending at (x, y) from above, then from
+    // below.
     v.interior.assign(std::size_t(W) * H, 0);
-    for (int x = 0; x < W; ++x) {
-      int run = 0;
-      for (int y = 0; y < H; ++y) up[y] = run = tmp[std::size_t(y) * W + x] ? run + 1 : 0;
-      int down = 0;
-      for (int y = H - 1; y >= 0; --y) {
-        down = tmp[std::size_t(y) * W + x] ? down + 1 : 0;
-        v.interior[std::size_t(y) * W + x] = up[y] > m && down > m;
+    std::vector<int> above(std::size_t(W) * H), run(W, 0);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x)
+        above[std::size_t(y) * W + x] = run[x] = tmp[std::size_t(y) * W + x] ? run[x] + 1 : 0;
+    std::fill(run.begin(), run.end(), 0);
+    for (int y = H - 1; y >= 0; --y)
+      for (int x = 0; x < W; ++x) {
+        const std::size_t i = std::size_t(y) * W + x;
+        run[x] = tmp[i] ? run[x] + 1 : 0;
+        v.interior[i] = above[i] > m && run[x] > m;
       }
-    }
     out.push_back(std::move(v));
   }
   return out;
