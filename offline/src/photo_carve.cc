@@ -168,8 +168,10 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
   struct Surface {
     int ii, jj, k;
     std::size_t x;
+    Eigen::Vector3d centre;  // in the world
   };
-  std::vector<Surface> surface;
+  std::vector<Surface> surface, exposed;  // exposed: the voxels carved in the last iteration
+  std::vector<uint8_t> on_surface(L.size(), 0);
   std::vector<uint8_t> carve_flag;
   std::vector<DepthBuffer> buffers(cams.size()), before(cams.size());
   // Each voxel's unnormalised outward normal (below), kept between iterations: it changes only
@@ -184,16 +186,41 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
   // judgement, the patch test looked deeper along the normal
   std::vector<ChangeMap> changes(cams.size());
   for (int iter = 0; iter < options.max_iterations; ++iter) {
-    surface.clear();
-    for (int jj = 1; jj + 1 < L.nj; ++jj)
-      for (int ii = 1; ii + 1 < L.ni; ++ii)
-        for (int k = 1; k + 1 < L.nk; ++k) {
+    // The surface voxels (an empty 6-neighbour), in lattice order: scanned once; then the
+    // previous iteration's that were kept and the occupied neighbours of the carved ones.
+    if (iter == 0) {
+      for (int jj = 1; jj + 1 < L.nj; ++jj)
+        for (int ii = 1; ii + 1 < L.ni; ++ii)
+          for (int k = 1; k + 1 < L.nk; ++k) {
+            const std::size_t x = L.index(ii, jj, k);
+            if (occ[x] && (!occ[x - sk] || !occ[x + sk] || !occ[x - si] || !occ[x + si] ||
+                           !occ[x - sj] || !occ[x + sj])) {
+              surface.push_back({ii, jj, k, x, centre(ii, jj, k)});
+            }
+          }
+    } else {
+      std::vector<Surface> next;
+      next.reserve(surface.size() + 6 * exposed.size());
+      for (std::size_t n = 0; n < surface.size(); ++n)
+        if (!carve_flag[n]) next.push_back(surface[n]);
+      for (const Surface& c : exposed) {
+        const int nb[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+        for (const auto& d : nb) {
+          const int ii = c.ii + d[0], jj = c.jj + d[1], k = c.k + d[2];
+          if (ii < 1 || jj < 1 || k < 1 || ii + 1 >= L.ni || jj + 1 >= L.nj || k + 1 >= L.nk)
+            continue;
           const std::size_t x = L.index(ii, jj, k);
-          if (occ[x] && (!occ[x - sk] || !occ[x + sk] || !occ[x - si] || !occ[x + si] ||
-                         !occ[x - sj] || !occ[x + sj])) {
-            surface.push_back({ii, jj, k, x});
+          if (occ[x] && !on_surface[x]) {
+            on_surface[x] = 1;
+            next.push_back({ii, jj, k, x, centre(ii, jj, k)});
           }
         }
+      }
+      std::sort(next.begin(), next.end(),
+                [](const Surface& a, const Surface& b) { return a.x < b.x; });
+      surface.swap(next);
+    }
+    for (const Surface& v : surface) on_surface[v.x] = 1;
     // 1. Visibility: every camera's depth buffer of the surface voxels (a splat of the voxel's
     // projected size around its centre).
     const bool incremental = options.incremental && iter > 0;
@@ -201,7 +228,7 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
     parallel_for(cams.size(), options.threads, [&](std::size_t a, std::size_t b) {
       for (std::size_t c = a; c < b; ++c) {
         buffers[c].reset(cams[c]);
-        for (const Surface& s : surface) buffers[c].splat(cams[c], centre(s.ii, s.jj, s.k), L.dt);
+        for (const Surface& s : surface) buffers[c].splat(cams[c], s.centre, L.dt);
         if (incremental) changes[c].build(buffers[c], before[c]);
       }
     });
@@ -256,7 +283,7 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         Eigen::Vector3d normal = Eigen::Vector3d::Zero();
         normal[g.u()] = normal_l.x(), normal[g.v()] = normal_l.y(), normal[g.a()] = normal_l.z();
         normal.normalize();
-        const Eigen::Vector3d x = centre(s.ii, s.jj, s.k);
+        const Eigen::Vector3d& x = s.centre;
         if (normal_kept && unchanged(s, x, normal)) continue;
         judged_now[n] = 1;
         if (options.incremental) deeper_read[s.x] = 0;
@@ -320,6 +347,7 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
       }
     });
     std::size_t carved = 0;
+    exposed.clear();
     for (std::size_t n = 0; n < surface.size(); ++n) {
       result.judged += judged_now[n];
       if (options.incremental && judged_now[n]) judged[surface[n].x] = 1;
@@ -328,6 +356,8 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
       if (carve_flag[n]) {
         const Surface& s = surface[n];
         occ[s.x] = kEmpty;
+        on_surface[s.x] = 0;
+        exposed.push_back(s);
         ++carved;
         for (int jj = std::max(0, s.jj - 2); jj <= std::min(L.nj - 1, s.jj + 2); ++jj)
           for (int ii = std::max(0, s.ii - 2); ii <= std::min(L.ni - 1, s.ii + 2); ++ii)
