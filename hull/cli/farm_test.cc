@@ -213,12 +213,13 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
 // --surface: the surface stage after carving (offline/surface_refine.h) runs in the process: the
 // same topology as the carved frames, vertices moved (the hull's bulges inwards, so no frame's
 // bounds grow), its setting in the fingerprint (a rerun skips, another setting recomputes).
+// --refine runs it with 10 steps unless told otherwise: the default's files are --surface 10's.
 TEST_F(HullFarm, SurfaceStage) {
   const fs::path carved = dir_ / "surface_carved", surface = dir_ / "surface_on";
-  auto r = run(hull() + " offline " + args(carved) + " --frames 0:3 --threads 2 --json", dir_);
+  auto r = run(hull() + " offline " + args(carved) + " --surface off --frames 0:3 --threads 2 --json",
+               dir_);
   ASSERT_EQ(r.code, 0) << r.err;
-  r = run(hull() + " offline " + args(surface) + " --surface 10 --frames 0:3 --threads 2 --json",
-          dir_);
+  r = run(hull() + " offline " + args(surface) + " --frames 0:3 --threads 2 --json", dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("\"computed\":4,\"skipped\":0"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\"surface\":"), std::string::npos) << r.out;
@@ -246,8 +247,9 @@ TEST_F(HullFarm, SurfaceStage) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("\"computed\":1,\"skipped\":0"), std::string::npos) << r.out;
   // Refused by reason, one line: a negative step count, the photo term without the stage.
-  for (const std::string& bad : {std::string(" --surface -1"), std::string(" --surface-photo 2"),
-                                 std::string(" --surface x")}) {
+  for (const std::string& bad :
+       {std::string(" --surface -1"), std::string(" --surface off --surface-photo 2"),
+        std::string(" --surface x")}) {
     r = run(hull() + " offline " + args(surface) + bad, dir_);
     EXPECT_EQ(r.code, 2) << bad;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

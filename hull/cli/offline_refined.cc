@@ -37,6 +37,12 @@ namespace fs = std::filesystem;
 namespace studio::hull::cli {
 namespace {
 
+// --refine runs the surface stage with this many steps unless --surface says otherwise: the carve
+// alone leaves the hull's bulges between the silhouette cones (-12 % / -19 % mean / p95 surface
+// distance vs the hull, against -21 % / -26 % with the steps; docs/offline.md).
+constexpr int kDefaultSurfaceSteps = 10;
+constexpr int kSurfaceUnset = -2;
+
 constexpr const char* kUsage =
     R"(       studio-hull offline --take DIR [--rig rig.yaml] --box X0,Y0,Z0,X1,Y1,Z1 --grid N
                            --out DIR (--refine | --texture | --surface S, any together)
@@ -71,10 +77,11 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
   --surface S|off   surface stage on the mesh (after carving with --refine): S Laplacian steps
                     with the silhouette rims (the middle of each facet) anchored, each move
                     kept inside the visual hull, moving the hull's bulges between the
-                    silhouette cones inwards (10 recommended: -21 % mean / -26 % p95 surface
-                    distance vs the hull with --refine on the two concave test poses; 30:
-                    -23 % / -28 %, also on five other poses not tuned on, at 3x the stage's
-                    cost; union PSNR +1.2-1.6 dB); default off
+                    silhouette cones inwards (10: -21 % mean / -26 % p95 surface distance vs
+                    the hull with --refine on the two concave test poses, against -12 % / -19 %
+                    carving alone; 30: -23 % / -28 %, also on five other poses not tuned on, at
+                    3x the stage's cost; union PSNR +1.2-1.6 dB). Default: 10 with --refine,
+                    off without it (--surface S alone smooths the hull itself)
   --surface-photo N photo-consistency iterations of the surface stage before the steps (patch
                     search along the normals; default 0: measured no gain, docs/offline.md)
   --plan N          print the take's frames split into N contiguous shards, one A:B per line
@@ -107,7 +114,8 @@ struct Args {
   bool patches = true;
   int max_depth = 12;
   int judges = offline::CarveOptions{}.max_judges;  // 0: all
-  int surface = -1, surface_photo = 0;  // -1: no surface stage
+  // -1: no surface stage; kSurfaceUnset until the arguments are read: --refine's default steps.
+  int surface = kSurfaceUnset, surface_photo = 0;
   std::optional<bool> progress;
 };
 
@@ -246,6 +254,7 @@ Expected<Args> parse(int argc, char** argv) {
   if (a.plan > 0) return a;
   if (a.out.empty()) return fail("--out DIR is required");
   if (a.index_only) return a;
+  if (a.surface == kSurfaceUnset) a.surface = a.refine ? kDefaultSurfaceSteps : -1;
   if (!a.refine && !a.texture && a.surface < 0)
     return fail("give --refine, --surface and/or --texture");
   if (!a.box_text) return fail("--box is required");
