@@ -117,10 +117,7 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
     parallel_for(cams.size(), o.threads, [&](std::size_t a, std::size_t b) {
       for (std::size_t c = a; c < b; ++c) {
         buffers[c].reset(cams[c]);
-        for (const auto& t : mesh.triangles)
-          buffers[c].triangle(cams[c], mesh.vertices[t[0]].cast<double>(),
-                              mesh.vertices[t[1]].cast<double>(),
-                              mesh.vertices[t[2]].cast<double>());
+        buffers[c].mesh(cams[c], mesh);
       }
     });
     // 1-2. Data term per vertex.

@@ -71,11 +71,7 @@ Expected<TextureBlend> TextureBlend::create(const hull::Mesh& occluder,
     run_on(pool, workers, [&, w] {
       for (std::size_t c = std::size_t(w); c < cams.size(); c += std::size_t(workers)) {
         buffers[c].reset(cams[c]);
-        for (const auto& t : occluder.triangles) {
-          buffers[c].triangle(cams[c], occluder.vertices[t[0]].cast<double>(),
-                              occluder.vertices[t[1]].cast<double>(),
-                              occluder.vertices[t[2]].cast<double>());
-        }
+        buffers[c].mesh(cams[c], occluder);
       }
     });
   }

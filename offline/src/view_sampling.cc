@@ -113,6 +113,31 @@ void DepthBuffer::triangle(const SampledView& v, const Eigen::Vector3d& a, const
     if (!v.project(*w[k], &p[k], &xc)) return;
     z[k] = xc.z();
   }
+  raster(p, z);
+}
+
+void DepthBuffer::mesh(const SampledView& v, const hull::Mesh& m) {
+  // Each vertex projected once (a vertex is in ~6 triangles); the same values triangle() gets.
+  const std::size_t nv = m.vertices.size();
+  projected_.resize(nv);
+  depth_of_.resize(nv);
+  for (std::size_t n = 0; n < nv; ++n) {
+    Eigen::Vector3d xc;
+    depth_of_[n] = v.project(m.vertices[n].cast<double>(), &projected_[n], &xc) ? xc.z() : -1;
+  }
+  for (const auto& t : m.triangles) {
+    Eigen::Vector2d p[3];
+    double z[3];
+    bool front = true;
+    for (int k = 0; k < 3 && front; ++k) {
+      p[k] = projected_[t[k]], z[k] = depth_of_[t[k]];
+      front = z[k] > 0;
+    }
+    if (front) raster(p, z);
+  }
+}
+
+void DepthBuffer::raster(const Eigen::Vector2d* p, const double* z) {
   const double area = (p[1] - p[0]).x() * (p[2] - p[0]).y() - (p[1] - p[0]).y() * (p[2] - p[0]).x();
   if (std::abs(area) < 1e-12) return;
   const int x0 = std::max(0, int(std::ceil(std::min({p[0].x(), p[1].x(), p[2].x()}))));

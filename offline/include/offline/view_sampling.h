@@ -11,6 +11,7 @@
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "hull/segment_mesh.h"
 #include "offline/photo_carve.h"
 
 namespace studio::offline {
@@ -66,6 +67,8 @@ class DepthBuffer {
   // well below a cell for the small triangles of a hull mesh).
   void triangle(const SampledView& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                 const Eigen::Vector3d& c);
+  // Every triangle of `m` (each drawn as triangle() draws it; its vertices projected once).
+  void mesh(const SampledView& v, const hull::Mesh& m);
   float at(int x, int y) const { return depth_[std::size_t(y) * std::size_t(width_) + x]; }
   int width() const { return width_; }
   int height() const { return height_; }
@@ -77,6 +80,9 @@ class DepthBuffer {
 
  private:
   void mark(int x0, int y0, int x1, int y1);  // grows the drawn rectangle
+  void raster(const Eigen::Vector2d* p, const double* z);  // a projected triangle
+  std::vector<Eigen::Vector2d> projected_;  // mesh(): each vertex's pixel ...
+  std::vector<double> depth_of_;            // ... and camera depth (<= 0: behind)
   int width_ = 0, height_ = 0;
   std::vector<float> depth_;
   int dirty_x0_ = 0, dirty_y0_ = 0, dirty_x1_ = -1, dirty_y1_ = -1;  // drawn since reset()
