@@ -174,10 +174,11 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
   std::vector<uint8_t> on_surface(L.size(), 0);
   std::vector<uint8_t> carve_flag;
   std::vector<DepthBuffer> buffers(cams.size()), before(cams.size());
-  // Each voxel's unnormalised outward normal (below), kept between iterations: it changes only
-  // when a voxel of its 5x5x5 neighbourhood was carved (|component| <= 75).
+  // Each voxel's unnormalised outward normal (below), kept between iterations and updated when a
+  // voxel of its 5x5x5 neighbourhood is carved (|component| <= 75). normal_state: 0 not yet
+  // computed, 1 as at the voxel's last judgement, 2 changed since.
   std::vector<std::array<int8_t, 3>> normal_cache(L.size());
-  std::vector<uint8_t> normal_valid(L.size(), 0);
+  std::vector<uint8_t> normal_state(L.size(), 0);
   const double tol = options.depth_tolerance * L.dt;
   // Incremental judging: judged[x] = judged (and kept) with its current normal; changes[c] =
   // the pixels of camera c's depth buffer that changed since the previous iteration.
@@ -261,9 +262,9 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
       for (std::size_t n = a; n < b; ++n) {
         const Surface& s = surface[n];
         if (depth[s.x] > max_depth) continue;
-        const bool normal_kept = normal_valid[s.x] != 0;
+        const bool normal_kept = normal_state[s.x] == 1;
         // Outward normal: away from the occupied voxels of the 5x5x5 neighbourhood.
-        if (!normal_valid[s.x]) {
+        if (normal_state[s.x] == 0) {
           int sum[3] = {0, 0, 0};
           for (int dj = -2; dj <= 2; ++dj)
             for (int di = -2; di <= 2; ++di)
@@ -275,8 +276,8 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
                 }
               }
           normal_cache[s.x] = {int8_t(sum[0]), int8_t(sum[1]), int8_t(sum[2])};
-          normal_valid[s.x] = 1;
         }
+        normal_state[s.x] = 1;
         const auto& nc = normal_cache[s.x];
         const Eigen::Vector3d normal_l(nc[0], nc[1], nc[2]);
         if (normal_l.squaredNorm() == 0) continue;
@@ -359,10 +360,17 @@ Expected<CarveResult> photo_carve(const hull::SegmentSet& hull, std::span<const 
         on_surface[s.x] = 0;
         exposed.push_back(s);
         ++carved;
+        // Now empty: one more empty neighbour (at offset s - v) in each computed normal around.
         for (int jj = std::max(0, s.jj - 2); jj <= std::min(L.nj - 1, s.jj + 2); ++jj)
           for (int ii = std::max(0, s.ii - 2); ii <= std::min(L.ni - 1, s.ii + 2); ++ii)
-            for (int k = std::max(0, s.k - 2); k <= std::min(L.nk - 1, s.k + 2); ++k)
-              normal_valid[L.index(ii, jj, k)] = 0;
+            for (int k = std::max(0, s.k - 2); k <= std::min(L.nk - 1, s.k + 2); ++k) {
+              const std::size_t v = L.index(ii, jj, k);
+              if (normal_state[v] == 0) continue;
+              auto& nc = normal_cache[v];
+              nc[0] = int8_t(nc[0] + (s.ii - ii)), nc[1] = int8_t(nc[1] + (s.jj - jj)),
+              nc[2] = int8_t(nc[2] + (s.k - k));
+              normal_state[v] = 2;
+            }
       }
     }
     result.iterations = iter + 1;
