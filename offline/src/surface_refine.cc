@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <span>
 #include <thread>
 #include <unordered_map>
 #include <vector>
@@ -14,6 +15,23 @@ namespace studio::offline {
 namespace {
 
 using detail::parallel_for;
+
+// Each vertex's neighbours, sorted, in one array (compressed rows).
+class Adjacency {
+ public:
+  explicit Adjacency(const std::vector<std::vector<uint32_t>>& lists) : offset_(lists.size() + 1) {
+    for (std::size_t n = 0; n < lists.size(); ++n) offset_[n + 1] = offset_[n] + lists[n].size();
+    index_.reserve(offset_.back());
+    for (const auto& l : lists) index_.insert(index_.end(), l.begin(), l.end());
+  }
+  std::span<const uint32_t> operator[](std::size_t n) const {
+    return {index_.data() + offset_[n], offset_[n + 1] - offset_[n]};
+  }
+
+ private:
+  std::vector<std::size_t> offset_;
+  std::vector<uint32_t> index_;
+};
 
 }  // namespace
 
@@ -77,18 +95,21 @@ Expected<SurfaceRefineResult> refine_surface(const hull::Mesh& input,
 
   // Edges (each once per triangle side; a shared edge counts twice, which only scales the
   // smoothness uniformly on a closed mesh).
-  std::vector<std::vector<uint32_t>> adjacent(nv);
+  std::vector<std::vector<uint32_t>> lists(nv);
   for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) adjacent[t[k]].push_back(t[(k + 1) % 3]);
-  for (auto& a : adjacent) {
+    for (int k = 0; k < 3; ++k) lists[t[k]].push_back(t[(k + 1) % 3]);
+  for (auto& a : lists) {
     std::sort(a.begin(), a.end());
     a.erase(std::unique(a.begin(), a.end()), a.end());
   }
   for (std::size_t n = 0; n < nv; ++n)
-    for (const uint32_t m : adjacent[n])
-      if (!std::binary_search(adjacent[m].begin(), adjacent[m].end(), uint32_t(n)))
-        adjacent[m].insert(std::lower_bound(adjacent[m].begin(), adjacent[m].end(), uint32_t(n)),
-                           uint32_t(n));
+    for (const uint32_t m : lists[n])
+      if (!std::binary_search(lists[m].begin(), lists[m].end(), uint32_t(n)))
+        lists[m].insert(std::lower_bound(lists[m].begin(), lists[m].end(), uint32_t(n)),
+                        uint32_t(n));
+  // The same lists, contiguous (every step walks them all).
+  const Adjacency adjacent(lists);
+  lists = {};
 
   const double cell = o.cell, tol = o.depth_tolerance_cells * cell;
   const int lo = -int(std::lround(o.search_in_cells / o.step_cells));
