@@ -475,12 +475,11 @@ TEST(PhotoCarve, IncrementalJudgingCarvesTheSameVoxels) {
     sim::Motion motion;
     int64_t frame;
   };
-  for (const Case& k : {Case{"crouch, 9 cameras", 9, 704, 576, 160, 560, 6, false, false,
-                             sim::Motion::crouch, 45},
-                        Case{"patterned, threshold 4", 8, 352, 288, 128, 280, 4, true, false,
-                             sim::Motion::idle, 10},
-                        Case{"distorted camera", 6, 352, 288, 96, 280, 5, false, true,
-                             sim::Motion::crouch, 30}}) {
+  for (const Case& k :
+       {Case{"crouch, 9 cameras", 9, 704, 576, 160, 560, 6, false, false, sim::Motion::crouch, 45},
+        Case{"patterned, threshold 4", 8, 352, 288, 128, 280, 4, true, false, sim::Motion::idle,
+             10},
+        Case{"distorted camera", 6, 352, 288, 96, 280, 5, false, true, sim::Motion::crouch, 30}}) {
     SCOPED_TRACE(k.name);
     sim::RingOptions ring;
     ring.count = k.cameras;

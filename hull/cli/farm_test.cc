@@ -216,8 +216,8 @@ TEST_F(HullFarm, ShardsWithOneKilledAndRestartedEqualAnUnshardedRun) {
 // --refine runs it with 10 steps unless told otherwise: the default's files are --surface 10's.
 TEST_F(HullFarm, SurfaceStage) {
   const fs::path carved = dir_ / "surface_carved", surface = dir_ / "surface_on";
-  auto r = run(hull() + " offline " + args(carved) + " --surface off --frames 0:3 --threads 2 --json",
-               dir_);
+  auto r = run(
+      hull() + " offline " + args(carved) + " --surface off --frames 0:3 --threads 2 --json", dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   r = run(hull() + " offline " + args(surface) + " --frames 0:3 --threads 2 --json", dir_);
   ASSERT_EQ(r.code, 0) << r.err;

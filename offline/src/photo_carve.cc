@@ -39,7 +39,8 @@ class ChangeMap {
   void build(const DepthBuffer& now, const DepthBuffer& before) {
     const DepthBuffer::Rect a = now.drawn(), b = before.drawn();
     x0_ = std::min(a.x0, b.x0), y0_ = std::min(a.y0, b.y0);
-    w_ = std::max(0, std::max(a.x1, b.x1) - x0_ + 1), h_ = std::max(0, std::max(a.y1, b.y1) - y0_ + 1);
+    w_ = std::max(0, std::max(a.x1, b.x1) - x0_ + 1);
+    h_ = std::max(0, std::max(a.y1, b.y1) - y0_ + 1);
     changed_.resize(std::size_t(w_) * std::size_t(h_));
     for (int y = 0; y < h_; ++y)
       for (int x = 0; x < w_; ++x)

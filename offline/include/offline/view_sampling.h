@@ -79,10 +79,10 @@ class DepthBuffer {
   Rect drawn() const { return {dirty_x0_, dirty_y0_, dirty_x1_, dirty_y1_}; }
 
  private:
-  void mark(int x0, int y0, int x1, int y1);  // grows the drawn rectangle
+  void mark(int x0, int y0, int x1, int y1);               // grows the drawn rectangle
   void raster(const Eigen::Vector2d* p, const double* z);  // a projected triangle
-  std::vector<Eigen::Vector2d> projected_;  // mesh(): each vertex's pixel ...
-  std::vector<double> depth_of_;            // ... and camera depth (<= 0: behind)
+  std::vector<Eigen::Vector2d> projected_;                 // mesh(): each vertex's pixel ...
+  std::vector<double> depth_of_;                           // ... and camera depth (<= 0: behind)
   int width_ = 0, height_ = 0;
   std::vector<float> depth_;
   int dirty_x0_ = 0, dirty_y0_ = 0, dirty_x1_ = -1, dirty_y1_ = -1;  // drawn since reset()
