@@ -3,15 +3,13 @@
 // dilate 10 px, erode 7 px); the views listed in dinoSR_good_silhouette_images.txt. The segment
 // hull's mesh, re-projected into every used view, must match the silhouette with IoU >= 0.9.
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <filesystem>
-#include <fstream>
+#include <opencv2/imgproc.hpp>
 
-#include "core/rig.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
+#include "support/middlebury_dino.h"
 
 namespace fs = std::filesystem;
 
@@ -21,38 +19,16 @@ namespace {
 TEST(MiddleburyDino, ReprojectedMeshMatchesSilhouettes) {
   const fs::path dir = fs::path(STUDIO_SHARED_DATA) / "middlebury_dino";
   if (!fs::exists(dir / "dinoSR_par.txt")) GTEST_SKIP() << "no " << dir << " (shared test data)";
-  auto rig = import_middlebury((dir / "dinoSR_par.txt").string(), 640, 480);
-  ASSERT_TRUE(rig) << rig.error().message;
-  std::ifstream list(dir / "dinoSR_good_silhouette_images.txt");
-  std::vector<std::string> good;
-  for (std::string name; list >> name;) {
-    if (name.size() > 4 && name.ends_with(".png")) good.push_back(name.substr(0, name.size() - 4));
-  }
-  ASSERT_GE(good.size(), 10u);
-  std::vector<Camera> cams;
-  std::vector<cv::Mat> sil;
-  std::vector<RunMask> masks;
-  const cv::Mat dilate = cv::getStructuringElement(cv::MORPH_ELLIPSE, {21, 21});
-  const cv::Mat erode = cv::getStructuringElement(cv::MORPH_ELLIPSE, {15, 15});
-  for (const std::string& id : good) {
-    const Camera* c = rig->find_camera(id);
-    ASSERT_NE(c, nullptr) << id;
-    const cv::Mat img = cv::imread((dir / (id + ".png")).string(), cv::IMREAD_COLOR);
-    ASSERT_FALSE(img.empty()) << id;
-    std::vector<cv::Mat> ch;
-    cv::split(img, ch);
-    cv::Mat m = cv::max(cv::max(ch[0], ch[1]), ch[2]) > int(0.19 * 255);
-    cv::dilate(m, m, dilate);
-    cv::erode(m, m, erode);
-    cams.push_back(*c);
-    sil.push_back(m);
-    masks.push_back(RunMask::from_mask(MaskView(m.ptr<uint8_t>(), m.cols, m.rows, std::ptrdiff_t(m.step))));
-  }
+  auto dino = studio::testing::load_middlebury_dino(dir.string());
+  ASSERT_TRUE(dino) << dino.error().message;
+  const std::vector<Camera>& cams = dino->cameras;
+  const std::vector<cv::Mat>& sil = dino->silhouettes;
+  const std::vector<RunMask>& masks = dino->masks;
   std::vector<View> views;
   for (std::size_t k = 0; k < cams.size(); ++k) views.push_back({&cams[k], &masks[k]});
   GridSpec g;
-  g.box_min = Eigen::Vector3d(-0.061897, -0.018874, -0.057845) - Eigen::Vector3d::Constant(0.005);
-  g.box_max = Eigen::Vector3d(0.010897, 0.068227, 0.015495) + Eigen::Vector3d::Constant(0.005);
+  g.box_min = studio::testing::DinoViews::box_min(0.005);
+  g.box_max = studio::testing::DinoViews::box_max(0.005);
   g.cells_u = g.cells_v = 200;
   CutOptions o;
   o.threads = 2;
