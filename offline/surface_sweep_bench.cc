@@ -46,9 +46,7 @@ double silhouette_loss(const hull::Mesh& m, const std::vector<ColourView>& views
   for (std::size_t c = 0; c < sv.size(); ++c) {
     DepthBuffer d;
     d.reset(sv[c]);
-    for (const auto& t : m.triangles)
-      d.triangle(sv[c], m.vertices[t[0]].cast<double>(), m.vertices[t[1]].cast<double>(),
-                 m.vertices[t[2]].cast<double>());
+    d.mesh(sv[c], m);
     for (int y = 0; y < sv[c].camera->height; ++y)
       for (int x = 0; x < sv[c].camera->width; ++x)
         if (sv[c].inside(x, y)) {

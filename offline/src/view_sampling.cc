@@ -103,21 +103,8 @@ void DepthBuffer::splat(const SampledView& v, const Eigen::Vector3d& x, double s
   }
 }
 
-void DepthBuffer::triangle(const SampledView& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                           const Eigen::Vector3d& c) {
-  Eigen::Vector2d p[3];
-  double z[3];
-  const Eigen::Vector3d* w[3] = {&a, &b, &c};
-  for (int k = 0; k < 3; ++k) {
-    Eigen::Vector3d xc;
-    if (!v.project(*w[k], &p[k], &xc)) return;
-    z[k] = xc.z();
-  }
-  raster(p, z);
-}
-
 void DepthBuffer::mesh(const SampledView& v, const hull::Mesh& m) {
-  // Each vertex projected once (a vertex is in ~6 triangles); the same values triangle() gets.
+  // Each vertex projected once (a vertex is in ~6 triangles).
   const std::size_t nv = m.vertices.size();
   projected_.resize(nv);
   depth_of_.resize(nv);

@@ -63,15 +63,11 @@ class DepthBuffer {
   void reset(const SampledView& v);
   // A cube of edge `size` at x, drawn as the square of its projected size around its centre.
   void splat(const SampledView& v, const Eigen::Vector3d& x, double size);
-  // A triangle (world vertices), depth interpolated linearly in screen space (perspective error
-  // well below a cell for the small triangles of a hull mesh).
-  void triangle(const SampledView& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                const Eigen::Vector3d& c);
-  // Every triangle of `m` (each drawn as triangle() draws it; its vertices projected once).
+  // Every triangle of `m` whose vertices are all in front, depth interpolated linearly in screen
+  // space (perspective error well below a cell for the small triangles of a hull mesh); each
+  // vertex projected once.
   void mesh(const SampledView& v, const hull::Mesh& m);
   float at(int x, int y) const { return depth_[std::size_t(y) * std::size_t(width_) + x]; }
-  int width() const { return width_; }
-  int height() const { return height_; }
   // The pixels drawn since reset() lie in [x0, x1] x [y0, y1] (empty: x1 < x0); infinity elsewhere.
   struct Rect {
     int x0, y0, x1, y1;
