@@ -3,10 +3,12 @@
 // parallel, one per core). Stages after keying: hull = cut + segment marching cubes + exact
 // crossings (the baseline: `studio-hull offline` without --refine); carve = photo_carve;
 // refined_mesh; surface = refine_surface (default options: the shape prior); texture =
-// vertex_colours; encode = the glb bytes. BM_Frame runs a whole frame per mode at 256^2 and 512^2
-// columns (frames_per_min_1core: one core, the thread CPU time of the stages). BM_Quality: the
-// refinement's quality (surface distance to the true actor, counters in mm) against its cost, per
-// threshold and surface setting, with the hull as the baseline in the same run.
+// vertex_colours; encode = the glb bytes; balance = the colour balance before the carve (the
+// CLI's default: the hull's mesh, estimate_colour_balance, apply_colour_balance). BM_Frame runs a
+// whole frame per mode at 256^2 and 512^2 columns (frames_per_min_1core: one core, the thread CPU
+// time of the stages). BM_Quality: the refinement's quality (surface distance to the true actor,
+// counters in mm) against its cost, per threshold and surface setting, with the hull as the
+// baseline in the same run.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -15,6 +17,7 @@
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
+#include "offline/colour_balance.h"
 #include "offline/frame_files.h"
 #include "offline/photo_carve.h"
 #include "offline/surface_refine.h"
@@ -69,7 +72,8 @@ struct ThreadClock {
 void BM_Frame(benchmark::State& state) {
   const Scene& s = Scene::get();
   const int mode = int(state.range(1));
-  double t_hull = 0, t_carve = 0, t_mesh = 0, t_surface = 0, t_texture = 0, t_encode = 0;
+  double t_hull = 0, t_balance = 0, t_carve = 0, t_mesh = 0, t_surface = 0, t_texture = 0,
+         t_encode = 0;
   double carve_iterations = 0, carve_judged = 0;
   const bool textured = mode == 2 || mode == 4;
   // Thread CPU time (every stage runs on this thread with the default threads = 1): figures
@@ -88,7 +92,12 @@ void BM_Frame(benchmark::State& state) {
       mesh = hull_mesh(s, set);
       t_mesh += ms(t0);
     } else {
-      const CarveResult carved = photo_carve(set, s.views).value();
+      std::vector<Image<Rgb8>> store;
+      const std::vector<ColourView> views = apply_colour_balance(
+          s.views, estimate_colour_balance(hull_mesh(s, set), s.views).value(), &store);
+      t_balance += ms(t0);
+      t0 = ThreadClock::now();
+      const CarveResult carved = photo_carve(set, views).value();
       t_carve += ms(t0);
       carve_iterations += carved.iterations;
       carve_judged += double(carved.judged);
@@ -117,6 +126,7 @@ void BM_Frame(benchmark::State& state) {
   }
   const double n = double(state.iterations());
   state.counters["cut_ms"] = t_hull / n;
+  state.counters["balance_ms"] = t_balance / n;
   state.counters["carve_ms"] = t_carve / n;
   if (mode != 0) {
     state.counters["carve_iterations"] = carve_iterations / n;
@@ -126,7 +136,8 @@ void BM_Frame(benchmark::State& state) {
   state.counters["surface_ms"] = t_surface / n;
   state.counters["texture_ms"] = t_texture / n;
   state.counters["encode_ms"] = t_encode / n;
-  const double frame_ms = (t_hull + t_carve + t_mesh + t_surface + t_texture + t_encode) / n;
+  const double frame_ms =
+      (t_hull + t_balance + t_carve + t_mesh + t_surface + t_texture + t_encode) / n;
   state.counters["frames_per_min_1core"] = 60000 / frame_ms;
 }
 BENCHMARK(BM_Frame)

@@ -7,7 +7,12 @@
 // ring's azimuths, the cyclorama's walls 6 m high instead of 4 so that they see cloth above the
 // actor: a larger studio's rig, e.g. 8 + overhead + 8 = 17 cameras), LOSS_PER_CAMERA=1 (the
 // hull's and the carved mesh's silhouette loss per camera: a mask wider than the actor shows),
-// CARVE_MAX_JUDGES / CARVE_MIN_COS / CARVE_THRESHOLD (the carve's CarveOptions, default otherwise).
+// CARVE_MAX_JUDGES / CARVE_MIN_COS / CARVE_THRESHOLD (the carve's CarveOptions, default otherwise),
+// RESPONSE=E,B[,SEED] (the cameras' colour responses differ: sim::random_camera_response with
+// exposure spread E and white-balance spread B), BALANCE=0 (no colour balance before the carve),
+// BALANCE_COS_DIFF (ColourBalanceOptions::max_cos_difference).
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -16,6 +21,7 @@
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
+#include "offline/colour_balance.h"
 #include "offline/photo_carve.h"
 #include "offline/surface_refine.h"
 #include "offline/view_sampling.h"
@@ -35,6 +41,7 @@ struct Pose {
 struct Prepared {
   testing::Frame f;
   std::vector<ColourView> views;
+  std::vector<Image<Rgb8>> balanced;  // the images after the colour balance (BALANCE)
   hull::Mesh hull_mesh, carved_mesh;
   testing::SurfaceScore hull, carved;
 };
@@ -92,6 +99,15 @@ int main(int argc, char** argv) {
         cams.push_back(c);
       }
     }
+    // RESPONSE=E,B[,SEED]: the cameras' colour responses differ (sim::random_camera_response:
+    // exposure spread E, white-balance spread B); BALANCE=0: no colour balance before the carve.
+    if (const char* r = std::getenv("RESPONSE")) {
+      double e = 0, b = 0;
+      unsigned long long seed = 1;
+      std::sscanf(r, "%lf,%lf,%llu", &e, &b, &seed);
+      so.camera_response = sim::random_camera_response(int(cams.size()), seed, e, b);
+    }
+    const bool balance = !std::getenv("BALANCE") || std::atoi(std::getenv("BALANCE")) != 0;
     auto studio = sim::SimulatedStudio::create(cams, so).value();
     Prepared& p = prep[i];
     p.f = testing::render_frame(studio, poses[i].frame);
@@ -101,6 +117,32 @@ int main(int argc, char** argv) {
     const auto set = hull::visual_hull(testing::studio_grid(grid), cut).value();
     p.hull_mesh = hull::segment_marching_cubes(set);
     (void)hull::refine_crossings(p.hull_mesh, set, cut);
+    if (balance) {
+      ColourBalanceOptions bo;
+      bo.threads = 2;
+      if (const char* d = std::getenv("BALANCE_COS_DIFF")) bo.max_cos_difference = std::atof(d);
+      const auto t0 = std::chrono::steady_clock::now();
+      const ColourBalance cb = estimate_colour_balance(p.hull_mesh, p.views, bo).value();
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      p.views = apply_colour_balance(p.views, cb, &p.balanced);
+      // Against the truth: the display-space gains (g^(1/2.2)) that equalise the cameras,
+      // geometric mean 1 per channel; the worst camera and channel.
+      double worst = 0;
+      if (!so.camera_response.empty())
+        for (int k = 0; k < 3; ++k) {
+          double mean_log = 0;
+          for (const auto& g : so.camera_response) mean_log += std::log(g[k]) / 2.2;
+          mean_log /= double(cams.size());
+          for (std::size_t c = 0; c < cams.size(); ++c) {
+            const double want = std::exp(mean_log - std::log(so.camera_response[c][k]) / 2.2);
+            worst = std::max(worst, std::abs(cb.gains[c][k] / want - 1));
+          }
+        }
+      std::printf(
+          "  balance: %zu points, %d pairs, residual %.4f, worst gain error %.2f %% (%.0f ms)\n",
+          cb.points, cb.pairs, cb.residual, 100 * worst, ms);
+    }
     CarveOptions co;
     co.threads = 2;
     if (const char* j = std::getenv("CARVE_MAX_JUDGES")) co.max_judges = std::atoi(j);

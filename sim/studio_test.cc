@@ -406,6 +406,78 @@ TEST(SimStudio, HeadCentreProjectsInsideTheMask) {
   }
 }
 
+// A camera's colour response (StudioOptions::camera_response) is a linear gain per channel on
+// everything it sees: in display values g^(1/2.2), on the cloth and on the actor alike (the actor's
+// interior and the background away from the silhouette, noise off), other cameras untouched,
+// the true mask unchanged.
+TEST(SimStudio, CameraResponseScalesWhatThatCameraSees) {
+  StudioOptions flat;
+  flat.noise_sigma = 0;
+  StudioOptions tinted = flat;
+  tinted.camera_response.assign(6, {1, 1, 1});
+  tinted.camera_response[2] = {1.2, 0.9, 0.8};
+  const SimulatedStudio a = make(flat), b = make(tinted);
+  for (int c : {1, 2}) {
+    Image<Rgb8> ia, ib;
+    Mask ma, mb;
+    a.render(c, 30, &ia, &ma);
+    b.render(c, 30, &ib, &mb);
+    ASSERT_EQ(ma.pixels(), mb.pixels());
+    const std::array<double, 3> g = tinted.camera_response[std::size_t(c)];
+    double worst[2] = {0, 0};  // background, actor: |measured - expected| grey levels
+    int counted[2] = {0, 0};
+    for (int y = 0; y < ia.height(); ++y)
+      for (int x = 0; x < ia.width(); ++x) {
+        const bool actor = interior(ma, x, y, 255);
+        if (!actor && !interior(ma, x, y, 0)) continue;
+        const uint8_t* p = &ia(x, y).r;
+        const uint8_t* q = &ib(x, y).r;
+        for (int k = 0; k < 3; ++k) {
+          if (p[k] < 8 || p[k] > 200) continue;  // rounding dominates; clipped
+          const double expected = p[k] * std::pow(g[std::size_t(k)], 1 / 2.2);
+          worst[actor] = std::max(worst[actor], std::abs(q[k] - expected));
+          ++counted[actor];
+        }
+      }
+    EXPECT_GT(counted[0], 10000) << c;
+    EXPECT_GT(counted[1], 1000) << c;
+    // Rounding of the 8-bit values (the background's, then the floor shadow's on it) and of the
+    // gamma table (1/1024 of linear light).
+    EXPECT_LE(worst[0], c == 2 ? 1.6 : 0.0) << "camera " << c << " background";
+    EXPECT_LE(worst[1], c == 2 ? 3.0 : 0.0) << "camera " << c << " actor";
+    if (c == 2) {
+      long brighter_red = 0, darker_blue = 0, n = 0;
+      for (int y = 0; y < ia.height(); ++y)
+        for (int x = 0; x < ia.width(); ++x)
+          if (interior(ma, x, y, 255)) {
+            ++n;
+            brighter_red += ib(x, y).r > ia(x, y).r;
+            darker_blue += ib(x, y).b < ia(x, y).b;
+          }
+      EXPECT_GT(brighter_red, n * 9 / 10);
+      EXPECT_GT(darker_blue, n * 9 / 10);
+    }
+  }
+  // The draw: one entry per camera, deterministic, within the spreads.
+  const auto r = random_camera_response(9, 7, 0.1, 0.04);
+  ASSERT_EQ(r.size(), 9u);
+  EXPECT_EQ(r, random_camera_response(9, 7, 0.1, 0.04));
+  EXPECT_NE(r, random_camera_response(9, 8, 0.1, 0.04));
+  for (const auto& g : r) {
+    EXPECT_GE(g[1], 0.9);
+    EXPECT_LE(g[1], 1.1);
+    EXPECT_GE(g[0] / g[1], 0.96);
+    EXPECT_LE(g[2] / g[1], 1.04);
+  }
+  StudioOptions bad;
+  bad.camera_response.assign(5, {1, 1, 1});  // 6 cameras
+  auto r5 = SimulatedStudio::create(ring_cameras(), bad);
+  ASSERT_FALSE(r5);
+  EXPECT_NE(r5.error().message.find("camera_response"), std::string::npos);
+  bad.camera_response.assign(6, {1, 0, 1});
+  EXPECT_FALSE(SimulatedStudio::create(ring_cameras(), bad));
+}
+
 TEST(SimStudio, RejectsBadConfigurationWithOneLine) {
   EXPECT_FALSE(SimulatedStudio::create({}, {}));
   StudioOptions o;

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -56,42 +57,52 @@ std::map<std::string, std::string> files_of(const fs::path& dir) {
   return out;
 }
 
+// The farm take's rig: 6 cameras (5 on the ring + overhead) at 176x144.
+sim::RingOptions small_rig() {
+  sim::RingOptions ring;
+  ring.width = 176;
+  ring.height = 144;
+  ring.focal_px = 140;
+  return ring;
+}
+
+// A take of the simulated studio with frames 0..last in `dir`.
+void record_take(const fs::path& dir, const sim::StudioOptions& so, uint64_t last,
+                 const sim::RingOptions& ring = small_rig()) {
+  auto studio = sim::SimulatedStudio::create(sim::ring_cameras(ring), so);
+  ASSERT_TRUE(studio) << studio.error().message;
+  for (int c = 0; c < studio->camera_count(); ++c) {
+    const Camera& cam = studio->cameras()[std::size_t(c)];
+    capture::TakeInfo info;
+    info.take = "take";
+    info.camera_id = cam.id;
+    info.width = uint32_t(cam.width);
+    info.height = uint32_t(cam.height);
+    info.period_ns = 40'000'000;
+    info.start_frame = 0;
+    info.calibration_yaml = yaml::format_camera(cam, 2);
+    auto rec = capture::Recorder::start({.dir = (dir / cam.id).string(), .queue_frames = 64}, info);
+    ASSERT_TRUE(rec) << rec.error().message;
+    for (uint64_t f = 0; f <= last; ++f) {
+      Image<Rgb8> image;
+      studio->render(c, int64_t(f), &image, nullptr);
+      ASSERT_TRUE((*rec)->push(f, int64_t(f) * 40'000'000, image.view()));
+    }
+    (*rec)->stop(last + 1);
+    auto done = (*rec)->wait();
+    ASSERT_TRUE(done) << done.error().message;
+  }
+}
+
 class HullFarm : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("hull_farm_test_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    sim::RingOptions ring;
-    ring.width = 176;
-    ring.height = 144;
-    ring.focal_px = 140;
     sim::StudioOptions so;
     so.actor.motion = sim::Motion::walk;
-    auto studio = sim::SimulatedStudio::create(sim::ring_cameras(ring), so);
-    ASSERT_TRUE(studio) << studio.error().message;
-    for (int c = 0; c < studio->camera_count(); ++c) {
-      const Camera& cam = studio->cameras()[std::size_t(c)];
-      capture::TakeInfo info;
-      info.take = "take";
-      info.camera_id = cam.id;
-      info.width = uint32_t(cam.width);
-      info.height = uint32_t(cam.height);
-      info.period_ns = 40'000'000;
-      info.start_frame = kFirst;
-      info.calibration_yaml = yaml::format_camera(cam, 2);
-      auto rec = capture::Recorder::start(
-          {.dir = (dir_ / "take" / cam.id).string(), .queue_frames = 64}, info);
-      ASSERT_TRUE(rec) << rec.error().message;
-      for (uint64_t f = kFirst; f <= kLast; ++f) {
-        Image<Rgb8> image;
-        studio->render(c, int64_t(f), &image, nullptr);
-        ASSERT_TRUE((*rec)->push(f, int64_t(f) * 40'000'000, image.view()));
-      }
-      (*rec)->stop(kLast + 1);
-      auto done = (*rec)->wait();
-      ASSERT_TRUE(done) << done.error().message;
-    }
+    record_take(dir_ / "take", so, kLast);
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
@@ -257,6 +268,79 @@ TEST_F(HullFarm, SurfaceStage) {
   }
 }
 
+// --colour-balance (default on): a take whose cameras differ in exposure and white balance
+// (camera 2 about 20 % brighter) is equalised per frame; the gains in the JSON frame events are
+// the simulated ones (display values, the rig's mean 1); the camera far off the mean is named
+// on stderr for the operator; off: no gains, other files (the setting is in the fingerprint).
+TEST_F(HullFarm, ColourBalanceEqualisesTheCameras) {
+  sim::StudioOptions so;
+  so.actor.motion = sim::Motion::walk;
+  // The offline tests' rig (8 on the ring + overhead, 704x576): the small take's 6 cameras at
+  // 176x144 share too few surface points seen from similar angles (their gains stay 1).
+  sim::RingOptions rig;
+  rig.count = 9;
+  so.camera_response = sim::random_camera_response(9, 5, 0.05, 0.03);
+  so.camera_response[2] = {1.5, 1.5, 1.5};  // ~ +20 % in display values
+  const fs::path take = dir_ / "tinted_take";
+  record_take(take, so, 3, rig);
+  const std::string common = "--take " + take.string() +
+                             " --box -1.5,0,-1.5,1.5,2.4,1.5 --grid 128 --refine --texture"
+                             " --threads 2 --json --out ";
+  const fs::path on = dir_ / "balance_on", off = dir_ / "balance_off";
+  auto r = run(hull() + " offline " + common + on.string(), dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The simulated gains that equalise the cameras, in display values, geometric mean 1.
+  std::vector<std::array<double, 3>> want(9);
+  for (int k = 0; k < 3; ++k) {
+    double mean_log = 0;
+    for (const auto& g : so.camera_response) mean_log += std::log(g[std::size_t(k)]) / 2.2 / 9;
+    for (std::size_t c = 0; c < 9; ++c)
+      want[c][std::size_t(k)] =
+          std::exp(mean_log - std::log(so.camera_response[c][std::size_t(k)]) / 2.2);
+  }
+  int frames = 0;
+  double worst = 0;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("\"event\":\"frame\"") == std::string::npos) continue;
+    ++frames;
+    for (std::size_t c = 0; c < 9; ++c) {
+      const std::string key = "\"cam" + std::to_string(c) + "\":[";
+      const auto at = line.find(key);
+      ASSERT_NE(at, std::string::npos) << line;
+      double g[3];
+      ASSERT_EQ(std::sscanf(line.c_str() + at + key.size(), "%lf,%lf,%lf", &g[0], &g[1], &g[2]), 3)
+          << line;
+      for (int k = 0; k < 3; ++k)
+        worst = std::max(worst, std::abs(g[k] / want[c][std::size_t(k)] - 1));
+    }
+  }
+  EXPECT_EQ(frames, 4) << r.out;
+  std::printf("  colour gains vs the simulated responses: worst %.2f %% over 4 frames\n",
+              100 * worst);
+  EXPECT_LT(worst, 0.03);
+  EXPECT_NE(r.out.find("\"balance\":"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("camera cam2: colours"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("camera cam1: colours"), std::string::npos) << r.err;
+
+  r = run(hull() + " offline " + common + off.string() + " --colour-balance off", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.find("colour_gains"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("camera cam2"), std::string::npos) << r.err;
+  for (int f = 0; f <= 3; ++f) {
+    const std::string name = offline::frame_file_name("actor", f);
+    const auto a = offline::verify_frame_file((on / name).string());
+    const auto b = offline::verify_frame_file((off / name).string());
+    ASSERT_TRUE(a && b) << name;
+    EXPECT_NE(a->options, b->options) << name;
+  }
+  // Another value is refused, one line.
+  r = run(hull() + " offline " + common + off.string() + " --colour-balance maybe", dir_);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("--colour-balance"), std::string::npos) << r.err;
+}
+
 TEST_F(HullFarm, BadInputIsOneLine) {
   const fs::path out = dir_ / "bad";
   for (const std::string& a :
@@ -284,6 +368,7 @@ TEST_F(HullFarm, BadInputIsOneLine) {
   EXPECT_NE(r.out.find("--refine"), std::string::npos);
   EXPECT_NE(r.out.find("--texture"), std::string::npos);
   EXPECT_NE(r.out.find("--surface"), std::string::npos);
+  EXPECT_NE(r.out.find("--colour-balance on|off"), std::string::npos);
 }
 
 // The Slurm submission itself (no Slurm needed): one job array over the plan's shards, each task

@@ -25,6 +25,7 @@
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
 #include "keyer/config/keyer_yaml.h"
+#include "offline/colour_balance.h"
 #include "offline/frame_files.h"
 #include "offline/photo_carve.h"
 #include "offline/surface_refine.h"
@@ -49,7 +50,7 @@ constexpr const char* kUsage =
                            [--frames A:B] [--name NAME] [--fps F] [--axis x|y|z]
                            [--keyer keyer.yaml | --key blue|green] [--min-views N|all]
                            [--threshold T] [--ncc T|off] [--judges N|all]
-                           [--max-depth CELLS] [--threads N]
+                           [--max-depth CELLS] [--colour-balance on|off] [--threads N]
                            [--surface STEPS|off] [--surface-photo ITERATIONS]
                            [--json | --progress | --quiet]
        studio-hull offline --take DIR [--rig rig.yaml] --plan SHARDS   (prints A:B per shard)
@@ -74,6 +75,13 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
                     (default 3: on large rigs the grazing views' spill and light tint carve
                     the true surface); all: every camera that sees it
   --max-depth C     carving stops C cells below the hull (default 12)
+  --colour-balance on|off
+                    per frame, before carving and texturing, estimate each camera's colour gains
+                    from the hull's surface points that two cameras see and equalise the images
+                    (default on: cameras a few percent apart in exposure or white balance
+                    disagree on every bright point and the carve removes the true surface;
+                    docs/offline.md); the gains are in --json's frame events, and a camera
+                    more than 10 % off the rig's mean is named on stderr
   --surface S|off   surface stage on the mesh (after carving with --refine): S Laplacian steps
                     with the silhouette rims (the middle of each facet) anchored, each move
                     kept inside the visual hull, moving the hull's bulges between the
@@ -112,6 +120,7 @@ struct Args {
   int plan = 0;
   double fps = 25, threshold = 6, ncc = 0;
   bool patches = true;
+  bool balance = true;  // --colour-balance
   int max_depth = 12;
   int judges = offline::CarveOptions{}.max_judges;  // 0: all
   // -1: no surface stage; kSurfaceUnset until the arguments are read: --refine's default steps.
@@ -209,6 +218,9 @@ Expected<Args> parse(int argc, char** argv) {
           return fail("--judges: '" + v + "': expected 2..64 or all");
         a.judges = int(*d);
       }
+    } else if (opt == "--colour-balance") {
+      if (v != "on" && v != "off") return fail("--colour-balance: '" + v + "': expected on or off");
+      a.balance = v == "on";
     } else if (opt == "--ncc") {
       if (v == "off") {
         a.patches = false;
@@ -264,6 +276,22 @@ Expected<Args> parse(int argc, char** argv) {
   if (a.surface_photo > 0 && a.surface < 0) return fail("--surface-photo needs --surface");
   return a;
 }
+
+// {"<camera id>":[r,g,b],...}: a colour balance's gains per camera.
+std::string gains_json(const std::vector<Camera>& cameras,
+                       const std::vector<Eigen::Vector3f>& gains) {
+  std::string out = "{";
+  char buf[160];
+  for (std::size_t c = 0; c < gains.size() && c < cameras.size(); ++c) {
+    std::snprintf(buf, sizeof buf, "%s\"%s\":[%.4f,%.4f,%.4f]", c ? "," : "", cameras[c].id.c_str(),
+                  gains[c].x(), gains[c].y(), gains[c].z());
+    out += buf;
+  }
+  return out + "}";
+}
+
+// Whether the images' colours shape the output (the colour balance matters only then).
+bool uses_colour(const Args& a) { return a.refine || a.texture || a.surface_photo > 0; }
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -440,6 +468,9 @@ int run_refined(int argc, char** argv) {
       std::snprintf(buf, sizeof buf, " judges %d", a.judges);
       settings += buf;
     }
+    if (a.balance && uses_colour(a)) {  // (absent when off: earlier files keep theirs)
+      settings += " colour_balance 1";
+    }
     if (a.surface >= 0) {  // (absent when off: files made without it keep their fingerprint)
       std::snprintf(buf, sizeof buf, " surface %d photo %d inside_hull %d rim_band %.9g", a.surface,
                     a.surface_photo, int(surface.inside_hull), surface.rim_band_cells);
@@ -477,9 +508,14 @@ int run_refined(int argc, char** argv) {
   std::size_t done = 0, skipped = 0, computed = 0;
   double computed_ms = 0;
   struct Stages {
-    double read = 0, key = 0, cut = 0, carve = 0, mesh = 0, surface = 0, texture = 0, write = 0;
+    double read = 0, key = 0, cut = 0, balance = 0, carve = 0, mesh = 0, surface = 0, texture = 0,
+           write = 0;
   } total;
-  const auto report = [&](uint64_t f, bool skip, double ms) {  // under lock
+  const bool balancing = a.balance && uses_colour(a);
+  // Per camera: the sum of the estimated log gains over computed frames (the summary's mean).
+  std::vector<Eigen::Vector3d> log_gain_sum(cameras.size(), Eigen::Vector3d::Zero());
+  const auto report = [&](uint64_t f, bool skip, double ms,
+                          const std::vector<Eigen::Vector3f>& gains) {  // under lock
     ++done;
     if (skip)
       ++skipped;
@@ -492,8 +528,9 @@ int run_refined(int argc, char** argv) {
     if (a.json) {
       std::printf(
           "{\"event\":\"frame\",\"frame\":%llu,\"skipped\":%s,\"ms\":%.1f,\"done\":%zu,\"total\":%"
-          "zu,\"eta_s\":%.1f}\n",
-          (unsigned long long)f, skip ? "true" : "false", ms, done, selected.size(), eta_s);
+          "zu,\"eta_s\":%.1f%s}\n",
+          (unsigned long long)f, skip ? "true" : "false", ms, done, selected.size(), eta_s,
+          gains.empty() ? "" : (",\"colour_gains\":" + gains_json(cameras, gains)).c_str());
       std::fflush(stdout);
     }
     if (bar) {
@@ -522,7 +559,7 @@ int run_refined(int argc, char** argv) {
         if (auto ok = offline::verify_frame_file(path);
             ok && ok->frame == int64_t(f) && ok->options == tag) {
           std::lock_guard g(lock);
-          report(f, true, ms_since(t_frame));
+          report(f, true, ms_since(t_frame), {});
           continue;
         }
       }
@@ -542,7 +579,30 @@ int run_refined(int argc, char** argv) {
       if (!hull) return give_up(hull.error().message);
       s.cut = ms_since(t0);
       t0 = std::chrono::steady_clock::now();
+      // The hull's mesh: the output without --refine; with it, the colour balance's points only
+      // (its cost counted in the balance's).
       Mesh mesh;
+      const auto hull_mesh = [&]() -> Expected<void> {
+        mesh = segment_marching_cubes(*hull);
+        return refine_crossings(mesh, *hull, cut_views, cut);
+      };
+      if (!a.refine) {
+        if (auto ok = hull_mesh(); !ok) return give_up(ok.error().message);
+        s.mesh = ms_since(t0);
+        t0 = std::chrono::steady_clock::now();
+      }
+      std::vector<Image<Rgb8>> balanced;
+      std::vector<Eigen::Vector3f> gains;
+      if (balancing) {
+        if (a.refine)
+          if (auto ok = hull_mesh(); !ok) return give_up(ok.error().message);
+        auto cb = offline::estimate_colour_balance(mesh, views);
+        if (!cb) return give_up(cb.error().message);
+        views = offline::apply_colour_balance(views, *cb, &balanced);
+        gains = cb->gains;
+        s.balance = ms_since(t0);
+        t0 = std::chrono::steady_clock::now();
+      }
       if (a.refine) {
         auto carved = offline::photo_carve(*hull, views, carve);
         if (!carved) return give_up(carved.error().message);
@@ -551,13 +611,9 @@ int run_refined(int argc, char** argv) {
         auto refined = offline::refined_mesh(carved->set, *hull, views);
         if (!refined) return give_up(refined.error().message);
         mesh = std::move(*refined);
-      } else {
-        mesh = segment_marching_cubes(*hull);
-        if (auto ok = refine_crossings(mesh, *hull, cut_views, cut); !ok)
-          return give_up(ok.error().message);
+        s.mesh = ms_since(t0);
+        t0 = std::chrono::steady_clock::now();
       }
-      s.mesh = ms_since(t0);
-      t0 = std::chrono::steady_clock::now();
       if (a.surface >= 0) {
         auto refined = offline::refine_surface(mesh, views, surface);
         if (!refined) return give_up(refined.error().message);
@@ -579,10 +635,13 @@ int run_refined(int argc, char** argv) {
         return give_up(ok.error().message);
       s.write = ms_since(t0);
       std::lock_guard g(lock);
-      total.read += s.read, total.key += s.key, total.cut += s.cut, total.carve += s.carve;
+      total.read += s.read, total.key += s.key, total.cut += s.cut, total.balance += s.balance,
+          total.carve += s.carve;
+      for (std::size_t c = 0; c < gains.size(); ++c)
+        log_gain_sum[c] += gains[c].cast<double>().array().log().matrix();
       total.mesh += s.mesh, total.surface += s.surface, total.texture += s.texture,
           total.write += s.write;
-      report(f, false, ms_since(t_frame));
+      report(f, false, ms_since(t_frame), gains);
     }
   };
   {
@@ -600,6 +659,23 @@ int run_refined(int argc, char** argv) {
     std::cerr << "studio-hull: " << indexed.error().message << "\n";
     return 1;
   }
+  // The mean gains over the computed frames (geometric); a camera far off the rig's mean is worth
+  // an operator's look (its exposure, aperture or white balance), balanced or not.
+  std::vector<Eigen::Vector3f> mean_gains;
+  if (balancing && computed > 0) {
+    for (const Eigen::Vector3d& l : log_gain_sum)
+      mean_gains.push_back((l / double(computed)).array().exp().matrix().cast<float>());
+    for (std::size_t c = 0; c < mean_gains.size(); ++c) {
+      const Eigen::Vector3f& g = mean_gains[c];
+      const float off = std::max({std::abs(g.x() - 1), std::abs(g.y() - 1), std::abs(g.z() - 1)});
+      if (off > 0.10f)
+        std::fprintf(stderr,
+                     "studio-hull: camera %s: colours %.0f %% off the rig's mean (gains R %.3f G "
+                     "%.3f B %.3f, balanced before carving and texturing): check its exposure "
+                     "and white balance\n",
+                     cameras[c].id.c_str(), 100 * off, g.x(), g.y(), g.z());
+    }
+  }
   if (a.json) {
     const double n = std::max<double>(1, double(computed));
     std::printf(
@@ -607,13 +683,14 @@ int run_refined(int argc, char** argv) {
         "s,"
         "\"grid\":%d,\"cameras\":%zu,\"refine\":%s,\"texture\":%s,\"unit\":\"ms per computed "
         "frame\","
-        "\"read\":%.2f,\"key\":%.2f,\"cut\":%.2f,\"carve\":%.2f,\"mesh\":%.2f,\"surface\":%.2f,"
-        "\"texture_ms\":%.2f,"
-        "\"write\":%.2f,\"wall_ms\":%.1f}\n",
+        "\"read\":%.2f,\"key\":%.2f,\"cut\":%.2f,\"balance\":%.2f,\"carve\":%.2f,\"mesh\":%.2f,"
+        "\"surface\":%.2f,\"texture_ms\":%.2f,"
+        "\"write\":%.2f,\"wall_ms\":%.1f%s}\n",
         selected.size(), computed, skipped, *indexed ? "true" : "false", a.grid, cameras.size(),
         a.refine ? "true" : "false", a.texture ? "true" : "false", total.read / n, total.key / n,
-        total.cut / n, total.carve / n, total.mesh / n, total.surface / n, total.texture / n,
-        total.write / n, ms_since(wall0));
+        total.cut / n, total.balance / n, total.carve / n, total.mesh / n, total.surface / n,
+        total.texture / n, total.write / n, ms_since(wall0),
+        mean_gains.empty() ? "" : (",\"colour_gains\":" + gains_json(cameras, mean_gains)).c_str());
   }
   return 0;
 }

@@ -200,6 +200,7 @@ struct Shader {
   Eigen::Vector3d key, fill;  // camera frame
   double spill, ring;
   double exposure = 1;  // relative exposure (sim/projector_light.h)
+  std::array<float, 3> response{1, 1, 1};  // the camera's linear gains (StudioOptions)
   std::array<std::array<float, 3>, frame_code::kBands> code{};  // albedo of each band
   // Display colour of the hit on `part` along d at t, given the background colour behind it.
   std::array<float, 3> operator()(const CamPart& part, const Eigen::Vector3d& d, double t,
@@ -224,8 +225,8 @@ struct Shader {
     const float pattern = part.patterned && !banded ? part.pattern(p) : 1.0f;
     std::array<float, 3> out;
     for (int k = 0; k < 3; ++k) {
-      const float lin =
-          static_cast<float>(exposure) * pattern * (*albedo)[k] * (light + ring_w * kRing[k]);
+      const float lin = static_cast<float>(exposure) * response[std::size_t(k)] * pattern *
+                        (*albedo)[k] * (light + ring_w * kRing[k]);
       out[k] = kGamma(lin) * (1 - s) + back[k] * s;
     }
     return out;
@@ -501,9 +502,12 @@ void render_actor(const StudioOptions& options, const CameraCache& cam, const Pr
   const std::vector<CamPart> parts =
       to_camera(cam, frame.truth.body, 1, options.frame_code, options.patterned_costume);
   // (touched_rect below repeats this rectangle arithmetic: keep the two in step.)
-  Shader shader{cam.R * kKeyLight, cam.R * kFillLight, options.spill,
+  Shader shader{cam.R * kKeyLight,
+                cam.R * kFillLight,
+                options.spill,
                 options.ring_light * options.projector_light.ring_level,
-                options.projector_light.exposure};
+                options.projector_light.exposure,
+                cam.response};
   for (int b = 0; b < frame_code::kBands; ++b) {
     const Albedo a = frame_code::albedo(frame_code::digit(frame.truth.frame, b));
     shader.code[b] = {a.r, a.g, a.b};

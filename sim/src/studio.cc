@@ -50,6 +50,10 @@ Expected<void> StudioOptions::validate() const {
     return fail(detail::cat("aa_samples ", aa_samples, " outside [2, 64]"));
   }
   if (threads < 1 || threads > 64) return fail(detail::cat("threads ", threads, " outside [1, 64]"));
+  for (std::size_t i = 0; i < camera_response.size(); ++i)
+    for (double g : camera_response[i])
+      if (!(g >= 0.25 && g <= 4))
+        return fail(detail::cat("camera_response[", i, "]: gain ", g, " outside [0.25, 4]"));
   return projector_light.validate();
 }
 
@@ -234,6 +238,16 @@ void build_background(const StudioOptions& o, const Image<Rgb8>& projection, Cam
   if (!light.empty() || light.ring_level != 1 || light.exposure != 1) {
     detail::light_background(light, {hw, ht}, cam->camera, &cam->background, &cam->surface);
   }
+  if (cam->response != std::array<float, 3>{1, 1, 1}) {
+    // The background is display values: a linear gain g is g^(1/2.2) there (the shader's gamma).
+    float f[3];
+    for (int k = 0; k < 3; ++k) f[k] = std::pow(cam->response[std::size_t(k)], 1 / 2.2f);
+    for (Rgb8& p : cam->background.pixels()) {
+      uint8_t* c = &p.r;
+      for (int k = 0; k < 3; ++k)
+        c[k] = static_cast<uint8_t>(std::clamp(c[k] * f[k] + 0.5f, 0.0f, 255.0f));
+    }
+  }
 }
 
 uint64_t mix(uint64_t a, uint64_t b) {
@@ -295,6 +309,9 @@ struct SimulatedStudio::Impl {
     CameraCache& cache = caches[i];
     cache = CameraCache{};
     cache.camera = cameras[i];
+    if (!options.camera_response.empty())
+      for (int k = 0; k < 3; ++k)
+        cache.response[std::size_t(k)] = float(options.camera_response[i][std::size_t(k)]);
     cache.pinhole = cache.camera.distortion.is_identity();
     cache.R = cache.camera.cam_from_world.R();
     cache.t = cache.camera.cam_from_world.translation;
@@ -407,6 +424,20 @@ struct SimulatedStudio::Impl {
 };
 
 SimulatedStudio::SimulatedStudio(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+std::vector<std::array<double, 3>> random_camera_response(int cameras, uint64_t seed,
+                                                          double exposure_spread,
+                                                          double balance_spread) {
+  std::mt19937_64 rng(mix(seed, 0x5E5501));
+  std::uniform_real_distribution<double> unit(-1, 1);
+  const double e = std::clamp(exposure_spread, 0.0, 0.5), b = std::clamp(balance_spread, 0.0, 0.5);
+  std::vector<std::array<double, 3>> out(std::size_t(std::max(0, cameras)));
+  for (auto& g : out) {
+    const double exposure = 1 + e * unit(rng), red = 1 + b * unit(rng), blue = 1 + b * unit(rng);
+    g = {exposure * red, exposure, exposure * blue};
+  }
+  return out;
+}
+
 SimulatedStudio::SimulatedStudio(SimulatedStudio&&) noexcept = default;
 SimulatedStudio& SimulatedStudio::operator=(SimulatedStudio&&) noexcept = default;
 SimulatedStudio::~SimulatedStudio() = default;
@@ -415,6 +446,10 @@ Expected<SimulatedStudio> SimulatedStudio::create(std::vector<Camera> cameras,
                                                   const StudioOptions& options) {
   if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
   if (cameras.empty()) return fail("simulated studio needs at least one camera");
+  if (!options.camera_response.empty() && options.camera_response.size() != cameras.size()) {
+    return fail(detail::cat("camera_response has ", options.camera_response.size(), " entries for ",
+                            cameras.size(), " cameras"));
+  }
   std::size_t max_bytes = 0;
   for (const Camera& c : cameras) {
     const auto& k = c.intrinsics;

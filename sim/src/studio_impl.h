@@ -31,6 +31,7 @@ struct CameraCache {
   Eigen::Vector3d t;
   Eigen::Vector3d centre;             // camera centre in the world
   Image<Rgb8> background;             // noiseless empty studio
+  std::array<float, 3> response{1, 1, 1};  // StudioOptions::camera_response (linear gains)
   Image<uint8_t> surface;             // Surface per pixel
   // World (x, z) where each floor pixel's ray meets the floor (y = 0); NaN off the floor. Static
   // per camera: the per-frame shadow (apply_shadow) reads it instead of intersecting the ray.

@@ -32,6 +32,7 @@
 // cannot rule out for the pixel, and the background copy and the noise are one pass outside
 // the rectangle the actor and its shadow touch. See BENCHMARKS.md ("Simulated studio").
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -89,6 +90,11 @@ struct StudioOptions {
   // limb's twist over time), hue kept (the key is unaffected). false: plainly coloured clothing
   // (every figure so far).
   bool patterned_costume = false;
+  // Each camera's colour response: a linear-light gain per channel (R, G, B) applied to all it
+  // sees, cloth and actor (exposure, aperture and white balance: a real rig's cameras differ by a
+  // few percent per channel after white balance). Empty: every camera 1, 1, 1 (every figure so
+  // far); else one entry per camera, each gain in [0.25, 4]. random_camera_response() draws one.
+  std::vector<std::array<double, 3>> camera_response;
 
   int threads = 2;  // render_all() threads over cameras
   // The renderer as it was before issue 20's cuts (every candidate part ray cast for every
@@ -99,6 +105,14 @@ struct StudioOptions {
 
   Expected<void> validate() const;
 };
+
+// A rig's colour responses drawn from `seed`: per camera an exposure factor uniform in
+// [1 - exposure_spread, 1 + exposure_spread] times, on red and blue, a white-balance factor
+// uniform in [1 - balance_spread, 1 + balance_spread] (green: the balance's reference). Spreads
+// in [0, 0.5].
+std::vector<std::array<double, 3>> random_camera_response(int cameras, uint64_t seed,
+                                                          double exposure_spread,
+                                                          double balance_spread);
 
 // Ground truth of one frame.
 struct FrameTruth {

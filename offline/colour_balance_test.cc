@@ -1,0 +1,181 @@
+// The colour balance (offline/colour_balance.h) against the simulated studio's truth: cameras
+// whose responses differ (sim::StudioOptions::camera_response) are equalised from the frame's own
+// hull, the carve then keeps the true surface it removes without the balance, and a rig whose
+// cameras agree is left as it is.
+#include "offline/colour_balance.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "hull/crossing_refine.h"
+#include "hull/segment_mesh.h"
+#include "hull/silhouette_cut.h"
+#include "offline/photo_carve.h"
+#include "sim/cameras.h"
+#include "testing/truth.h"
+
+namespace studio::offline {
+namespace {
+
+struct Scene {
+  testing::Frame f;
+  std::vector<ColourView> views;
+  std::vector<hull::View> cut;
+  hull::SegmentSet set;
+  hull::Mesh hull_mesh;
+  std::vector<std::array<double, 3>> response;
+};
+
+// 8 ring cameras + overhead (704x576), the actor at `frame`, keyed masks, the hull at `grid`.
+Scene make_scene(sim::Motion motion, int64_t frame, std::vector<std::array<double, 3>> response,
+                 int grid) {
+  sim::RingOptions ring;
+  ring.count = 9;
+  sim::StudioOptions so;
+  so.actor.motion = motion;
+  so.camera_response = response;
+  auto studio = sim::SimulatedStudio::create(sim::ring_cameras(ring), so).value();
+  Scene s;
+  s.response = std::move(response);
+  s.f = testing::render_frame(studio, frame);
+  s.views = s.f.views();
+  for (const auto& v : s.views) s.cut.push_back({v.camera, v.mask});
+  s.set = hull::visual_hull(testing::studio_grid(grid), s.cut).value();
+  s.hull_mesh = hull::segment_marching_cubes(s.set);
+  EXPECT_TRUE(hull::refine_crossings(s.hull_mesh, s.set, s.cut));
+  return s;
+}
+
+// The gains that equalise the simulated cameras, in display values (a linear gain g is
+// g^(1/2.2) after the display transfer), geometric mean 1 per channel; and the largest relative
+// difference of `gains` from them.
+double worst_gain_error(const std::vector<std::array<double, 3>>& response,
+                        const std::vector<Eigen::Vector3f>& gains) {
+  double worst = 0;
+  for (int k = 0; k < 3; ++k) {
+    double mean_log = 0;
+    for (const auto& g : response) mean_log += std::log(g[std::size_t(k)]) / 2.2;
+    mean_log /= double(response.size());
+    for (std::size_t c = 0; c < response.size(); ++c) {
+      const double want = std::exp(mean_log - std::log(response[c][std::size_t(k)]) / 2.2);
+      worst = std::max(worst, std::abs(gains[c][k] / want - 1));
+    }
+  }
+  return worst;
+}
+
+TEST(ColourBalance, RecoversTheSimulatedCamerasResponses) {
+  // Exposure within +-10 %, white balance within +-5 % on red and blue: up to 15 grey levels
+  // apart on a bright shirt, against the carve's 6.
+  const auto response = sim::random_camera_response(9, 3, 0.10, 0.05);
+  const Scene s = make_scene(sim::Motion::idle, 10, response, 128);
+  ColourBalanceOptions o;
+  const ColourBalance cb = estimate_colour_balance(s.hull_mesh, s.views, o).value();
+  const double before =
+      worst_gain_error(response, std::vector<Eigen::Vector3f>(9, Eigen::Vector3f::Ones()));
+  const double after = worst_gain_error(response, cb.gains);
+  std::printf(
+      "  %zu points seen twice, %d pairs, residual %.4f; worst gain error %.2f %% (no "
+      "balance: %.2f %%)\n",
+      cb.points, cb.pairs, cb.residual, 100 * after, 100 * before);
+  // Measured: 1.72 % (5.88 % without the balance); the rest is view-dependent light the gains
+  // cannot model (the spill towards grazing views, each camera's own LED ring).
+  EXPECT_GT(before, 0.05);
+  EXPECT_LT(after, 0.025);
+  EXPECT_GE(cb.pairs, 16);  // the ring's neighbours and the overhead with the ring
+  o.threads = 2;
+  const ColourBalance two = estimate_colour_balance(s.hull_mesh, s.views, o).value();
+  EXPECT_EQ(two.gains, cb.gains);
+  EXPECT_EQ(two.points, cb.points);
+
+  // The balanced images: each camera's pixels multiplied by its gains.
+  std::vector<Image<Rgb8>> store;
+  const std::vector<ColourView> balanced = apply_colour_balance(s.views, cb, &store);
+  ASSERT_EQ(balanced.size(), s.views.size());
+  for (std::size_t c = 0; c < balanced.size(); ++c) {
+    const Rgb8 in = s.views[c].image.row(300)[350], out = balanced[c].image.row(300)[350];
+    EXPECT_NEAR(out.r, std::min(255.0, in.r * double(cb.gains[c].x())), 0.51);
+    EXPECT_NEAR(out.b, std::min(255.0, in.b * double(cb.gains[c].z())), 0.51);
+  }
+}
+
+// The positive control's other half: cameras that agree get gains of 1 (within the estimate's
+// noise), so the default changes nothing on a consistent rig.
+TEST(ColourBalance, LeavesAConsistentRigAlone) {
+  const Scene s = make_scene(sim::Motion::crouch, 45, {}, 128);
+  ColourBalanceOptions o;
+  const ColourBalance cb = estimate_colour_balance(s.hull_mesh, s.views, o).value();
+  float worst = 0;
+  for (const auto& g : cb.gains) worst = std::max(worst, (g.array() - 1).abs().maxCoeff());
+  std::printf("  %zu points, %d pairs, residual %.4f, largest |gain - 1| %.4f\n", cb.points,
+              cb.pairs, cb.residual, worst);
+  EXPECT_LT(worst, 0.015);  // measured 0.98 %
+}
+
+// What the balance is for: the carve on a rig whose cameras differ (exposure +-10 %, white
+// balance +-5 %) removes the true surface without it (the carved mesh farther from the truth than
+// the hull), and with it carves as on a rig whose cameras agree.
+TEST(ColourBalance, TheCarveOnDifferingCamerasNeedsIt) {
+  const auto carved_distance = [](const Scene& s, bool balance) {
+    std::vector<Image<Rgb8>> store;
+    std::vector<ColourView> views = s.views;
+    if (balance)
+      views = apply_colour_balance(s.views, estimate_colour_balance(s.hull_mesh, s.views).value(),
+                                   &store);
+    CarveOptions co;
+    co.threads = 2;
+    const CarveResult carved = photo_carve(s.set, views, co).value();
+    const hull::Mesh mesh = refined_mesh(carved.set, s.set, views, 2).value();
+    return testing::surface_distance(mesh, s.f.truth.body).both;
+  };
+  const Scene agree = make_scene(sim::Motion::idle, 10, {}, 256);
+  const Scene differ =
+      make_scene(sim::Motion::idle, 10, sim::random_camera_response(9, 3, 0.10, 0.05), 256);
+  const double hull = testing::surface_distance(differ.hull_mesh, differ.f.truth.body).both.mean;
+  const testing::Distances reference = carved_distance(agree, false);
+  const testing::Distances without = carved_distance(differ, false);
+  const testing::Distances with = carved_distance(differ, true);
+  std::printf(
+      "  surface distance mean / p95 (mm): hull %.2f; carved, cameras agreeing %.2f / "
+      "%.2f; differing %.2f / %.2f, balanced %.2f / %.2f\n",
+      1e3 * hull, 1e3 * reference.mean, 1e3 * reference.p95, 1e3 * without.mean, 1e3 * without.p95,
+      1e3 * with.mean, 1e3 * with.p95);
+  EXPECT_GT(without.mean, hull);  // measured 5.92 against 5.73 mm
+  EXPECT_LT(with.mean, 0.92 * hull);
+  EXPECT_LT(with.mean, 1.02 * reference.mean);
+  EXPECT_LT(with.p95, 1.03 * reference.p95);
+}
+
+TEST(ColourBalance, RefusesBadInputAndKeepsUnlinkedCamerasAtOne) {
+  const Scene s = make_scene(sim::Motion::idle, 10, {}, 64);
+  ColourBalanceOptions bad;
+  bad.min_level = 300;
+  auto r = estimate_colour_balance(s.hull_mesh, s.views, bad);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
+  EXPECT_FALSE(estimate_colour_balance(s.hull_mesh, {}));
+  std::vector<ColourView> wrong = s.views;
+  wrong[2].image =
+      ImageView<const Rgb8>(wrong[2].image.data(), 100, 100, wrong[2].image.stride_bytes());
+  auto w = estimate_colour_balance(s.hull_mesh, wrong);
+  ASSERT_FALSE(w);
+  EXPECT_NE(w.error().message.find("image is 100x100"), std::string::npos) << w.error().message;
+  // An empty mesh: no points, no pairs, every gain 1; so is a camera no pair reaches.
+  const ColourBalance none = estimate_colour_balance(hull::Mesh{}, s.views).value();
+  EXPECT_EQ(none.points, 0u);
+  EXPECT_EQ(none.pairs, 0);
+  for (const auto& g : none.gains) EXPECT_EQ(g, Eigen::Vector3f::Ones());
+  ColourBalanceOptions strict;
+  strict.min_samples = 1 << 30;
+  const ColourBalance unlinked = estimate_colour_balance(s.hull_mesh, s.views, strict).value();
+  EXPECT_GT(unlinked.points, 0u);
+  for (const auto& g : unlinked.gains) EXPECT_EQ(g, Eigen::Vector3f::Ones());
+  std::vector<Image<Rgb8>> store;
+  const auto same = apply_colour_balance(s.views, unlinked, &store);
+  EXPECT_TRUE(store.empty());
+  EXPECT_EQ(same[0].image.data(), s.views[0].image.data());
+}
+
+}  // namespace
+}  // namespace studio::offline

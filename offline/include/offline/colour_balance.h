@@ -1,0 +1,72 @@
+#pragma once
+// Per-camera colour balance for the photo-consistency test and the texture blend (beyond the
+// paper). A real rig's cameras differ in exposure, aperture and white balance by a few percent
+// per channel even after white balancing; the carve's colour test allows a spread of 6 grey
+// levels (CarveOptions::threshold), so a camera 5 % brighter than its neighbours disagrees with
+// them on every bright surface point and the carve removes the true surface. The texture blend
+// shows the same difference as seams where the most frontal camera changes.
+//
+// Estimated from the frame itself, no chart needed: every surface point of a mesh (the visual
+// hull) seen by two cameras under the carve's spill rules (in front, facing at cos >= min_cos,
+// not hidden by the mesh, sampled edge_margin_px inside the silhouette) at similar angles gives,
+// per camera pair and channel, the log ratio of their colours. Per pair the median of those ratios
+// (phantom points of the hull see different surfaces in the two cameras, albedo edges and the
+// cameras' own ring-light tint differ both ways: the median keeps the common factor); the gains are
+// the least-squares solution of the pairwise medians over the camera graph, weighted by the pairs'
+// sample counts, per connected set of cameras with a geometric mean of 1 per channel (the rig's
+// average response). A linear gain in the sensor is a factor in display values too (the power
+// law of the display transfer keeps products), so the gains apply to the 8-bit colours directly.
+// Cameras that share no surface with another (fewer than min_samples points) keep gain 1.
+
+#include <Eigen/Core>
+#include <span>
+#include <vector>
+
+#include "core/error.h"
+#include "core/image.h"
+#include "hull/segment_mesh.h"
+#include "offline/photo_carve.h"
+
+namespace studio::offline {
+
+struct ColourBalanceOptions {
+  double min_cos = 0.5;           // the carve's facing test (grazing views carry spill)
+  int edge_margin_px = 2;         // samples this far inside the silhouette (spill, edge)
+  double depth_tolerance = 0.02;  // metres: visibility slack against the mesh's depth buffers
+  // A point is compared between two cameras only where they see it at similar angles
+  // (|cos_i - cos_j| <= this): each camera's own LED ring lights what faces it, and the spill
+  // grows towards grazing views, so points seen frontally by one camera and obliquely by the
+  // other are brighter (bluer) in the first by the viewing geometry, not by the camera.
+  double max_cos_difference = 0.25;
+  int min_samples = 30;    // per camera pair: fewer shared points, the pair is not used
+  double min_level = 16;   // channel values below (noise dominates) or above (clipping)
+  double max_level = 250;  // are not compared
+  double max_gain = 2;     // estimated gains are clamped to [1 / max_gain, max_gain]
+  int threads = 1;
+  Expected<void> validate() const;
+};
+
+struct ColourBalance {
+  // Per view (in the order given): multiply its colours by these (R, G, B) factors.
+  std::vector<Eigen::Vector3f> gains;
+  std::size_t points = 0;  // mesh vertices seen by two or more cameras
+  int pairs = 0;           // camera pairs with >= min_samples shared points (the graph's edges)
+  // Median over the used pairs and channels of |log ratio| after the gains: what is left
+  // between cameras (0 for a consistent rig; the spread of the data otherwise).
+  double residual = 0;
+};
+
+// Fails on invalid options, no views or a view whose image or mask size differs from its camera.
+// `mesh` needs no normals (computed here). Independent of options.threads.
+Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
+                                                std::span<const ColourView> views,
+                                                const ColourBalanceOptions& options = {});
+
+// The views with their images multiplied by the gains (rounded, clamped to 0..255). `images`
+// holds the new pixels (the returned views point into it: keep it alive and unmoved); a view
+// whose gains are all exactly 1 keeps its own image.
+std::vector<ColourView> apply_colour_balance(std::span<const ColourView> views,
+                                             const ColourBalance& balance,
+                                             std::vector<Image<Rgb8>>* images);
+
+}  // namespace studio::offline
