@@ -84,6 +84,7 @@ TEST(ColourBalance, RecoversTheSimulatedCamerasResponses) {
   EXPECT_GT(before, 0.05);
   EXPECT_LT(after, 0.025);
   EXPECT_GE(cb.pairs, 16);  // the ring's neighbours and the overhead with the ring
+  EXPECT_EQ(cb.gains, cb.estimated);  // beyond the tolerance: applied
   o.threads = 2;
   const ColourBalance two = estimate_colour_balance(s.hull_mesh, s.views, o).value();
   EXPECT_EQ(two.gains, cb.gains);
@@ -107,10 +108,15 @@ TEST(ColourBalance, LeavesAConsistentRigAlone) {
   ColourBalanceOptions o;
   const ColourBalance cb = estimate_colour_balance(s.hull_mesh, s.views, o).value();
   float worst = 0;
-  for (const auto& g : cb.gains) worst = std::max(worst, (g.array() - 1).abs().maxCoeff());
+  for (const auto& g : cb.estimated) worst = std::max(worst, (g.array() - 1).abs().maxCoeff());
   std::printf("  %zu points, %d pairs, residual %.4f, largest |gain - 1| %.4f\n", cb.points,
               cb.pairs, cb.residual, worst);
   EXPECT_LT(worst, 0.015);  // measured 0.98 %
+  // Within the tolerance (4 %): the images are left as they are.
+  for (const auto& g : cb.gains) EXPECT_EQ(g, Eigen::Vector3f::Ones());
+  ColourBalanceOptions strict;
+  strict.tolerance = 0;
+  EXPECT_EQ(estimate_colour_balance(s.hull_mesh, s.views, strict).value().gains, cb.estimated);
 }
 
 // What the balance is for: the carve on a rig whose cameras differ (exposure +-10 %, white
@@ -121,8 +127,8 @@ TEST(ColourBalance, TheCarveOnDifferingCamerasNeedsIt) {
     std::vector<Image<Rgb8>> store;
     std::vector<ColourView> views = s.views;
     if (balance)
-      views = apply_colour_balance(s.views, estimate_colour_balance(s.hull_mesh, s.views).value(),
-                                   &store);
+      views = apply_colour_balance(  // as studio-hull offline: its own hull at 128 columns
+          s.views, estimate_colour_balance(testing::studio_grid(256), s.views).value(), &store);
     CarveOptions co;
     co.threads = 2;
     const CarveResult carved = photo_carve(s.set, views, co).value();
@@ -161,6 +167,7 @@ TEST(ColourBalance, RefusesBadInputAndKeepsUnlinkedCamerasAtOne) {
   auto w = estimate_colour_balance(s.hull_mesh, wrong);
   ASSERT_FALSE(w);
   EXPECT_NE(w.error().message.find("image is 100x100"), std::string::npos) << w.error().message;
+  EXPECT_FALSE(estimate_colour_balance(testing::studio_grid(64), s.views, {}, 0));
   // An empty mesh: no points, no pairs, every gain 1; so is a camera no pair reaches.
   const ColourBalance none = estimate_colour_balance(hull::Mesh{}, s.views).value();
   EXPECT_EQ(none.points, 0u);

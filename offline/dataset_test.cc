@@ -109,12 +109,12 @@ TEST(ColourBalanceDino, RecoversGainsAppliedToRealImages) {
   double worst = 0, worst_own = 0;
   for (int c = 0; c < 3; ++c) {
     double mean_log = 0;
-    for (std::size_t k = 0; k < n; ++k) mean_log += std::log(est.gains[k][c] * applied[k][c]);
+    for (std::size_t k = 0; k < n; ++k) mean_log += std::log(est.estimated[k][c] * applied[k][c]);
     mean_log /= double(n);
     for (std::size_t k = 0; k < n; ++k) {
-      const double combined = std::exp(std::log(est.gains[k][c] * applied[k][c]) - mean_log);
-      worst = std::max(worst, std::abs(combined / own.gains[k][c] - 1));
-      worst_own = std::max(worst_own, double(std::abs(own.gains[k][c] - 1)));
+      const double combined = std::exp(std::log(est.estimated[k][c] * applied[k][c]) - mean_log);
+      worst = std::max(worst, std::abs(combined / own.estimated[k][c] - 1));
+      worst_own = std::max(worst_own, double(std::abs(own.estimated[k][c] - 1)));
     }
   }
   std::printf(

@@ -10,7 +10,7 @@
 // CARVE_MAX_JUDGES / CARVE_MIN_COS / CARVE_THRESHOLD (the carve's CarveOptions, default otherwise),
 // RESPONSE=E,B[,SEED] (the cameras' colour responses differ: sim::random_camera_response with
 // exposure spread E and white-balance spread B), BALANCE=0 (no colour balance before the carve),
-// BALANCE_COS_DIFF (ColourBalanceOptions::max_cos_difference).
+// BALANCE_COS_DIFF / BALANCE_TOL (ColourBalanceOptions::max_cos_difference / tolerance).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -121,8 +121,13 @@ int main(int argc, char** argv) {
       ColourBalanceOptions bo;
       bo.threads = 2;
       if (const char* d = std::getenv("BALANCE_COS_DIFF")) bo.max_cos_difference = std::atof(d);
+      if (const char* t = std::getenv("BALANCE_TOL")) bo.tolerance = std::atof(t);
       const auto t0 = std::chrono::steady_clock::now();
-      const ColourBalance cb = estimate_colour_balance(p.hull_mesh, p.views, bo).value();
+      hull::CutOptions cut_options;
+      cut_options.threads = 2;
+      const ColourBalance cb =
+          estimate_colour_balance(testing::studio_grid(grid), p.views, cut_options, 128, bo)
+              .value();
       const double ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       p.views = apply_colour_balance(p.views, cb, &p.balanced);
@@ -136,12 +141,17 @@ int main(int argc, char** argv) {
           mean_log /= double(cams.size());
           for (std::size_t c = 0; c < cams.size(); ++c) {
             const double want = std::exp(mean_log - std::log(so.camera_response[c][k]) / 2.2);
-            worst = std::max(worst, std::abs(cb.gains[c][k] / want - 1));
+            worst = std::max(worst, std::abs(cb.estimated[c][k] / want - 1));
           }
         }
+      float largest = 0;
+      for (const auto& g : cb.estimated)
+        largest = std::max(largest, (g.array() - 1).abs().maxCoeff());
       std::printf(
-          "  balance: %zu points, %d pairs, residual %.4f, worst gain error %.2f %% (%.0f ms)\n",
-          cb.points, cb.pairs, cb.residual, 100 * worst, ms);
+          "  balance (%s): %zu points, %d pairs, residual %.4f, largest |gain - 1| %.2f %%, worst "
+          "gain error %.2f %% (%.0f ms)\n",
+          cb.gains == cb.estimated ? "applied" : "within the tolerance", cb.points, cb.pairs,
+          cb.residual, 100 * largest, 100 * worst, ms);
     }
     CarveOptions co;
     co.threads = 2;

@@ -316,6 +316,7 @@ TEST_F(HullFarm, ColourBalanceEqualisesTheCameras) {
     }
   }
   EXPECT_EQ(frames, 4) << r.out;
+  EXPECT_NE(r.out.find("\"colour_balanced_frames\":4"), std::string::npos) << r.out;
   std::printf("  colour gains vs the simulated responses: worst %.2f %% over 4 frames\n",
               100 * worst);
   EXPECT_LT(worst, 0.03);

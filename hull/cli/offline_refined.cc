@@ -77,11 +77,12 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
   --max-depth C     carving stops C cells below the hull (default 12)
   --colour-balance on|off
                     per frame, before carving and texturing, estimate each camera's colour gains
-                    from the hull's surface points that two cameras see and equalise the images
-                    (default on: cameras a few percent apart in exposure or white balance
-                    disagree on every bright point and the carve removes the true surface;
-                    docs/offline.md); the gains are in --json's frame events, and a camera
-                    more than 10 % off the rig's mean is named on stderr
+                    from the hull's surface points that two cameras see, and equalise the images
+                    when some camera is more than 4 % off the rig's mean (default on: cameras
+                    5-10 % apart in exposure or white balance disagree on every bright point and
+                    the carve removes the true surface; docs/offline.md); --json's frame events
+                    carry the gains and whether they were applied, and a camera more than 10 %
+                    off the mean over the job is named on stderr
   --surface S|off   surface stage on the mesh (after carving with --refine): S Laplacian steps
                     with the silhouette rims (the middle of each facet) anchored, each move
                     kept inside the visual hull, moving the hull's bulges between the
@@ -514,8 +515,10 @@ int run_refined(int argc, char** argv) {
   const bool balancing = a.balance && uses_colour(a);
   // Per camera: the sum of the estimated log gains over computed frames (the summary's mean).
   std::vector<Eigen::Vector3d> log_gain_sum(cameras.size(), Eigen::Vector3d::Zero());
+  std::size_t balanced_frames = 0;  // frames whose images the balance changed
   const auto report = [&](uint64_t f, bool skip, double ms,
-                          const std::vector<Eigen::Vector3f>& gains) {  // under lock
+                          const std::vector<Eigen::Vector3f>& gains,
+                          bool applied) {  // under lock
     ++done;
     if (skip)
       ++skipped;
@@ -530,7 +533,10 @@ int run_refined(int argc, char** argv) {
           "{\"event\":\"frame\",\"frame\":%llu,\"skipped\":%s,\"ms\":%.1f,\"done\":%zu,\"total\":%"
           "zu,\"eta_s\":%.1f%s}\n",
           (unsigned long long)f, skip ? "true" : "false", ms, done, selected.size(), eta_s,
-          gains.empty() ? "" : (",\"colour_gains\":" + gains_json(cameras, gains)).c_str());
+          gains.empty() ? ""
+                        : (",\"colour_gains\":" + gains_json(cameras, gains) +
+                           ",\"colour_balanced\":" + (applied ? "true" : "false"))
+                              .c_str());
       std::fflush(stdout);
     }
     if (bar) {
@@ -559,7 +565,7 @@ int run_refined(int argc, char** argv) {
         if (auto ok = offline::verify_frame_file(path);
             ok && ok->frame == int64_t(f) && ok->options == tag) {
           std::lock_guard g(lock);
-          report(f, true, ms_since(t_frame), {});
+          report(f, true, ms_since(t_frame), {}, false);
           continue;
         }
       }
@@ -579,27 +585,23 @@ int run_refined(int argc, char** argv) {
       if (!hull) return give_up(hull.error().message);
       s.cut = ms_since(t0);
       t0 = std::chrono::steady_clock::now();
-      // The hull's mesh: the output without --refine; with it, the colour balance's points only
-      // (its cost counted in the balance's).
       Mesh mesh;
-      const auto hull_mesh = [&]() -> Expected<void> {
+      if (!a.refine) {  // the hull's mesh is the output
         mesh = segment_marching_cubes(*hull);
-        return refine_crossings(mesh, *hull, cut_views, cut);
-      };
-      if (!a.refine) {
-        if (auto ok = hull_mesh(); !ok) return give_up(ok.error().message);
+        if (auto ok = refine_crossings(mesh, *hull, cut_views, cut); !ok)
+          return give_up(ok.error().message);
         s.mesh = ms_since(t0);
         t0 = std::chrono::steady_clock::now();
       }
       std::vector<Image<Rgb8>> balanced;
-      std::vector<Eigen::Vector3f> gains;
+      std::vector<Eigen::Vector3f> gains;  // the estimate (reported)
+      bool applied = false;                // ... and whether the images were balanced by it
       if (balancing) {
-        if (a.refine)
-          if (auto ok = hull_mesh(); !ok) return give_up(ok.error().message);
-        auto cb = offline::estimate_colour_balance(mesh, views);
+        auto cb = offline::estimate_colour_balance(grid, views, cut);
         if (!cb) return give_up(cb.error().message);
         views = offline::apply_colour_balance(views, *cb, &balanced);
-        gains = cb->gains;
+        gains = cb->estimated;
+        applied = cb->gains == cb->estimated;
         s.balance = ms_since(t0);
         t0 = std::chrono::steady_clock::now();
       }
@@ -641,7 +643,8 @@ int run_refined(int argc, char** argv) {
         log_gain_sum[c] += gains[c].cast<double>().array().log().matrix();
       total.mesh += s.mesh, total.surface += s.surface, total.texture += s.texture,
           total.write += s.write;
-      report(f, false, ms_since(t_frame), gains);
+      balanced_frames += applied;
+      report(f, false, ms_since(t_frame), gains, applied);
     }
   };
   {
@@ -690,7 +693,10 @@ int run_refined(int argc, char** argv) {
         a.refine ? "true" : "false", a.texture ? "true" : "false", total.read / n, total.key / n,
         total.cut / n, total.balance / n, total.carve / n, total.mesh / n, total.surface / n,
         total.texture / n, total.write / n, ms_since(wall0),
-        mean_gains.empty() ? "" : (",\"colour_gains\":" + gains_json(cameras, mean_gains)).c_str());
+        mean_gains.empty() ? ""
+                           : (",\"colour_gains\":" + gains_json(cameras, mean_gains) +
+                              ",\"colour_balanced_frames\":" + std::to_string(balanced_frames))
+                                 .c_str());
   }
   return 0;
 }

@@ -6,6 +6,7 @@
 #include <mutex>
 #include <numeric>
 
+#include "hull/crossing_refine.h"
 #include "offline/view_sampling.h"
 #include "parallel_for.h"
 
@@ -23,6 +24,7 @@ Expected<void> ColourBalanceOptions::validate() const {
   if (!(min_level >= 1 && max_level > min_level && max_level <= 255))
     return fail("colour balance: need 1 <= min_level < max_level <= 255");
   if (!(max_gain > 1 && max_gain <= 16)) return fail("colour balance: max_gain outside (1, 16]");
+  if (!(tolerance >= 0 && tolerance < 1)) return fail("colour balance: tolerance outside [0, 1)");
   if (threads < 1 || threads > 64) return fail("colour balance: threads outside [1, 64]");
   return {};
 }
@@ -174,7 +176,32 @@ Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
           float(std::abs(e.m[std::size_t(k)] + log_gain[std::size_t(e.i)][std::size_t(k)] -
                          log_gain[std::size_t(e.j)][std::size_t(k)])));
   out.residual = left.empty() ? 0 : median(left);
+  out.estimated = out.gains;
+  if (std::all_of(out.gains.begin(), out.gains.end(), [&](const Eigen::Vector3f& g) {
+        return (g.array() - 1).abs().maxCoeff() <= float(options.tolerance);
+      }))
+    for (Eigen::Vector3f& g : out.gains) g = Eigen::Vector3f::Ones();
   return out;
+}
+
+Expected<ColourBalance> estimate_colour_balance(const hull::GridSpec& grid,
+                                                std::span<const ColourView> views,
+                                                const hull::CutOptions& cut, int columns,
+                                                const ColourBalanceOptions& options) {
+  if (columns < 1) return fail("colour balance: columns must be >= 1");
+  hull::GridSpec coarse = grid;
+  coarse.cells_u = std::min(grid.cells_u, columns);
+  coarse.cells_v = std::min(grid.cells_v, columns);
+  std::vector<hull::View> silhouettes;
+  for (const ColourView& v : views) silhouettes.push_back({v.camera, v.mask});
+  auto set = hull::visual_hull(coarse, silhouettes, cut);
+  if (!set) return std::unexpected(set.error());
+  hull::MeshOptions mo;
+  mo.normals = false;  // estimate_colour_balance computes its own
+  hull::Mesh mesh = hull::segment_marching_cubes(*set, mo);
+  if (auto ok = hull::refine_crossings(mesh, *set, silhouettes, cut, false); !ok)
+    return std::unexpected(ok.error());
+  return estimate_colour_balance(mesh, views, options);
 }
 
 std::vector<ColourView> apply_colour_balance(std::span<const ColourView> views,

@@ -25,6 +25,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "hull/segment_mesh.h"
+#include "hull/silhouette_cut.h"
 #include "offline/photo_carve.h"
 
 namespace studio::offline {
@@ -42,13 +43,22 @@ struct ColourBalanceOptions {
   double min_level = 16;   // channel values below (noise dominates) or above (clipping)
   double max_level = 250;  // are not compared
   double max_gain = 2;     // estimated gains are clamped to [1 / max_gain, max_gain]
+  // When every camera's estimated gains lie within 1 +- tolerance the rig is left as it is (all
+  // gains 1): that close, the estimate's own error (the view-dependent light above: up to ~3-4 %
+  // on the simulated rig whose cameras agree) is as large as the differences, and the carve
+  // tolerates them; otherwise every camera is corrected (leaving the cameras within the tolerance
+  // alone left their few percent against the corrected ones and cost the carve more than it
+  // gained). Measured: docs/offline.md, "Colour balance".
+  double tolerance = 0.04;
   int threads = 1;
   Expected<void> validate() const;
 };
 
 struct ColourBalance {
-  // Per view (in the order given): multiply its colours by these (R, G, B) factors.
+  // Per view (in the order given): multiply its colours by these (R, G, B) factors: the
+  // estimate, or all 1 when the whole rig lies within the tolerance.
   std::vector<Eigen::Vector3f> gains;
+  std::vector<Eigen::Vector3f> estimated;  // per view, before the tolerance
   std::size_t points = 0;  // mesh vertices seen by two or more cameras
   int pairs = 0;           // camera pairs with >= min_samples shared points (the graph's edges)
   // Median over the used pairs and channels of |log ratio| after the gains: what is left
@@ -60,6 +70,14 @@ struct ColourBalance {
 // `mesh` needs no normals (computed here). Independent of options.threads.
 Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
                                                 std::span<const ColourView> views,
+                                                const ColourBalanceOptions& options = {});
+
+// The same from the views' own visual hull over `grid`, cut at no more than `columns` columns
+// per axis (the gains need surface points, not detail: 128 columns estimate them as well as 256
+// at a quarter of the mesh; BENCHMARKS.md) with `cut`'s visibility policy and exact crossings.
+Expected<ColourBalance> estimate_colour_balance(const hull::GridSpec& grid,
+                                                std::span<const ColourView> views,
+                                                const hull::CutOptions& cut = {}, int columns = 128,
                                                 const ColourBalanceOptions& options = {});
 
 // The views with their images multiplied by the gains (rounded, clamped to 0..255). `images`
