@@ -3,7 +3,9 @@
 // variant: the product (per-vertex colour on the hull, the carved and the surface-refined mesh),
 // the same blend per sub-pixel on the refined mesh, and on the TRUE surface (the oracle).
 // Usage: offline_texture_sweep "variant;variant;..." where a variant is key=value,... (keys:
-// min_cos, margin, slack, sharp); POSES=0123456 selects poses (0, 1: refine_test's pair).
+// min_cos, margin, slack, sharp); POSES=0123456 selects poses (0, 1: refine_test's pair);
+// RESPONSE=E,B[,SEED]: the rig's cameras differ in colour response (sim::random_camera_response;
+// the held-out camera keeps 1, 1, 1); BALANCE=0: no colour balance (offline/colour_balance.h).
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -12,6 +14,7 @@
 #include "hull/crossing_refine.h"
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
+#include "offline/colour_balance.h"
 #include "offline/photo_carve.h"
 #include "offline/surface_refine.h"
 #include "offline/texture.h"
@@ -49,6 +52,7 @@ std::vector<Camera> rig() {
 struct Prepared {
   testing::Frame f;
   std::vector<ColourView> views;
+  std::vector<Image<Rgb8>> balanced;  // the images after the colour balance
   hull::Mesh hull_mesh, carved_mesh, refined_mesh, truth_mesh;
   Image<Rgb8> plate;
   Mask true_mask;
@@ -74,11 +78,23 @@ int main(int argc, char** argv) {
     sim::StudioOptions so;
     so.actor.motion = poses[i].motion;
     so.actor.seed = poses[i].seed;
+    if (const char* r = std::getenv("RESPONSE")) {  // the held-out camera (last) keeps 1, 1, 1
+      double e = 0, b = 0;
+      unsigned long long seed = 1;
+      std::sscanf(r, "%lf,%lf,%llu", &e, &b, &seed);
+      so.camera_response = sim::random_camera_response(int(rig().size()), seed, e, b);
+      so.camera_response.back() = {1, 1, 1};
+    }
     auto studio = sim::SimulatedStudio::create(rig(), so).value();
     Prepared& p = prep[i];
     p.f = testing::render_frame(studio, poses[i].frame);
     p.views = p.f.views();
     p.views.pop_back();
+    if (!std::getenv("BALANCE") || std::atoi(std::getenv("BALANCE")) != 0) {
+      const ColourBalance cb = estimate_colour_balance(testing::studio_grid(grid), p.views).value();
+      p.views = apply_colour_balance(p.views, cb, &p.balanced);
+      std::printf("  balance %s\n", cb.gains == cb.estimated ? "applied" : "within the tolerance");
+    }
     const int held = int(p.f.cameras.size()) - 1;
     studio.render(held, poses[i].frame, nullptr, &p.true_mask);
     p.plate = studio.background(held);
