@@ -47,21 +47,14 @@ Scene make_scene(sim::Motion motion, int64_t frame, std::vector<std::array<doubl
   return s;
 }
 
-// The gains that equalise the simulated cameras, in display values (a linear gain g is
-// g^(1/2.2) after the display transfer), geometric mean 1 per channel; and the largest relative
-// difference of `gains` from them.
+// The largest relative difference of `gains` from the simulated ones (sim::balancing_gains).
 double worst_gain_error(const std::vector<std::array<double, 3>>& response,
                         const std::vector<Eigen::Vector3f>& gains) {
+  const auto want = sim::balancing_gains(response);
   double worst = 0;
-  for (int k = 0; k < 3; ++k) {
-    double mean_log = 0;
-    for (const auto& g : response) mean_log += std::log(g[std::size_t(k)]) / 2.2;
-    mean_log /= double(response.size());
-    for (std::size_t c = 0; c < response.size(); ++c) {
-      const double want = std::exp(mean_log - std::log(response[c][std::size_t(k)]) / 2.2);
-      worst = std::max(worst, std::abs(gains[c][k] / want - 1));
-    }
-  }
+  for (std::size_t c = 0; c < want.size(); ++c)
+    for (int k = 0; k < 3; ++k)
+      worst = std::max(worst, std::abs(gains[c][k] / want[c][std::size_t(k)] - 1));
   return worst;
 }
 

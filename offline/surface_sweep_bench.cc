@@ -134,16 +134,10 @@ int main(int argc, char** argv) {
       // Against the truth: the display-space gains (g^(1/2.2)) that equalise the cameras,
       // geometric mean 1 per channel; the worst camera and channel.
       double worst = 0;
-      if (!so.camera_response.empty())
-        for (int k = 0; k < 3; ++k) {
-          double mean_log = 0;
-          for (const auto& g : so.camera_response) mean_log += std::log(g[k]) / 2.2;
-          mean_log /= double(cams.size());
-          for (std::size_t c = 0; c < cams.size(); ++c) {
-            const double want = std::exp(mean_log - std::log(so.camera_response[c][k]) / 2.2);
-            worst = std::max(worst, std::abs(cb.estimated[c][k] / want - 1));
-          }
-        }
+      const auto want = sim::balancing_gains(so.camera_response);
+      for (std::size_t c = 0; c < want.size(); ++c)
+        for (int k = 0; k < 3; ++k)
+          worst = std::max(worst, std::abs(cb.estimated[c][k] / want[c][std::size_t(k)] - 1));
       float largest = 0;
       for (const auto& g : cb.estimated)
         largest = std::max(largest, (g.array() - 1).abs().maxCoeff());

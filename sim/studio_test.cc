@@ -469,6 +469,13 @@ TEST(SimStudio, CameraResponseScalesWhatThatCameraSees) {
     EXPECT_GE(g[0] / g[1], 0.96);
     EXPECT_LE(g[2] / g[1], 1.04);
   }
+  // The balance's truth: display factors to the geometric mean (here of two cameras).
+  const auto bal = balancing_gains({{1.21, 1, 0.81}, {1, 1, 1}});
+  ASSERT_EQ(bal.size(), 2u);
+  EXPECT_NEAR(bal[0][0], std::pow(1.1 / 1.21, 1 / 2.2), 1e-12);
+  EXPECT_NEAR(bal[1][0], std::pow(1.1, 1 / 2.2), 1e-12);
+  EXPECT_NEAR(bal[0][1], 1, 1e-12);
+  EXPECT_NEAR(bal[0][2] * bal[1][2], 1, 1e-12);
   StudioOptions bad;
   bad.camera_response.assign(5, {1, 1, 1});  // 6 cameras
   auto r5 = SimulatedStudio::create(ring_cameras(), bad);

@@ -289,15 +289,7 @@ TEST_F(HullFarm, ColourBalanceEqualisesTheCameras) {
   const fs::path on = dir_ / "balance_on", off = dir_ / "balance_off";
   auto r = run(hull() + " offline " + common + on.string(), dir_);
   ASSERT_EQ(r.code, 0) << r.err;
-  // The simulated gains that equalise the cameras, in display values, geometric mean 1.
-  std::vector<std::array<double, 3>> want(9);
-  for (int k = 0; k < 3; ++k) {
-    double mean_log = 0;
-    for (const auto& g : so.camera_response) mean_log += std::log(g[std::size_t(k)]) / 2.2 / 9;
-    for (std::size_t c = 0; c < 9; ++c)
-      want[c][std::size_t(k)] =
-          std::exp(mean_log - std::log(so.camera_response[c][std::size_t(k)]) / 2.2);
-  }
+  const std::vector<std::array<double, 3>> want = sim::balancing_gains(so.camera_response);
   int frames = 0;
   double worst = 0;
   std::istringstream lines(r.out);

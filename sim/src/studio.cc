@@ -438,6 +438,19 @@ std::vector<std::array<double, 3>> random_camera_response(int cameras, uint64_t 
   return out;
 }
 
+std::vector<std::array<double, 3>> balancing_gains(
+    const std::vector<std::array<double, 3>>& camera_response) {
+  std::vector<std::array<double, 3>> out(camera_response.size());
+  for (std::size_t k = 0; k < 3; ++k) {
+    double mean_log = 0;
+    for (const auto& g : camera_response) mean_log += std::log(g[k]);
+    mean_log /= double(std::max<std::size_t>(1, camera_response.size()));
+    for (std::size_t c = 0; c < out.size(); ++c)
+      out[c][k] = std::exp((mean_log - std::log(camera_response[c][k])) / 2.2);
+  }
+  return out;
+}
+
 SimulatedStudio::SimulatedStudio(SimulatedStudio&&) noexcept = default;
 SimulatedStudio& SimulatedStudio::operator=(SimulatedStudio&&) noexcept = default;
 SimulatedStudio::~SimulatedStudio() = default;

@@ -114,6 +114,12 @@ std::vector<std::array<double, 3>> random_camera_response(int cameras, uint64_t 
                                                           double exposure_spread,
                                                           double balance_spread);
 
+// The truth a colour balance is scored against: per camera the factors on its 8-bit (display)
+// values that bring it to the rig's geometric mean per channel, i.e. (mean / g)^(1/2.2) for
+// linear gains g (the display transfer's power law turns a linear gain into its 1/2.2 power).
+std::vector<std::array<double, 3>> balancing_gains(
+    const std::vector<std::array<double, 3>>& camera_response);
+
 // Ground truth of one frame.
 struct FrameTruth {
   int64_t frame = 0;
