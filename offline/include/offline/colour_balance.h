@@ -16,7 +16,9 @@
 // sample counts, per connected set of cameras with a geometric mean of 1 per channel (the rig's
 // average response). A linear gain in the sensor is a factor in display values too (the power
 // law of the display transfer keeps products), so the gains apply to the 8-bit colours directly.
-// Cameras that share no surface with another (fewer than min_samples points) keep gain 1.
+// Cameras that share no surface with another (fewer than min_samples points) keep gain 1. The
+// gains are applied only when some camera's estimate lies beyond the tolerance (below): a rig
+// whose cameras agree is left as it is.
 
 #include <Eigen/Core>
 #include <span>
