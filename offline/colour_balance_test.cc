@@ -94,6 +94,36 @@ TEST(ColourBalance, RecoversTheSimulatedCamerasResponses) {
   }
 }
 
+// A take's estimate pools its frames' shared points (ColourBalanceEstimator): the counts add up,
+// and three walk frames give the gains as well as one frame does.
+TEST(ColourBalance, PooledOverTheFramesOfATake) {
+  const auto response = sim::random_camera_response(9, 3, 0.10, 0.05);
+  ColourBalanceEstimator take(9);
+  std::size_t points = 0;
+  double worst_single = 0;
+  for (const int64_t frame : {5, 35, 65}) {
+    const Scene s = make_scene(sim::Motion::walk, frame, response, 128);
+    ASSERT_TRUE(take.add(s.hull_mesh, s.views));
+    const ColourBalance one = estimate_colour_balance(s.hull_mesh, s.views).value();
+    points += one.points;
+    worst_single = std::max(worst_single, worst_gain_error(response, one.estimated));
+  }
+  const ColourBalance pooled = take.solve();
+  const double worst = worst_gain_error(response, pooled.estimated);
+  std::printf("  3 walk frames: pooled worst gain error %.2f %%, single frames up to %.2f %%\n",
+              100 * worst, 100 * worst_single);
+  EXPECT_EQ(pooled.frames, 3);
+  EXPECT_EQ(pooled.points, points);
+  EXPECT_EQ(pooled.gains, pooled.estimated);  // beyond the tolerance: applied
+  EXPECT_LT(worst, 0.03);
+  // A frame of another rig is refused and adds nothing.
+  const Scene s = make_scene(sim::Motion::walk, 5, {}, 64);
+  EXPECT_FALSE(take.add(s.hull_mesh, std::span(s.views).first(8)));
+  EXPECT_EQ(take.solve().points, points);
+  EXPECT_EQ(ColourBalanceEstimator(9).solve().gains,
+            std::vector<Eigen::Vector3f>(9, Eigen::Vector3f::Ones()));
+}
+
 // The positive control's other half: cameras that agree get gains of 1 (within the estimate's
 // noise), so the default changes nothing on a consistent rig.
 TEST(ColourBalance, LeavesAConsistentRigAlone) {

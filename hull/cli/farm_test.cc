@@ -268,10 +268,12 @@ TEST_F(HullFarm, SurfaceStage) {
   }
 }
 
-// --colour-balance (default on): a take whose cameras differ in exposure and white balance
-// (camera 2 about 20 % brighter) is equalised per frame; the gains in the JSON frame events are
-// the simulated ones (display values, the rig's mean 1); the camera far off the mean is named
-// on stderr for the operator; off: no gains, other files (the setting is in the fingerprint).
+// --colour-balance: a take whose cameras differ in exposure and white balance (camera 2 about
+// 20 % brighter) is equalised; the default estimates once for the take (a "colour_balance" JSON
+// event; a shard computes the same gains, so its frame is the same file), frame estimates each
+// frame (the gains in its event); both are the simulated ones (display values, the rig's mean 1)
+// within 3 %; the camera far off the mean is named on stderr for the operator; off: no gains,
+// other files (the setting is in the fingerprint).
 TEST_F(HullFarm, ColourBalanceEqualisesTheCameras) {
   sim::StudioOptions so;
   so.actor.motion = sim::Motion::walk;
@@ -286,35 +288,69 @@ TEST_F(HullFarm, ColourBalanceEqualisesTheCameras) {
   const std::string common = "--take " + take.string() +
                              " --box -1.5,0,-1.5,1.5,2.4,1.5 --grid 128 --refine --texture"
                              " --threads 2 --json --out ";
-  const fs::path on = dir_ / "balance_on", off = dir_ / "balance_off";
-  auto r = run(hull() + " offline " + common + on.string(), dir_);
-  ASSERT_EQ(r.code, 0) << r.err;
   const std::vector<std::array<double, 3>> want = sim::balancing_gains(so.camera_response);
-  int frames = 0;
-  double worst = 0;
-  std::istringstream lines(r.out);
-  for (std::string line; std::getline(lines, line);) {
-    if (line.find("\"event\":\"frame\"") == std::string::npos) continue;
-    ++frames;
+  // The largest relative difference of the gains in a JSON line from the simulated ones.
+  const auto gain_error = [&](const std::string& line) {
+    double worst = 0;
     for (std::size_t c = 0; c < 9; ++c) {
       const std::string key = "\"cam" + std::to_string(c) + "\":[";
       const auto at = line.find(key);
-      ASSERT_NE(at, std::string::npos) << line;
+      if (at == std::string::npos) return 1.0;
       double g[3];
-      ASSERT_EQ(std::sscanf(line.c_str() + at + key.size(), "%lf,%lf,%lf", &g[0], &g[1], &g[2]), 3)
-          << line;
+      if (std::sscanf(line.c_str() + at + key.size(), "%lf,%lf,%lf", &g[0], &g[1], &g[2]) != 3)
+        return 1.0;
       for (int k = 0; k < 3; ++k)
         worst = std::max(worst, std::abs(g[k] / want[c][std::size_t(k)] - 1));
     }
-  }
-  EXPECT_EQ(frames, 4) << r.out;
+    return worst;
+  };
+  const auto lines_of = [](const std::string& out, const std::string& event) {
+    std::vector<std::string> found;
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);)
+      if (line.find("\"event\":\"" + event + "\"") != std::string::npos) found.push_back(line);
+    return found;
+  };
+
+  // The default: one estimate for the take, pooled over its frames (4 here), applied to all.
+  const fs::path on = dir_ / "balance_take", per_frame = dir_ / "balance_frame",
+                 off = dir_ / "balance_off";
+  auto r = run(hull() + " offline " + common + on.string(), dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto take_event = lines_of(r.out, "colour_balance");
+  ASSERT_EQ(take_event.size(), 1u) << r.out;
+  EXPECT_NE(take_event[0].find("\"frames\":4"), std::string::npos) << take_event[0];
+  EXPECT_NE(take_event[0].find("\"applied\":true"), std::string::npos) << take_event[0];
+  const double take_error = gain_error(take_event[0]);
+  EXPECT_EQ(lines_of(r.out, "frame").size(), 4u) << r.out;
   EXPECT_NE(r.out.find("\"colour_balanced_frames\":4"), std::string::npos) << r.out;
-  std::printf("  colour gains vs the simulated responses: worst %.2f %% over 4 frames\n",
-              100 * worst);
-  EXPECT_LT(worst, 0.03);
   EXPECT_NE(r.out.find("\"balance\":"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("camera cam2: colours"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("camera cam1: colours"), std::string::npos) << r.err;
+  // A shard computes the same take estimate: frame 2 alone gives the same file.
+  const fs::path shard = dir_ / "balance_shard";
+  r = run(hull() + " offline " + common + shard.string() + " --frames 2:2", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(slurp(shard / offline::frame_file_name("actor", 2)),
+            slurp(on / offline::frame_file_name("actor", 2)));
+
+  // Frame by frame: each frame's own estimate in its event.
+  r = run(hull() + " offline " + common + per_frame.string() + " --colour-balance frame", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(lines_of(r.out, "colour_balance").empty()) << r.out;
+  double frame_error = 0;
+  const auto frame_events = lines_of(r.out, "frame");
+  EXPECT_EQ(frame_events.size(), 4u) << r.out;
+  for (const std::string& line : frame_events) {
+    EXPECT_NE(line.find("\"colour_balanced\":true"), std::string::npos) << line;
+    frame_error = std::max(frame_error, gain_error(line));
+  }
+  std::printf(
+      "  colour gains vs the simulated responses: the take's %.2f %%, frame by frame "
+      "worst %.2f %%\n",
+      100 * take_error, 100 * frame_error);
+  EXPECT_LT(take_error, 0.03);
+  EXPECT_LT(frame_error, 0.03);
 
   r = run(hull() + " offline " + common + off.string() + " --colour-balance off", dir_);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -324,8 +360,10 @@ TEST_F(HullFarm, ColourBalanceEqualisesTheCameras) {
     const std::string name = offline::frame_file_name("actor", f);
     const auto a = offline::verify_frame_file((on / name).string());
     const auto b = offline::verify_frame_file((off / name).string());
-    ASSERT_TRUE(a && b) << name;
+    const auto c = offline::verify_frame_file((per_frame / name).string());
+    ASSERT_TRUE(a && b && c) << name;
     EXPECT_NE(a->options, b->options) << name;
+    EXPECT_NE(a->options, c->options) << name;
   }
   // Another value is refused, one line.
   r = run(hull() + " offline " + common + off.string() + " --colour-balance maybe", dir_);
@@ -361,7 +399,7 @@ TEST_F(HullFarm, BadInputIsOneLine) {
   EXPECT_NE(r.out.find("--refine"), std::string::npos);
   EXPECT_NE(r.out.find("--texture"), std::string::npos);
   EXPECT_NE(r.out.find("--surface"), std::string::npos);
-  EXPECT_NE(r.out.find("--colour-balance on|off"), std::string::npos);
+  EXPECT_NE(r.out.find("--colour-balance take|frame|off"), std::string::npos);
 }
 
 // The Slurm submission itself (no Slurm needed): one job array over the plan's shards, each task

@@ -50,7 +50,8 @@ constexpr const char* kUsage =
                            [--frames A:B] [--name NAME] [--fps F] [--axis x|y|z]
                            [--keyer keyer.yaml | --key blue|green] [--min-views N|all]
                            [--threshold T] [--ncc T|off] [--judges N|all]
-                           [--max-depth CELLS] [--colour-balance on|off] [--threads N]
+                           [--max-depth CELLS] [--colour-balance take|frame|off]
+                           [--threads N]
                            [--surface STEPS|off] [--surface-photo ITERATIONS]
                            [--json | --progress | --quiet]
        studio-hull offline --take DIR [--rig rig.yaml] --plan SHARDS   (prints A:B per shard)
@@ -75,14 +76,17 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
                     (default 3: on large rigs the grazing views' spill and light tint carve
                     the true surface); all: every camera that sees it
   --max-depth C     carving stops C cells below the hull (default 12)
-  --colour-balance on|off
-                    per frame, before carving and texturing, estimate each camera's colour gains
-                    from the hull's surface points that two cameras see, and equalise the images
-                    when some camera is more than 4 % off the rig's mean (default on: cameras
-                    5-10 % apart in exposure or white balance disagree on every bright point and
-                    the carve removes the true surface; docs/offline.md); --json's frame events
-                    carry the gains and whether they were applied, and a camera more than 10 %
-                    off the mean over the job is named on stderr
+  --colour-balance take|frame|off
+                    equalise the cameras' colours before carving and texturing: each camera's
+                    gains estimated from hull surface points that two cameras see, applied when
+                    some camera is more than 4 % off the rig's mean (cameras 5-10 % apart in
+                    exposure or white balance disagree on every bright point and the carve
+                    removes the true surface; docs/offline.md). take (default): one estimate for
+                    the whole take, pooled over up to 8 frames spread over it (the same in every
+                    shard; no frame-to-frame colour flicker); frame: each frame its own (cameras
+                    whose exposure changes during the take); off. The gains are in --json (a
+                    "colour_balance" event, or per frame), and a camera more than 10 % off the
+                    rig's mean is named on stderr
   --surface S|off   surface stage on the mesh (after carving with --refine): S Laplacian steps
                     with the silhouette rims (the middle of each facet) anchored, each move
                     kept inside the visual hull, moving the hull's bulges between the
@@ -121,7 +125,7 @@ struct Args {
   int plan = 0;
   double fps = 25, threshold = 6, ncc = 0;
   bool patches = true;
-  bool balance = true;  // --colour-balance
+  enum class Balance { off, take, frame } balance = Balance::take;  // --colour-balance
   int max_depth = 12;
   int judges = offline::CarveOptions{}.max_judges;  // 0: all
   // -1: no surface stage; kSurfaceUnset until the arguments are read: --refine's default steps.
@@ -220,8 +224,11 @@ Expected<Args> parse(int argc, char** argv) {
         a.judges = int(*d);
       }
     } else if (opt == "--colour-balance") {
-      if (v != "on" && v != "off") return fail("--colour-balance: '" + v + "': expected on or off");
-      a.balance = v == "on";
+      if (v != "take" && v != "frame" && v != "off")
+        return fail("--colour-balance: '" + v + "': expected take, frame or off");
+      a.balance = v == "take"    ? Args::Balance::take
+                  : v == "frame" ? Args::Balance::frame
+                                 : Args::Balance::off;
     } else if (opt == "--ncc") {
       if (v == "off") {
         a.patches = false;
@@ -469,8 +476,9 @@ int run_refined(int argc, char** argv) {
       std::snprintf(buf, sizeof buf, " judges %d", a.judges);
       settings += buf;
     }
-    if (a.balance && uses_colour(a)) {  // (absent when off: earlier files keep theirs)
-      settings += " colour_balance 1";
+    if (a.balance != Args::Balance::off && uses_colour(a)) {  // (absent when off)
+      settings +=
+          a.balance == Args::Balance::take ? " colour_balance take" : " colour_balance frame";
     }
     if (a.surface >= 0) {  // (absent when off: files made without it keep their fingerprint)
       std::snprintf(buf, sizeof buf, " surface %d photo %d inside_hull %d rim_band %.9g", a.surface,
@@ -512,7 +520,40 @@ int run_refined(int argc, char** argv) {
     double read = 0, key = 0, cut = 0, balance = 0, carve = 0, mesh = 0, surface = 0, texture = 0,
            write = 0;
   } total;
-  const bool balancing = a.balance && uses_colour(a);
+  const bool balancing = a.balance != Args::Balance::off && uses_colour(a);
+  const bool take_balance = balancing && a.balance == Args::Balance::take;
+  // --colour-balance take: one estimate pooled over up to kBalanceFrames frames spread over the
+  // whole take (not the shard: every shard computes the same gains), made when the first frame
+  // needs it (a rerun that skips every frame reads none).
+  constexpr std::size_t kBalanceFrames = 8;
+  std::once_flag take_once;
+  std::optional<offline::ColourBalance> take_gains;
+  std::string take_error;
+  double take_ms = 0;
+  const auto estimate_take = [&](ColourFrame& frame, int slot) {
+    const auto t0 = std::chrono::steady_clock::now();
+    offline::ColourBalanceEstimator estimator(cameras.size());
+    const std::size_t n = std::min(kBalanceFrames, all.size());
+    CutOptions cut;
+    cut.min_views = a.min_views;
+    for (std::size_t i = 0; i < n; ++i) {
+      const uint64_t f = all[n == 1 ? 0 : i * (all.size() - 1) / (n - 1)];
+      double read = 0, key = 0;
+      if (auto ok = (*take)->load(f, slot, frame, read, key); !ok) {
+        take_error = "colour balance: frame " + std::to_string(f) + ": " + ok.error().message;
+        return;
+      }
+      std::vector<offline::ColourView> views;
+      for (std::size_t c = 0; c < cameras.size(); ++c)
+        views.push_back({&cameras[c], frame.images[c].view(), &frame.masks[c]});
+      if (auto ok = estimator.add(grid, views, cut); !ok) {
+        take_error = "colour balance: frame " + std::to_string(f) + ": " + ok.error().message;
+        return;
+      }
+    }
+    take_gains = estimator.solve();
+    take_ms = ms_since(t0);
+  };
   // Per camera: the sum of the estimated log gains over computed frames (the summary's mean).
   std::vector<Eigen::Vector3d> log_gain_sum(cameras.size(), Eigen::Vector3d::Zero());
   std::size_t balanced_frames = 0;  // frames whose images the balance changed
@@ -569,6 +610,20 @@ int run_refined(int argc, char** argv) {
           continue;
         }
       }
+      if (take_balance) {
+        std::call_once(take_once, [&] {
+          estimate_take(frame, slot);
+          if (!take_gains || !a.json) return;
+          std::lock_guard g(lock);
+          std::printf(
+              "{\"event\":\"colour_balance\",\"frames\":%d,\"points\":%zu,\"pairs\":%d,"
+              "\"residual\":%.4f,\"applied\":%s,\"ms\":%.1f,\"colour_gains\":%s}\n",
+              take_gains->frames, take_gains->points, take_gains->pairs, take_gains->residual,
+              take_gains->gains == take_gains->estimated ? "true" : "false", take_ms,
+              gains_json(cameras, take_gains->estimated).c_str());
+          std::fflush(stdout);
+        });
+      }
       Stages s;
       if (auto ok = (*take)->load(f, slot, frame, s.read, s.key); !ok)
         return give_up(ok.error().message);
@@ -594,9 +649,15 @@ int run_refined(int argc, char** argv) {
         t0 = std::chrono::steady_clock::now();
       }
       std::vector<Image<Rgb8>> balanced;
-      std::vector<Eigen::Vector3f> gains;  // the estimate (reported)
+      std::vector<Eigen::Vector3f> gains;  // --colour-balance frame: the estimate (reported) ...
       bool applied = false;                // ... and whether the images were balanced by it
-      if (balancing) {
+      if (take_balance) {
+        if (!take_gains) return give_up(take_error);
+        views = offline::apply_colour_balance(views, *take_gains, &balanced);
+        applied = take_gains->gains == take_gains->estimated;
+        s.balance = ms_since(t0);
+        t0 = std::chrono::steady_clock::now();
+      } else if (balancing) {
         auto cb = offline::estimate_colour_balance(grid, views, cut);
         if (!cb) return give_up(cb.error().message);
         views = offline::apply_colour_balance(views, *cb, &balanced);
@@ -662,22 +723,25 @@ int run_refined(int argc, char** argv) {
     std::cerr << "studio-hull: " << indexed.error().message << "\n";
     return 1;
   }
-  // The mean gains over the computed frames (geometric); a camera far off the rig's mean is worth
-  // an operator's look (its exposure, aperture or white balance), balanced or not.
+  // The take's gains (or, frame by frame, their geometric mean over the computed frames); a
+  // camera far off the rig's mean is worth an operator's look (its exposure, aperture or white
+  // balance), balanced or not.
   std::vector<Eigen::Vector3f> mean_gains;
-  if (balancing && computed > 0) {
+  if (take_balance && take_gains) {
+    mean_gains = take_gains->estimated;
+  } else if (balancing && computed > 0) {
     for (const Eigen::Vector3d& l : log_gain_sum)
       mean_gains.push_back((l / double(computed)).array().exp().matrix().cast<float>());
-    for (std::size_t c = 0; c < mean_gains.size(); ++c) {
-      const Eigen::Vector3f& g = mean_gains[c];
-      const float off = std::max({std::abs(g.x() - 1), std::abs(g.y() - 1), std::abs(g.z() - 1)});
-      if (off > 0.10f)
-        std::fprintf(stderr,
-                     "studio-hull: camera %s: colours %.0f %% off the rig's mean (gains R %.3f G "
-                     "%.3f B %.3f, balanced before carving and texturing): check its exposure "
-                     "and white balance\n",
-                     cameras[c].id.c_str(), 100 * off, g.x(), g.y(), g.z());
-    }
+  }
+  for (std::size_t c = 0; c < mean_gains.size(); ++c) {
+    const Eigen::Vector3f& g = mean_gains[c];
+    const float off = std::max({std::abs(g.x() - 1), std::abs(g.y() - 1), std::abs(g.z() - 1)});
+    if (off > 0.10f)
+      std::fprintf(stderr,
+                   "studio-hull: camera %s: colours %.0f %% off the rig's mean (gains R %.3f G "
+                   "%.3f B %.3f, balanced before carving and texturing): check its exposure "
+                   "and white balance\n",
+                   cameras[c].id.c_str(), 100 * off, g.x(), g.y(), g.z());
   }
   if (a.json) {
     const double n = std::max<double>(1, double(computed));

@@ -60,11 +60,17 @@ double median(std::vector<float>& v) {
 
 }  // namespace
 
-Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
-                                                std::span<const ColourView> views,
-                                                const ColourBalanceOptions& options) {
-  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
-  auto prepared = prepare_views(views, options.edge_margin_px);
+ColourBalanceEstimator::ColourBalanceEstimator(std::size_t cameras,
+                                               const ColourBalanceOptions& options)
+    : cameras_(cameras), options_(options), ratios_(cameras * cameras) {}
+
+Expected<void> ColourBalanceEstimator::add(const hull::Mesh& mesh,
+                                           std::span<const ColourView> views) {
+  if (auto ok = options_.validate(); !ok) return std::unexpected(ok.error());
+  if (views.size() != cameras_)
+    return fail("colour balance: " + std::to_string(views.size()) + " views for " +
+                std::to_string(cameras_) + " cameras");
+  auto prepared = prepare_views(views, options_.edge_margin_px);
   if (!prepared) return std::unexpected(prepared.error());
   const std::vector<SampledView>& sv = *prepared;
   const int n = int(sv.size());
@@ -76,12 +82,10 @@ Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
   const std::vector<Eigen::Vector3d> normals = vertex_normals(mesh);
   // Per ordered pair (i < j) and channel: log(colour_i) - log(colour_j) of the shared points.
   const auto pair_index = [n](int i, int j) { return std::size_t(i) * std::size_t(n) + j; };
-  std::vector<std::array<std::vector<float>, 3>> ratios(std::size_t(n) * std::size_t(n));
-  std::size_t points = 0;
   std::mutex merge;
-  const float lo = float(options.min_level), hi = float(options.max_level);
-  detail::parallel_for(mesh.vertices.size(), options.threads, [&](std::size_t a, std::size_t b) {
-    std::vector<std::array<std::vector<float>, 3>> local(ratios.size());
+  const float lo = float(options_.min_level), hi = float(options_.max_level);
+  detail::parallel_for(mesh.vertices.size(), options_.threads, [&](std::size_t a, std::size_t b) {
+    std::vector<std::array<std::vector<float>, 3>> local(ratios_.size());
     std::size_t seen_twice = 0;
     std::vector<std::pair<int, Observation>> obs;
     for (std::size_t v = a; v < b; ++v) {
@@ -90,13 +94,13 @@ Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
       obs.clear();
       for (int c = 0; c < n; ++c)
         if (auto o = observe(sv[std::size_t(c)], depth[std::size_t(c)], x, normals[v],
-                             options.min_cos, options.depth_tolerance))
+                             options_.min_cos, options_.depth_tolerance))
           obs.emplace_back(c, *o);
       if (obs.size() < 2) continue;
       ++seen_twice;
       for (std::size_t p = 0; p < obs.size(); ++p)
         for (std::size_t q = p + 1; q < obs.size(); ++q) {
-          if (std::abs(obs[p].second.cos - obs[q].second.cos) > options.max_cos_difference)
+          if (std::abs(obs[p].second.cos - obs[q].second.cos) > options_.max_cos_difference)
             continue;
           for (int k = 0; k < 3; ++k) {
             const float ci = obs[p].second.colour[k], cj = obs[q].second.colour[k];
@@ -107,20 +111,46 @@ Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
         }
     }
     std::lock_guard g(merge);
-    points += seen_twice;
+    points_ += seen_twice;
     for (std::size_t i = 0; i < local.size(); ++i)
       for (int k = 0; k < 3; ++k) {
-        auto& to = ratios[i][std::size_t(k)];
+        auto& to = ratios_[i][std::size_t(k)];
         const auto& from = local[i][std::size_t(k)];
         to.insert(to.end(), from.begin(), from.end());
       }
   });
   // The merge order depends on the threads; the medians and counts do not.
+  ++frames_;
+  return {};
+}
 
+Expected<void> ColourBalanceEstimator::add(const hull::GridSpec& grid,
+                                           std::span<const ColourView> views,
+                                           const hull::CutOptions& cut, int columns) {
+  if (columns < 1) return fail("colour balance: columns must be >= 1");
+  hull::GridSpec coarse = grid;
+  coarse.cells_u = std::min(grid.cells_u, columns);
+  coarse.cells_v = std::min(grid.cells_v, columns);
+  std::vector<hull::View> silhouettes;
+  for (const ColourView& v : views) silhouettes.push_back({v.camera, v.mask});
+  auto set = hull::visual_hull(coarse, silhouettes, cut);
+  if (!set) return std::unexpected(set.error());
+  hull::MeshOptions mo;
+  mo.normals = false;  // add() computes its own
+  hull::Mesh mesh = hull::segment_marching_cubes(*set, mo);
+  if (auto ok = hull::refine_crossings(mesh, *set, silhouettes, cut, false); !ok)
+    return std::unexpected(ok.error());
+  return add(mesh, views);
+}
+
+ColourBalance ColourBalanceEstimator::solve() {
+  const int n = int(cameras_);
+  const auto pair_index = [n](int i, int j) { return std::size_t(i) * std::size_t(n) + j; };
   ColourBalance out;
-  out.points = points;
-  out.gains.assign(sv.size(), Eigen::Vector3f::Ones());
-  std::vector<std::array<double, 3>> log_gain(sv.size(), {0, 0, 0});
+  out.points = points_;
+  out.frames = frames_;
+  out.gains.assign(cameras_, Eigen::Vector3f::Ones());
+  std::vector<std::array<double, 3>> log_gain(cameras_, {0, 0, 0});
   struct Edge {
     int i, j;
     double w;
@@ -129,16 +159,16 @@ Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
   std::vector<Edge> edges;
   for (int i = 0; i < n; ++i)
     for (int j = i + 1; j < n; ++j) {
-      auto& r = ratios[pair_index(i, j)];
+      auto& r = ratios_[pair_index(i, j)];
       const std::size_t count = std::min({r[0].size(), r[1].size(), r[2].size()});
-      if (count < std::size_t(options.min_samples)) continue;
+      if (count < std::size_t(options_.min_samples)) continue;
       Edge e{i, j, double(count), {}};
       for (int k = 0; k < 3; ++k) e.m[std::size_t(k)] = median(r[std::size_t(k)]);
       edges.push_back(e);
     }
   out.pairs = int(edges.size());
   // Connected sets of cameras (union-find over the used pairs).
-  std::vector<int> root(sv.size());
+  std::vector<int> root(cameras_);
   std::iota(root.begin(), root.end(), 0);
   const auto find = [&](int i) {
     while (root[std::size_t(i)] != i)
@@ -149,7 +179,7 @@ Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
   // Least squares per channel: w (g_i - g_j + m_ij)^2 over the edges (g = log gain, so that
   // the balanced colours agree: log c_i + g_i = log c_j + g_j), plus sum g = 0 per connected set.
   const int rows = int(edges.size()) + n;
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 3 && n > 0; ++k) {
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(rows, n);
     Eigen::VectorXd y = Eigen::VectorXd::Zero(rows);
     for (std::size_t r = 0; r < edges.size(); ++r) {
@@ -160,7 +190,7 @@ Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
     }
     for (int c = 0; c < n; ++c) A(Eigen::Index(edges.size()) + find(c), c) = 1;  // gauge rows
     const Eigen::VectorXd g = A.colPivHouseholderQr().solve(y);
-    const double cap = std::log(options.max_gain);
+    const double cap = std::log(options_.max_gain);
     for (int c = 0; c < n; ++c) {
       const bool linked = std::any_of(edges.begin(), edges.end(),
                                       [c](const Edge& e) { return e.i == c || e.j == c; });
@@ -178,30 +208,31 @@ Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
   out.residual = left.empty() ? 0 : median(left);
   out.estimated = out.gains;
   if (std::all_of(out.gains.begin(), out.gains.end(), [&](const Eigen::Vector3f& g) {
-        return (g.array() - 1).abs().maxCoeff() <= float(options.tolerance);
+        return (g.array() - 1).abs().maxCoeff() <= float(options_.tolerance);
       }))
     for (Eigen::Vector3f& g : out.gains) g = Eigen::Vector3f::Ones();
   return out;
+}
+
+Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
+                                                std::span<const ColourView> views,
+                                                const ColourBalanceOptions& options) {
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  if (views.empty()) return fail("no camera views");
+  ColourBalanceEstimator e(views.size(), options);
+  if (auto ok = e.add(mesh, views); !ok) return std::unexpected(ok.error());
+  return e.solve();
 }
 
 Expected<ColourBalance> estimate_colour_balance(const hull::GridSpec& grid,
                                                 std::span<const ColourView> views,
                                                 const hull::CutOptions& cut, int columns,
                                                 const ColourBalanceOptions& options) {
-  if (columns < 1) return fail("colour balance: columns must be >= 1");
-  hull::GridSpec coarse = grid;
-  coarse.cells_u = std::min(grid.cells_u, columns);
-  coarse.cells_v = std::min(grid.cells_v, columns);
-  std::vector<hull::View> silhouettes;
-  for (const ColourView& v : views) silhouettes.push_back({v.camera, v.mask});
-  auto set = hull::visual_hull(coarse, silhouettes, cut);
-  if (!set) return std::unexpected(set.error());
-  hull::MeshOptions mo;
-  mo.normals = false;  // estimate_colour_balance computes its own
-  hull::Mesh mesh = hull::segment_marching_cubes(*set, mo);
-  if (auto ok = hull::refine_crossings(mesh, *set, silhouettes, cut, false); !ok)
-    return std::unexpected(ok.error());
-  return estimate_colour_balance(mesh, views, options);
+  if (auto ok = options.validate(); !ok) return std::unexpected(ok.error());
+  if (views.empty()) return fail("no camera views");
+  ColourBalanceEstimator e(views.size(), options);
+  if (auto ok = e.add(grid, views, cut, columns); !ok) return std::unexpected(ok.error());
+  return e.solve();
 }
 
 std::vector<ColourView> apply_colour_balance(std::span<const ColourView> views,

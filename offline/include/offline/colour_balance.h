@@ -21,6 +21,7 @@
 // whose cameras agree is left as it is.
 
 #include <Eigen/Core>
+#include <array>
 #include <span>
 #include <vector>
 
@@ -61,13 +62,39 @@ struct ColourBalance {
   // estimate, or all 1 when the whole rig lies within the tolerance.
   std::vector<Eigen::Vector3f> gains;
   std::vector<Eigen::Vector3f> estimated;  // per view, before the tolerance
-  std::size_t points = 0;  // mesh vertices seen by two or more cameras
+  std::size_t points = 0;  // mesh vertices seen by two or more cameras (over all frames)
+  int frames = 0;          // frames pooled (ColourBalanceEstimator)
   int pairs = 0;           // camera pairs with >= min_samples shared points (the graph's edges)
   // Median over the used pairs and channels of |log ratio| after the gains: what is left
   // between cameras (0 for a consistent rig; the spread of the data otherwise).
   double residual = 0;
 };
 
+// The estimate pooled over several frames of a take (the cameras' responses are a property of
+// the rig, not of a frame: one set of gains for the take leaves no frame-to-frame flicker, and
+// the poses' view-dependent errors average): add() frames, then solve(). The views of every
+// frame are the same cameras in the same order.
+class ColourBalanceEstimator {
+ public:
+  explicit ColourBalanceEstimator(std::size_t cameras, const ColourBalanceOptions& options = {});
+  // One frame's shared points. Fails (nothing added) on invalid options, a view count other
+  // than `cameras`, or a view whose image or mask size differs from its camera.
+  Expected<void> add(const hull::Mesh& mesh, std::span<const ColourView> views);
+  // The same from the views' own hull over `grid` at no more than `columns` columns per axis.
+  Expected<void> add(const hull::GridSpec& grid, std::span<const ColourView> views,
+                     const hull::CutOptions& cut = {}, int columns = 128);
+  // The gains from every frame added so far (all 1 before any).
+  ColourBalance solve();
+
+ private:
+  std::size_t cameras_;
+  ColourBalanceOptions options_;
+  std::vector<std::array<std::vector<float>, 3>> ratios_;  // per camera pair and channel
+  std::size_t points_ = 0;
+  int frames_ = 0;
+};
+
+// One frame: ColourBalanceEstimator with that frame alone.
 // Fails on invalid options, no views or a view whose image or mask size differs from its camera.
 // `mesh` needs no normals (computed here). Independent of options.threads.
 Expected<ColourBalance> estimate_colour_balance(const hull::Mesh& mesh,
