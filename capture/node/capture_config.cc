@@ -1,6 +1,7 @@
 #include "capture_config.h"
 
 #include <algorithm>
+#include <array>
 #include <optional>
 #include <set>
 
@@ -40,7 +41,7 @@ const char kConfigHelp[] =
     "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true,\n"
     "               frame_code: false, stamp: false, offset_us: 0, jitter_us: 0, drop_every: 0,\n"
     "               readout_us: -1, motion: sequence, swing_peak_speed: 1.5,\n"
-    "               costume: plain, buffers: 16}\n"
+    "               costume: plain, response: [1, 1, 1], buffers: 16}\n"
     "                                    readout_us: exposure instant -> frame on the host (the\n"
     "                                    rest of the exposure, read-out, transfer); -1 (default):\n"
     "                                    a GigE camera's, half the exposure + 8 bits a pixel at\n"
@@ -54,11 +55,17 @@ const char kConfigHelp[] =
     "                                    buffers: frames the camera holds for a late consumer\n"
     "                                    (older ones are lost, counted as drops), as an aravis\n"
     "                                    source's buffers (default 16: a 600 ms stall at 25 fps)\n"
-    "                                    frame_code: the actor wears the frame number (preview tests)\n"
+    "                                    frame_code: the actor wears the frame number (preview "
+    "tests)\n"
     "                                    costume: plain (evenly coloured clothing) or patterned\n"
-    "                                    (a fixed pattern on the clothing's surface, the same from\n"
+    "                                    (a fixed pattern on the clothing's surface, the same "
+    "from\n"
     "                                    every camera: what photo-consistency needs to work on);\n"
     "                                    every camera of a studio must give the same\n"
+    "                                    response: the camera's linear gains on R, G, B, each in\n"
+    "                                    [0.25, 4] (exposure and white balance: a real rig's\n"
+    "                                    cameras differ by a few percent; what studio-hull\n"
+    "                                    offline's --colour-balance corrects)\n"
     "      source: {type: files, path: DIR, fps: 25, loop: false, paced: true}\n"
     "      source: {type: aravis, device: ID, pixel_format: BayerRG8, width: W, height: H,\n"
     "               fps: 25, trigger: free_run|software|line, line: Line0, buffers: 16,\n"
@@ -105,6 +112,7 @@ struct SimKeys {
   int buffers = SimSourceOptions{}.buffer_frames;
   sim::Motion motion = sim::Motion::sequence;  // the simulated actor's motion (sim/actor.h)
   double swing_peak_speed = 1.5;               // arm_swing: fingertip peak speed, m/s
+  std::array<double, 3> response{1, 1, 1};     // sim::StudioOptions::camera_response
   Expected<void> validate() const {
     if (index >= ring) return fail("index: must be below ring");
     if (readout_us < 0 && readout_us != -1) return fail("readout_us: -1 (auto) or >= 0");
@@ -163,6 +171,14 @@ const yaml::Schema<SimKeys> kSim{
                   return m;
                 }),
     yaml::field("swing_peak_speed", &SimKeys::swing_peak_speed).range(0.05, 10),
+    yaml::field("response", &SimKeys::response,
+                [](const yaml::Node& n) -> Expected<std::array<double, 3>> {
+                  auto v = n.as_doubles(3);
+                  if (!v) return std::unexpected(v.error());
+                  for (double g : *v)
+                    if (!(g >= 0.25 && g <= 4)) return n.fail("each gain must lie in [0.25, 4]");
+                  return std::array<double, 3>{(*v)[0], (*v)[1], (*v)[2]};
+                }),
 };
 const yaml::Schema<FileSourceOptions> kFiles{
     yaml::field("path", &FileSourceOptions::path).required().relative_path(),
@@ -270,6 +286,8 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
     so.paced = c.sim.paced;
     so.studio.frame_code = c.sim.frame_code;
     so.studio.patterned_costume = c.sim.patterned_costume;
+    if (c.sim.response != std::array<double, 3>{1, 1, 1})
+      so.studio.camera_response = {c.sim.response};  // the source's one camera
     so.studio.actor.motion = c.sim.motion;
     so.studio.actor.swing_peak_speed = c.sim.swing_peak_speed;
     so.stamp = c.sim.stamp;

@@ -129,6 +129,10 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
       {"cameras:\n  - id: a\n    source: {type: sim, costume: tartan}\n",
        "expected one of plain, patterned, got 'tartan'"},
       {"cameras:\n  - id: a\n    source: {type: sim, buffers: 0}\n", "buffers"},
+      {"cameras:\n  - id: a\n    source: {type: sim, response: [1, 0.1, 1]}\n",
+       "response: each gain must lie in [0.25, 4]"},
+      {"cameras:\n  - id: a\n    source: {type: sim, response: [1, 1]}\n",
+       "response: expected 3 numbers, got 2"},
       {"image: {rate: fast}\ncameras:\n  - id: a\n    source: {type: sim}\n", "image.rate"},
       {"cameras:\n  - id: a\n    source: {type: files, path: nowhere}\n", "nowhere"},
       {"clock: {fps: 25, period_ns: 40000000}\ncameras: []\n", "not both"},
@@ -150,7 +154,7 @@ TEST_F(CaptureNodeTest, BadConfigIsOneLine) {
                    {"--config", write_config("costume.yaml",
                                              "cameras:\n  - id: a\n    source: {type: sim, "
                                              "width: 176, height: 144, costume: patterned, "
-                                             "buffers: 16}\n")});
+                                             "response: [1.1, 1, 0.9], buffers: 16}\n")});
   EXPECT_TRUE(ok.wait_ready(30s)) << ok.log();
 }
 
