@@ -77,7 +77,8 @@ TEST(ColourBalance, RecoversTheSimulatedCamerasResponses) {
   EXPECT_GT(before, 0.05);
   EXPECT_LT(after, 0.025);
   EXPECT_GE(cb.pairs, 16);  // the ring's neighbours and the overhead with the ring
-  EXPECT_EQ(cb.gains, cb.estimated);  // beyond the tolerance: applied
+  EXPECT_TRUE(cb.applied);  // beyond the tolerance: applied
+  EXPECT_EQ(cb.gains, cb.estimated);
   o.threads = 2;
   const ColourBalance two = estimate_colour_balance(s.hull_mesh, s.views, o).value();
   EXPECT_EQ(two.gains, cb.gains);
@@ -114,7 +115,8 @@ TEST(ColourBalance, PooledOverTheFramesOfATake) {
               100 * worst, 100 * worst_single);
   EXPECT_EQ(pooled.frames, 3);
   EXPECT_EQ(pooled.points, points);
-  EXPECT_EQ(pooled.gains, pooled.estimated);  // beyond the tolerance: applied
+  EXPECT_TRUE(pooled.applied);  // beyond the tolerance: applied
+  EXPECT_EQ(pooled.gains, pooled.estimated);
   EXPECT_LT(worst, 0.03);
   // A frame of another rig is refused and adds nothing.
   const Scene s = make_scene(sim::Motion::walk, 5, {}, 64);
@@ -136,6 +138,7 @@ TEST(ColourBalance, LeavesAConsistentRigAlone) {
               cb.pairs, cb.residual, worst);
   EXPECT_LT(worst, 0.015);  // measured 0.98 %
   // Within the tolerance (4 %): the images are left as they are.
+  EXPECT_FALSE(cb.applied);
   for (const auto& g : cb.gains) EXPECT_EQ(g, Eigen::Vector3f::Ones());
   ColourBalanceOptions strict;
   strict.tolerance = 0;
@@ -195,6 +198,7 @@ TEST(ColourBalance, RefusesBadInputAndKeepsUnlinkedCamerasAtOne) {
   const ColourBalance none = estimate_colour_balance(hull::Mesh{}, s.views).value();
   EXPECT_EQ(none.points, 0u);
   EXPECT_EQ(none.pairs, 0);
+  EXPECT_FALSE(none.applied);  // (every estimate 1: nothing to apply, nothing reported applied)
   for (const auto& g : none.gains) EXPECT_EQ(g, Eigen::Vector3f::Ones());
   ColourBalanceOptions strict;
   strict.min_samples = 1 << 30;

@@ -144,8 +144,8 @@ int main(int argc, char** argv) {
       std::printf(
           "  balance (%s): %zu points, %d pairs, residual %.4f, largest |gain - 1| %.2f %%, worst "
           "gain error %.2f %% (%.0f ms)\n",
-          cb.gains == cb.estimated ? "applied" : "within the tolerance", cb.points, cb.pairs,
-          cb.residual, 100 * largest, 100 * worst, ms);
+          cb.applied ? "applied" : "within the tolerance", cb.points, cb.pairs, cb.residual,
+          100 * largest, 100 * worst, ms);
     }
     CarveOptions co;
     co.threads = 2;

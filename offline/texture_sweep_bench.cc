@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
     if (!std::getenv("BALANCE") || std::atoi(std::getenv("BALANCE")) != 0) {
       const ColourBalance cb = estimate_colour_balance(testing::studio_grid(grid), p.views).value();
       p.views = apply_colour_balance(p.views, cb, &p.balanced);
-      std::printf("  balance %s\n", cb.gains == cb.estimated ? "applied" : "within the tolerance");
+      std::printf("  balance %s\n", cb.applied ? "applied" : "within the tolerance");
     }
     const int held = int(p.f.cameras.size()) - 1;
     studio.render(held, poses[i].frame, nullptr, &p.true_mask);

@@ -619,7 +619,7 @@ int run_refined(int argc, char** argv) {
               "{\"event\":\"colour_balance\",\"frames\":%d,\"points\":%zu,\"pairs\":%d,"
               "\"residual\":%.4f,\"applied\":%s,\"ms\":%.1f,\"colour_gains\":%s}\n",
               take_gains->frames, take_gains->points, take_gains->pairs, take_gains->residual,
-              take_gains->gains == take_gains->estimated ? "true" : "false", take_ms,
+              take_gains->applied ? "true" : "false", take_ms,
               gains_json(cameras, take_gains->estimated).c_str());
           std::fflush(stdout);
         });
@@ -654,7 +654,7 @@ int run_refined(int argc, char** argv) {
       if (take_balance) {
         if (!take_gains) return give_up(take_error);
         views = offline::apply_colour_balance(views, *take_gains, &balanced);
-        applied = take_gains->gains == take_gains->estimated;
+        applied = take_gains->applied;
         s.balance = ms_since(t0);
         t0 = std::chrono::steady_clock::now();
       } else if (balancing) {
@@ -662,7 +662,7 @@ int run_refined(int argc, char** argv) {
         if (!cb) return give_up(cb.error().message);
         views = offline::apply_colour_balance(views, *cb, &balanced);
         gains = cb->estimated;
-        applied = cb->gains == cb->estimated;
+        applied = cb->applied;
         s.balance = ms_since(t0);
         t0 = std::chrono::steady_clock::now();
       }

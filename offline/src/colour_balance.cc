@@ -207,9 +207,10 @@ ColourBalance ColourBalanceEstimator::solve() {
                          log_gain[std::size_t(e.j)][std::size_t(k)])));
   out.residual = left.empty() ? 0 : median(left);
   out.estimated = out.gains;
-  if (std::all_of(out.gains.begin(), out.gains.end(), [&](const Eigen::Vector3f& g) {
-        return (g.array() - 1).abs().maxCoeff() <= float(options_.tolerance);
-      }))
+  out.applied = std::any_of(out.gains.begin(), out.gains.end(), [&](const Eigen::Vector3f& g) {
+    return (g.array() - 1).abs().maxCoeff() > float(options_.tolerance);
+  });
+  if (!out.applied)
     for (Eigen::Vector3f& g : out.gains) g = Eigen::Vector3f::Ones();
   return out;
 }

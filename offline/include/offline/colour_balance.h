@@ -62,6 +62,7 @@ struct ColourBalance {
   // estimate, or all 1 when the whole rig lies within the tolerance.
   std::vector<Eigen::Vector3f> gains;
   std::vector<Eigen::Vector3f> estimated;  // per view, before the tolerance
+  bool applied = false;    // some camera beyond the tolerance: `gains` are the estimate
   std::size_t points = 0;  // mesh vertices seen by two or more cameras (over all frames)
   int frames = 0;          // frames pooled (ColourBalanceEstimator)
   int pairs = 0;           // camera pairs with >= min_samples shared points (the graph's edges)
