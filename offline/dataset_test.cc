@@ -9,6 +9,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <random>
 
 #include "hull/crossing_refine.h"
@@ -24,26 +25,46 @@ namespace fs = std::filesystem;
 namespace studio::offline {
 namespace {
 
-TEST(PhotoCarveDino, IncrementalJudgingCarvesTheSameVoxelsOnRealImages) {
-  const fs::path dir = fs::path(STUDIO_SHARED_DATA) / "middlebury_dino";
-  if (!fs::exists(dir / "dinoSR_par.txt")) GTEST_SKIP() << "no " << dir << " (shared test data)";
-  auto dino = studio::testing::load_middlebury_dino(dir.string());
-  ASSERT_TRUE(dino) << dino.error().message;
+// The dino's views as the carve takes them, and its hull at 96 columns (the tight box + 5 mm).
+struct Dino {
+  studio::testing::DinoViews data;
   std::vector<ColourView> views;
   std::vector<hull::View> cut;
-  for (std::size_t k = 0; k < dino->cameras.size(); ++k) {
-    const cv::Mat& m = dino->rgb[k];
-    views.push_back({&dino->cameras[k],
-                     ImageView<const Rgb8>(reinterpret_cast<const Rgb8*>(m.data), m.cols, m.rows,
-                                           std::ptrdiff_t(m.step)),
-                     &dino->masks[k]});
-    cut.push_back({&dino->cameras[k], &dino->masks[k]});
+  hull::SegmentSet set;
+};
+// nullopt without the shared data (the caller skips) or when it does not load (a failure).
+std::optional<Dino> load_dino() {
+  const fs::path dir = fs::path(STUDIO_SHARED_DATA) / "middlebury_dino";
+  if (!fs::exists(dir / "dinoSR_par.txt")) return std::nullopt;
+  auto loaded = studio::testing::load_middlebury_dino(dir.string());
+  EXPECT_TRUE(loaded) << loaded.error().message;
+  if (!loaded) return std::nullopt;
+  Dino d;
+  d.data = std::move(*loaded);
+  for (std::size_t k = 0; k < d.data.cameras.size(); ++k) {
+    const cv::Mat& m = d.data.rgb[k];
+    d.views.push_back({&d.data.cameras[k],
+                       ImageView<const Rgb8>(reinterpret_cast<const Rgb8*>(m.data), m.cols, m.rows,
+                                             std::ptrdiff_t(m.step)),
+                       &d.data.masks[k]});
+    d.cut.push_back({&d.data.cameras[k], &d.data.masks[k]});
   }
   hull::GridSpec g;
   g.box_min = studio::testing::DinoViews::box_min(0.005);
   g.box_max = studio::testing::DinoViews::box_max(0.005);
   g.cells_u = g.cells_v = 96;
-  const hull::SegmentSet set = hull::visual_hull(g, cut).value();
+  d.set = hull::visual_hull(g, d.cut).value();
+  return d;
+}
+
+TEST(PhotoCarveDino, IncrementalJudgingCarvesTheSameVoxelsOnRealImages) {
+  const auto dino = load_dino();
+  if (!dino) {
+    if (!HasFailure()) GTEST_SKIP() << "no middlebury_dino in the shared test data";
+    return;
+  }
+  const std::vector<ColourView>& views = dino->views;
+  const hull::SegmentSet& set = dino->set;
   // The dino's shading differs between views more than the studio's cloth: two thresholds, the
   // default and a tighter one that carves more.
   for (const double threshold : {6.0, 4.0}) {
@@ -67,42 +88,34 @@ TEST(PhotoCarveDino, IncrementalJudgingCarvesTheSameVoxelsOnRealImages) {
 // cannot know). The dino's own estimate is printed: its light moved with the gantry, so its views
 // differ in brightness by themselves.
 TEST(ColourBalanceDino, RecoversGainsAppliedToRealImages) {
-  const fs::path dir = fs::path(STUDIO_SHARED_DATA) / "middlebury_dino";
-  if (!fs::exists(dir / "dinoSR_par.txt")) GTEST_SKIP() << "no " << dir << " (shared test data)";
-  auto dino = studio::testing::load_middlebury_dino(dir.string());
-  ASSERT_TRUE(dino) << dino.error().message;
-  const std::size_t n = dino->cameras.size();
+  const auto dino = load_dino();
+  if (!dino) {
+    if (!HasFailure()) GTEST_SKIP() << "no middlebury_dino in the shared test data";
+    return;
+  }
+  const std::vector<ColourView>& views = dino->views;
+  const std::size_t n = views.size();
   // Display-space gains in [0.8, 1] per camera and channel (below 1: nothing clips).
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(0.8, 1.0);
   std::vector<Eigen::Vector3d> applied(n);
   std::vector<Image<Rgb8>> altered;
   altered.reserve(n);
-  std::vector<ColourView> views, views_altered;
-  std::vector<hull::View> cut;
+  std::vector<ColourView> views_altered = views;
   for (std::size_t k = 0; k < n; ++k) {
-    const cv::Mat& m = dino->rgb[k];
-    const ImageView<const Rgb8> img(reinterpret_cast<const Rgb8*>(m.data), m.cols, m.rows,
-                                    std::ptrdiff_t(m.step));
-    views.push_back({&dino->cameras[k], img, &dino->masks[k]});
-    cut.push_back({&dino->cameras[k], &dino->masks[k]});
+    const ImageView<const Rgb8>& img = views[k].image;
     applied[k] = {u(rng), u(rng), u(rng)};
-    Image<Rgb8>& a = altered.emplace_back(m.cols, m.rows);
-    for (int y = 0; y < m.rows; ++y)
-      for (int x = 0; x < m.cols; ++x) {
+    Image<Rgb8>& a = altered.emplace_back(img.width(), img.height());
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x) {
         const Rgb8 p = img.row(y)[x];
         const auto q = [](double v) { return uint8_t(std::lround(v)); };
         a(x, y) = {q(p.r * applied[k].x()), q(p.g * applied[k].y()), q(p.b * applied[k].z())};
       }
-    views_altered.push_back({&dino->cameras[k], a.view(), &dino->masks[k]});
+    views_altered[k].image = a.view();
   }
-  hull::GridSpec g;
-  g.box_min = studio::testing::DinoViews::box_min(0.005);
-  g.box_max = studio::testing::DinoViews::box_max(0.005);
-  g.cells_u = g.cells_v = 96;
-  const hull::SegmentSet set = hull::visual_hull(g, cut).value();
-  hull::Mesh mesh = hull::segment_marching_cubes(set);
-  ASSERT_TRUE(hull::refine_crossings(mesh, set, cut));
+  hull::Mesh mesh = hull::segment_marching_cubes(dino->set);
+  ASSERT_TRUE(hull::refine_crossings(mesh, dino->set, dino->cut));
   const ColourBalance own = estimate_colour_balance(mesh, views).value();
   const ColourBalance est = estimate_colour_balance(mesh, views_altered).value();
   // est * applied, brought to a geometric mean of 1 per channel, against own.
