@@ -79,7 +79,7 @@ photo-consistency and/or textured from the cameras' colour images, one glTF bina
   --colour-balance take|frame|off
                     equalise the cameras' colours before carving and texturing: each camera's
                     gains estimated from hull surface points that two cameras see, applied when
-                    some camera is more than 4 % off the rig's mean (cameras 5-10 % apart in
+                    some camera is more than 2 % off the rig's mean (cameras 5-10 % apart in
                     exposure or white balance disagree on every bright point and the carve
                     removes the true surface; docs/offline.md). take (default): one estimate for
                     the whole take, pooled over up to 8 frames spread over it (the same in every
