@@ -179,6 +179,60 @@ TEST(ColourBalance, TheCarveOnDifferingCamerasNeedsIt) {
   EXPECT_LT(with.p95, 1.03 * reference.p95);
 }
 
+// A live estimate (the preview's, preview/rig_balance.h): a frame may hold only some cameras'
+// images (the others take no part), and a window of the newest samples per pair follows a
+// camera whose response changes.
+TEST(ColourBalance, FramesOfSomeCamerasAndABoundedWindow) {
+  const auto response = sim::random_camera_response(9, 3, 0.10, 0.05);
+  const Scene differ = make_scene(sim::Motion::idle, 10, response, 128);
+  const Scene agree = make_scene(sim::Motion::idle, 10, {}, 128);
+  // Cameras 0, 1 and 7 only (cam0 and its ring neighbours, as a preview between them textures
+  // with): pairs 0-1 and 0-7 (1 and 7, 90 degrees apart, share too little), every other gain 1.
+  std::vector<ColourView> some(9);
+  for (int c : {0, 1, 7}) some[std::size_t(c)] = differ.views[std::size_t(c)];
+  ColourBalanceEstimator three(9);
+  ASSERT_TRUE(three.add(differ.hull_mesh, some));
+  const ColourBalance b = three.solve();
+  EXPECT_EQ(b.pairs, 2);
+  const auto truth = sim::balancing_gains(response);
+  double worst = 0;
+  for (int i : {0, 1, 7})
+    for (int j : {0, 1, 7})
+      for (int k = 0; k < 3 && i < j; ++k)
+        worst = std::max(worst, std::abs(double(b.estimated[std::size_t(i)][k] /
+                                                b.estimated[std::size_t(j)][k]) /
+                                             (truth[std::size_t(i)][std::size_t(k)] /
+                                              truth[std::size_t(j)][std::size_t(k)]) -
+                                         1));
+  std::printf("  cameras 0, 1, 7 alone: worst pair ratio error %.2f %%\n", 100 * worst);
+  EXPECT_LT(worst, 0.025);  // measured 1.39 %
+  for (int c : {2, 3, 4, 5, 6, 8}) EXPECT_EQ(b.estimated[std::size_t(c)], Eigen::Vector3f::Ones());
+  // One view present: nothing to compare, the frame counts.
+  std::vector<ColourView> one(9);
+  one[0] = differ.views[0];
+  ASSERT_TRUE(three.add(differ.hull_mesh, one));
+  EXPECT_EQ(three.solve().frames, 2);
+  // A view half given (a mask without its camera) is refused.
+  std::vector<ColourView> half = some;
+  half[4].mask = differ.views[4].mask;
+  EXPECT_FALSE(three.add(differ.hull_mesh, half));
+
+  // The window: the cameras agree, then their responses change. Keeping only the newest frame's
+  // samples, the estimate is the new frame's alone; pooling everything, it is a mix of both.
+  ColourBalanceOptions window;
+  window.max_pair_samples = 1;  // a frame is kept whole: the newest frame
+  ColourBalanceEstimator follows(9, window), pools(9);
+  for (ColourBalanceEstimator* e : {&follows, &pools}) {
+    ASSERT_TRUE(e->add(agree.hull_mesh, agree.views));
+    ASSERT_TRUE(e->add(differ.hull_mesh, differ.views));
+  }
+  const ColourBalance alone = estimate_colour_balance(differ.hull_mesh, differ.views).value();
+  EXPECT_EQ(follows.solve().estimated, alone.estimated);
+  EXPECT_NE(pools.solve().estimated, alone.estimated);
+  EXPECT_GT(worst_gain_error(response, pools.solve().estimated),
+            worst_gain_error(response, alone.estimated));
+}
+
 TEST(ColourBalance, RefusesBadInputAndKeepsUnlinkedCamerasAtOne) {
   const Scene s = make_scene(sim::Motion::idle, 10, {}, 64);
   ColourBalanceOptions bad;

@@ -10,6 +10,8 @@
 // is BM_PreviewFrame/cameras:1/image_w:352 of the same run.
 // masks:5: the blend also carves against the five cameras' actor masks (the node's carve_masks;
 // ActorTexturer::set_carving_masks); per new mesh that adds the masks' upload.
+// BM_PreviewColourBalance: per new mesh, the cameras' colour balance pooled and solved
+// (preview/rig_balance.h; CPU, no GL).
 #include <benchmark/benchmark.h>
 
 #define GL_GLEXT_PROTOTYPES 1
@@ -19,6 +21,7 @@
 
 #include "actor_texturer.h"
 #include "overlay_renderer.h"
+#include "preview/rig_balance.h"
 #include "scene/view.h"
 #include "scene_assets/scene_description.h"
 #include "scene_config/scene_yaml.h"
@@ -169,6 +172,34 @@ BENCHMARK(BM_PreviewNewMesh)
     ->Args({1, 704, 0})
     ->Args({3, 704, 0})
     ->Args({3, 704, 5})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Per new mesh with the colour balance on (preview/rig_balance.h): one frame pooled from the three
+// texturing cameras' images and masks, then solved; its baseline is BM_PreviewNewMesh/cameras:3
+// of the same image width (the upload every new mesh pays).
+void BM_PreviewColourBalance(benchmark::State& state) {
+  Fixture& f = fixture();
+  const Samples& s = f.samples.at(int(state.range(0)));
+  std::map<std::string, Camera> rig;
+  for (const Camera& c : s.cameras) rig[c.id] = c;
+  std::vector<RunMask> runs;
+  for (const Mask& m : s.masks) runs.push_back(RunMask::from_mask(m.view()));
+  std::vector<preview::BalanceView> views;
+  for (int c : {0, 1, 4}) views.push_back({s.cameras[c].id, s.images[c].view(), &runs[c]});
+  preview::RigBalance balance;
+  for (auto _ : state)
+    if (auto ok = balance.add(rig, s.mesh, views); !ok)
+      state.SkipWithError(ok.error().message.c_str());
+  const offline::ColourBalance& b = balance.balance();
+  state.counters["pairs"] = b.pairs;
+  // Mesh vertices two of the cameras see, per frame.
+  state.counters["points"] = b.frames ? double(b.points) / b.frames : 0;
+}
+BENCHMARK(BM_PreviewColourBalance)
+    ->ArgNames({"image_w"})
+    ->Arg(352)
+    ->Arg(704)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

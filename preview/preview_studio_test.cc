@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -218,6 +219,9 @@ struct Score {
   uint64_t both = 0, rendered_only = 0, true_only = 0;
   double squared_both = 0, squared_rendered_only = 0, squared_true_only = 0;
   double psnr() const { return 10 * std::log10(255.0 * 255.0 / (squared / double(samples))); }
+  double psnr_both() const {
+    return 10 * std::log10(255.0 * 255 / (squared_both / (3.0 * double(both))));
+  }
 };
 
 Score score(const std::vector<Record>& records, const std::filesystem::path& dir,
@@ -260,19 +264,53 @@ Score score(const std::vector<Record>& records, const std::filesystem::path& dir
   return s;
 }
 
+// The held-out camera: between cam0 (azimuth 0) and cam1 (45), lower than the ring; it feeds
+// nothing. Its calibration and the preview's viewpoint from its pose.
+// kW x kH: the studio's image size (PreviewStudioTest::kWidth, kHeight).
+std::pair<Camera, Viewpoint> held_out(int kW, int kH) {
+  const double az = 20 * std::numbers::pi / 180;
+  const Eigen::Vector3d centre(3.6 * std::sin(az), 1.8, 3.6 * std::cos(az)), target(0, 1.1, 0);
+  const double focal = 560.0 * kW / 704.0;
+  const Camera held =
+      support::look_at_camera("held", centre, target, Eigen::Vector3d::UnitY(), kW, kH, focal);
+  return {held, {centre, target, 2 * std::atan(0.5 * kH / focal) * 180 / std::numbers::pi}};
+}
+
+// The headless preview's --json summary: "colour_balance" {"applied", "frames", ...,
+// "estimated": {camera id: [r, g, b]}}.
+struct BalanceSummary {
+  bool found = false, applied = false;
+  int frames = 0, pairs = 0;
+  std::map<std::string, Eigen::Vector3d> estimated;
+};
+BalanceSummary balance_summary(const std::string& log) {
+  BalanceSummary b;
+  std::smatch m;
+  if (!std::regex_search(
+          log, m,
+          std::regex(
+              R"re("colour_balance":\{"on":\w+,"applied":(\w+),"frames":(\d+),"pairs":(\d+))re")))
+    return b;
+  b.found = true;
+  b.applied = m[1] == "true";
+  b.frames = std::stoi(m[2]);
+  b.pairs = std::stoi(m[3]);
+  const std::size_t at = log.find("\"estimated\":{", std::size_t(m.position(0)));
+  if (at == std::string::npos) return b;
+  const std::string rest = log.substr(at, log.find('}', at) - at);
+  const std::regex gain(R"re("([^"]+)":\[([0-9.]+),([0-9.]+),([0-9.]+)\])re");
+  for (auto it = std::sregex_iterator(rest.begin(), rest.end(), gain); it != std::sregex_iterator();
+       ++it)
+    b.estimated[(*it)[1]] = {std::stod((*it)[2]), std::stod((*it)[3]), std::stod((*it)[4])};
+  return b;
+}
+
 TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
   // No scene: the preview's background is the clear colour. The plain actor (no frame code: its
   // sharp bands are a test artefact, not studio content).
   // Eight ring cameras + overhead: the hull of four at 90 degrees is a poor solid between them.
   start_studio(false, false, 9);
-  // Held out: between cam0 (azimuth 0) and cam1 (45), lower than the ring; it feeds nothing.
-  const double az = 20 * std::numbers::pi / 180;
-  const Eigen::Vector3d centre(3.6 * std::sin(az), 1.8, 3.6 * std::cos(az)), target(0, 1.1, 0);
-  const double focal = 560.0 * kWidth / 704.0;
-  const Camera held = support::look_at_camera("held", centre, target, Eigen::Vector3d::UnitY(),
-                                              kWidth, kHeight, focal);
-  const Viewpoint view{centre, target,
-                       2 * std::atan(0.5 * kHeight / focal) * 180 / std::numbers::pi};
+  const auto [held, view] = held_out(kWidth, kHeight);
   // nearest; blend (carving against every camera's mask of the frame, the default); keys: blend
   // carving against its three cameras' keys only (carve_masks: false).
   std::map<std::string, Process*> previews;
@@ -280,12 +318,26 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
     const std::string mode = name == "nearest" ? "nearest" : "blend";
     previews[name] =
         &spawn(name, "preview/studio-preview",
-               {"--headless", "--config",
+               {"--headless",
+                "--config",
                 preview_config(name, 1000, name == "keys" ? "carve_masks: false\n" : ""),
-                "--viewpoint", to_string(view), "--texturing", mode, "--overlays", "none", "--size",
-                std::to_string(kWidth) + "x" + std::to_string(kHeight), "--frames", "30",
-                "--timeout", "120", "--record", (dir_ / name).string(), "--screenshot",
-                (dir_ / (name + ".png")).string()});
+                "--viewpoint",
+                to_string(view),
+                "--texturing",
+                mode,
+                "--overlays",
+                "none",
+                "--size",
+                std::to_string(kWidth) + "x" + std::to_string(kHeight),
+                "--frames",
+                "30",
+                "--timeout",
+                "120",
+                "--record",
+                (dir_ / name).string(),
+                "--screenshot",
+                (dir_ / (name + ".png")).string(),
+                "--json"});
   }
   for (auto& [mode, p] : previews) {
     const auto code = p->wait_exit(std::chrono::seconds(150));
@@ -354,6 +406,19 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
         100 * sc->squared_both / sc->squared, (unsigned long long)sc->rendered_only,
         100 * sc->squared_rendered_only / sc->squared, (unsigned long long)sc->true_only,
         100 * sc->squared_true_only / sc->squared);
+  // The rig's cameras agree: the colour balance (on by default) estimates gains within its 3 %
+  // tolerance and applies none (measured: within 0.5 % in process, preview_quality_test).
+  const BalanceSummary same = balance_summary(previews["blend"]->log());
+  ASSERT_TRUE(same.found) << previews["blend"]->log();
+  double stray = 0;
+  for (const auto& [id, g] : same.estimated)
+    stray = std::max(stray, (g.array() - 1).abs().maxCoeff());
+  std::printf(
+      "identical cameras: colour balance over %d frames, %d pairs, largest estimate %.2f %% "
+      "off 1, applied: %s\n",
+      same.frames, same.pairs, 100 * stray, same.applied ? "yes" : "no");
+  EXPECT_GE(same.frames, 3);
+  EXPECT_FALSE(same.applied);
   ASSERT_GE(nearest.frames, 10);
   ASSERT_GE(blend.frames, 10);
   EXPECT_GT(blend.psnr(), nearest.psnr());
@@ -369,6 +434,125 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
   // preview_quality_test separates geometry from texturing: with the actor's true surface the
   // same blend reaches 28.2 dB; preview_error_sources_test measures what limits the hull.
   // Printed above and reported, not asserted.
+}
+
+// A rig whose cameras differ as a real rig's do (exposure +-10 %, white balance +-5 %: the
+// capture config's sim `response`, drawn by sim::random_camera_response, seed 3), previewed from
+// the held-out camera's pose (whose response is 1, 1, 1) with the colour balance (the default)
+// and without it. The gains the preview estimated live match the simulated cameras' relative
+// responses and are what the balanced preview draws with; the other draws with none.
+// BlendBeatsNearestAgainstAHeldOutCamera is the control: there the cameras agree and the default
+// balance leaves them alone.
+TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
+  auto response = sim::random_camera_response(9, 3, 0.1, 0.05);
+  for (double& g : response[1]) g *= 1.25;  // cam1's exposure a third of a stop up
+  start_studio(false, false, 9, response);
+  const auto [held, view] = held_out(kWidth, kHeight);
+  std::map<std::string, Process*> previews;
+  for (const std::string name : {"balanced", "unbalanced"})
+    previews[name] = &spawn(name, "preview/studio-preview",
+                            {"--headless",
+                             "--config",
+                             preview_config(name, 1000, "colour_balance_every: 1\n"),
+                             "--viewpoint",
+                             to_string(view),
+                             "--colour-balance",
+                             name == "balanced" ? "on" : "off",
+                             "--overlays",
+                             "none",
+                             "--size",
+                             std::to_string(kWidth) + "x" + std::to_string(kHeight),
+                             "--frames",
+                             "30",
+                             "--timeout",
+                             "120",
+                             "--record",
+                             (dir_ / name).string(),
+                             "--screenshot",
+                             (dir_ / (name + ".png")).string(),
+                             "--json"});
+  for (auto& [name, p] : previews) {
+    const auto code = p->wait_exit(std::chrono::seconds(150));
+    ASSERT_TRUE(code.has_value()) << name;
+    ASSERT_EQ(*code, 0) << p->log();
+  }
+  // The estimate: every pair of cameras it linked, their gain ratio against the truth's.
+  const BalanceSummary b = balance_summary(previews["balanced"]->log());
+  const BalanceSummary off = balance_summary(previews["unbalanced"]->log());
+  ASSERT_TRUE(b.found) << previews["balanced"]->log();
+  ASSERT_TRUE(off.found) << previews["unbalanced"]->log();
+  EXPECT_TRUE(b.applied);
+  EXPECT_GE(b.frames, 20);  // every textured mesh of 30 (colour_balance_every: 1)
+  EXPECT_FALSE(off.applied);
+  EXPECT_EQ(off.frames, 0);
+  const auto truth = sim::balancing_gains(response);
+  std::vector<std::pair<int, Eigen::Vector3d>> linked;  // camera index, estimate
+  for (const auto& [id, g] : b.estimated)
+    if (g != Eigen::Vector3d::Ones()) linked.emplace_back(std::stoi(id.substr(3)), g);
+  ASSERT_GE(linked.size(), 2u);
+  double worst = 0, worst_without = 0;
+  for (std::size_t p = 0; p < linked.size(); ++p)
+    for (std::size_t q = p + 1; q < linked.size(); ++q)
+      for (int k = 0; k < 3; ++k) {
+        const auto& [i, gi] = linked[p];
+        const auto& [j, gj] = linked[q];
+        const double want =
+            truth[std::size_t(i)][std::size_t(k)] / truth[std::size_t(j)][std::size_t(k)];
+        worst = std::max(worst, std::abs(gi[k] / gj[k] / want - 1));
+        worst_without = std::max(worst_without, std::abs(1 / want - 1));
+      }
+  std::printf(
+      "colour balance: %d frames pooled, %d camera pairs, %zu cameras linked; worst pair "
+      "ratio error %.2f %% (%.2f %% between the cameras without it)\n",
+      b.frames, b.pairs, linked.size(), 100 * worst, 100 * worst_without);
+  // Measured 0.5-4.1 % over 16 runs (pooling one mesh in 2: 0.9-3.4 % in 10): the poses of a
+  // run decide which cameras texture and how the view-dependent light (the backing's blue spill
+  // above all) biases the medians. preview_quality_test holds the estimate to 1 % on fixed poses
+  // (measured 0.44 %); here, against the running studio, it takes out at least half of the
+  // cameras' differences.
+  EXPECT_LT(worst, 0.5 * worst_without);
+  // The gains reached the drawing: each drawn mesh's texturing cameras' gains (frames.jsonl):
+  // some differ from 1 in the balanced preview once the estimate is applied, none in the other.
+  auto drawn_gains = [&](const std::string& name) {
+    std::vector<double> out;
+    std::ifstream in(dir_ / name / "frames.jsonl");
+    const std::regex list(R"re("gains":\[([^"]*)\],"balance_pooled")re"), number(R"re([0-9.]+)re");
+    for (std::string line; std::getline(in, line);) {
+      std::smatch m;
+      if (!std::regex_search(line, m, list)) continue;
+      const std::string l = m[1];
+      for (auto it = std::sregex_iterator(l.begin(), l.end(), number); it != std::sregex_iterator();
+           ++it)
+        out.push_back(std::stod(it->str()));
+    }
+    return out;
+  };
+  const auto on = drawn_gains("balanced"), plain = drawn_gains("unbalanced");
+  ASSERT_FALSE(on.empty());
+  ASSERT_FALSE(plain.empty());
+  EXPECT_TRUE(std::any_of(on.begin(), on.end(), [](double g) { return std::abs(g - 1) > 0.005; }));
+  EXPECT_TRUE(std::all_of(plain.begin(), plain.end(), [](double g) { return g == 1; }));
+  // Against the held-out camera (printed, not asserted): the cameras' few percent are small
+  // beside the visual hull's misregistration here, and which cameras texture the view changes
+  // with the poses of the run (measured in 3 runs: where both silhouettes agree -0.12, +0.64,
+  // -0.06 dB). preview_quality_test measures the balance's effect deterministically, in process.
+  sim::StudioOptions o;
+  o.threads = 1;
+  auto truth_studio = sim::SimulatedStudio::create({held}, o).value();
+  std::vector<Record> both_b, both_u;
+  for (const Record& r : read_records(dir_ / "balanced" / "frames.jsonl"))
+    for (const Record& u : read_records(dir_ / "unbalanced" / "frames.jsonl"))
+      if (r.source_frame == u.source_frame && r.textured && u.textured) {
+        both_b.push_back(r);
+        both_u.push_back(u);
+      }
+  const Score balanced = score(both_b, dir_ / "balanced", truth_studio),
+              unbalanced = score(both_u, dir_ / "unbalanced", truth_studio);
+  std::printf(
+      "the same %d meshes, held-out camera: where both silhouettes agree %.2f dB balanced, "
+      "%.2f dB not; the union %.2f / %.2f dB\n",
+      balanced.frames, balanced.psnr_both(), unbalanced.psnr_both(), balanced.psnr(),
+      unbalanced.psnr());
 }
 
 }  // namespace

@@ -70,19 +70,36 @@ Expected<void> ColourBalanceEstimator::add(const hull::Mesh& mesh,
   if (views.size() != cameras_)
     return fail("colour balance: " + std::to_string(views.size()) + " views for " +
                 std::to_string(cameras_) + " cameras");
-  auto prepared = prepare_views(views, options_.edge_margin_px);
+  // The views of this frame (absent ones skipped) and their cameras' indices.
+  std::vector<ColourView> present;
+  std::vector<int> index;
+  for (std::size_t c = 0; c < views.size(); ++c) {
+    const ColourView& v = views[c];
+    if (!v.camera && !v.mask && v.image.width() == 0) continue;  // absent this frame
+    if (!v.camera) return fail("colour balance: view " + std::to_string(c) + " has no camera");
+    present.push_back(v);
+    index.push_back(int(c));
+  }
+  if (present.size() < 2) {  // nothing to compare: a frame with no pair
+    ++frames_;
+    return {};
+  }
+  auto prepared = prepare_views(present, options_.edge_margin_px);
   if (!prepared) return std::unexpected(prepared.error());
   const std::vector<SampledView>& sv = *prepared;
   const int n = int(sv.size());
+  const int all = int(cameras_);
   std::vector<DepthBuffer> depth(sv.size());
   for (std::size_t c = 0; c < sv.size(); ++c) {
     depth[c].reset(sv[c]);
     depth[c].mesh(sv[c], mesh);
   }
   const std::vector<Eigen::Vector3d> normals = vertex_normals(mesh);
-  // Per ordered pair (i < j) and channel: log(colour_i) - log(colour_j) of the shared points.
-  const auto pair_index = [n](int i, int j) { return std::size_t(i) * std::size_t(n) + j; };
+  // Per ordered pair (i < j, the cameras' indices) and channel: log(colour_i) - log(colour_j) of
+  // the shared points.
+  const auto pair_index = [all](int i, int j) { return std::size_t(i) * std::size_t(all) + j; };
   std::mutex merge;
+  std::vector<std::array<std::vector<float>, 3>> fresh(ratios_.size());  // this frame's
   const float lo = float(options_.min_level), hi = float(options_.max_level);
   detail::parallel_for(mesh.vertices.size(), options_.threads, [&](std::size_t a, std::size_t b) {
     std::vector<std::array<std::vector<float>, 3>> local(ratios_.size());
@@ -95,7 +112,7 @@ Expected<void> ColourBalanceEstimator::add(const hull::Mesh& mesh,
       for (int c = 0; c < n; ++c)
         if (auto o = observe(sv[std::size_t(c)], depth[std::size_t(c)], x, normals[v],
                              options_.min_cos, options_.depth_tolerance))
-          obs.emplace_back(c, *o);
+          obs.emplace_back(index[std::size_t(c)], *o);
       if (obs.size() < 2) continue;
       ++seen_twice;
       for (std::size_t p = 0; p < obs.size(); ++p)
@@ -114,12 +131,24 @@ Expected<void> ColourBalanceEstimator::add(const hull::Mesh& mesh,
     points_ += seen_twice;
     for (std::size_t i = 0; i < local.size(); ++i)
       for (int k = 0; k < 3; ++k) {
-        auto& to = ratios_[i][std::size_t(k)];
+        auto& to = fresh[i][std::size_t(k)];
         const auto& from = local[i][std::size_t(k)];
         to.insert(to.end(), from.begin(), from.end());
       }
   });
-  // The merge order depends on the threads; the medians and counts do not.
+  // The merge order depends on the threads; the medians and counts do not. The window
+  // (max_pair_samples) drops older frames' samples first, never this frame's.
+  const std::size_t cap = options_.max_pair_samples;
+  for (std::size_t i = 0; i < ratios_.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      auto& to = ratios_[i][std::size_t(k)];
+      const auto& from = fresh[i][std::size_t(k)];
+      if (cap > 0 && to.size() + from.size() > cap) {
+        const std::size_t drop = std::min(to.size(), to.size() + from.size() - cap);
+        to.erase(to.begin(), to.begin() + std::ptrdiff_t(drop));
+      }
+      to.insert(to.end(), from.begin(), from.end());
+    }
   ++frames_;
   return {};
 }

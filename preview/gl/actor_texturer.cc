@@ -54,6 +54,7 @@ uniform float carve_step;
 uniform int carve_steps;
 uniform float angle_threshold;
 uniform float weight[3];
+uniform vec3 gain[3];  // per camera: its colour balance (preview/rig_balance.h), 1 when none
 uniform mat4 clip[3];
 uniform mat4 cam[3];
 uniform vec3 centre[3];
@@ -112,7 +113,7 @@ void add(int i, sampler2D colour, sampler2D depth, vec3 x, float tol, inout vec3
   if (z > texture(depth, st).r + tol) return;  // another part of the actor is nearer to camera i
   vec4 texel = texture(colour, uv);
   if (backing(texel)) { keyed += 1; return; }
-  vec3 c = texel.rgb;
+  vec3 c = texel.rgb * gain[i];
   float w = weight[i];
   if (mode == 2) {  // ULR at x: (1 - a / a_thr) / a, a = angle(novel ray, camera ray)
     vec3 to_cam = normalize(centre[i] - x);
@@ -171,6 +172,7 @@ struct Slot {
   std::vector<uint8_t> rgba;  // the image with its key in alpha (scratch)
   Eigen::Matrix4d clip = Eigen::Matrix4d::Identity(), cam = Eigen::Matrix4d::Identity();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // world
+  Eigen::Vector3f gains = Eigen::Vector3f::Ones();
 };
 
 // RGB8 → RGBA8 with the chroma key in alpha: 0 where blue exceeds red and green by `margin`
@@ -290,11 +292,15 @@ Expected<void> ActorTexturer::set_mesh(const scene::ActorMesh& mesh) {
   return {};
 }
 
-Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const uint8_t* rgb) {
+Expected<void> ActorTexturer::set_camera(int slot, const Camera& camera, const uint8_t* rgb,
+                                         const Eigen::Vector3f& gains) {
   if (slot < 0 || slot >= kMaxCameras) return fail("actor texturer: slot out of range");
   if (camera.width < 1 || camera.height < 1 || !rgb)
     return fail("actor texturer: camera " + camera.id + " without an image");
+  if (!gains.allFinite() || (gains.array() <= 0).any())
+    return fail("actor texturer: camera " + camera.id + ": colour gains must be finite and > 0");
   Slot& s = impl_->slots[slot];
+  s.gains = gains;
   // The caller's framebuffer and viewport, restored at the end (creating the slot binds its own).
   GLint previous_fbo = 0, viewport[4];
   glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous_fbo);
@@ -431,6 +437,7 @@ void ActorTexturer::draw(const DrawView& view, TextureMode mode,
     float w = s.colour ? weights[i] : 0.0f;
     if (mode == TextureMode::nearest && i > 0) w = 0;
     glUniform1f(at("weight" + k), w);
+    glUniform3fv(at("gain" + k), 1, s.gains.data());
     gl::set_matrix(p, ("clip" + k).c_str(), s.clip);
     gl::set_matrix(p, ("cam" + k).c_str(), s.cam);
     const Eigen::Vector3f c = s.centre.cast<float>();

@@ -4,9 +4,9 @@
 //
 // Three modes (TextureMode):
 //   flat:    the whole mesh flat-shaded in `untextured` (no images of the mesh's frame);
-//   nearest: the paper's: every surface point x coloured from one camera (slot 0) where it sees
-//            x (visible_0 below) and not the backing there, else `unseen`; a point that camera
-//            sees as backing is not drawn;
+//   nearest: the paper's: every surface point x coloured from one camera (slot 0, times its
+//            gains) where it sees x (visible_0 below) and not the backing there, else `unseen`;
+//            a point that camera sees as backing is not drawn;
 //   blend:   beyond the paper, image-based refinement of the hull and view-dependent blending of
 //            up to kMaxCameras cameras (unstructured lumigraph rendering, Buehler et al. 2001):
 //     1. carving (the image-based visual hull of Matusik et al. 2000, per pixel): the mesh is
@@ -21,12 +21,13 @@
 //        carved depth); backing_i(x): camera i sees the blue backing at x: the bilinear
 //        interpolation of its key (1 on pixels that are not backing by the chroma key's rule,
 //        blue above red and green by `key_margin`; 0 on backing) is below `key_threshold`;
-//     3. colour(x) = sum_i w_i v_i image_i(proj_i(x)) / sum_i w_i v_i, v_i = visible_i and not
-//        backing_i, with per-point ULR weights w_i = cos_i (1 - a_i / a_thr) / a_i, a_i the
-//        angle at x between the novel view's ray and camera i's ray, a_thr the blend's
-//        threshold angle (camera_select.h), cos_i = |normal . ray to camera i| (ULR's
-//        resolution penalty: a grazing view is foreshortened and spilled). A camera that cannot
-//        see x does not colour it.
+//     3. colour(x) = sum_i w_i v_i g_i image_i(proj_i(x)) / sum_i w_i v_i, g_i camera i's colour
+//        gains (set_camera; 1 unless balanced), v_i = visible_i and not backing_i, with
+//        per-point ULR weights w_i = cos_i (1 - a_i / a_thr) / a_i, a_i the angle at x between
+//        the novel view's ray and camera i's ray, a_thr the blend's threshold angle
+//        (camera_select.h), cos_i = |normal . ray to camera i| (ULR's resolution penalty: a
+//        grazing view is foreshortened and spilled). A camera that cannot see x does not
+//        colour it.
 // A point no camera sees is drawn in `unseen` (flat). Cameras are pinholes (K, cam_from_world,
 // image size; the paper's radial distortion is ignored here: below a pixel for the studio's lenses
 // at the preview's scale). Needs a current OpenGL 3.3 core context; GL names are plain unsigned
@@ -84,9 +85,11 @@ class ActorTexturer {
   // The mesh to draw (uploaded once per call).
   Expected<void> set_mesh(const scene::ActorMesh& mesh);
   // Camera slot (0..kMaxCameras-1): calibration and its RGB8 image (width*height*3 bytes, top
-  // row first). Renders the slot's visibility depth map of the current mesh: call after
-  // set_mesh().
-  Expected<void> set_camera(int slot, const Camera& camera, const uint8_t* rgb);
+  // row first), and the factors its colours are multiplied by where it colours the actor (its
+  // colour balance, preview/rig_balance.h; the key is the image's own). Renders the slot's
+  // visibility depth map of the current mesh: call after set_mesh().
+  Expected<void> set_camera(int slot, const Camera& camera, const uint8_t* rgb,
+                            const Eigen::Vector3f& gains = Eigen::Vector3f::Ones());
   // Blend mode's carving also against these silhouettes (up to kMaxMasks cameras, one size;
   // mask: width*height bytes, top row first, 0 backing, else actor): the march stops at the
   // first point inside every selected camera's key and every mask here, the image-based visual

@@ -199,6 +199,8 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
     po.asset_root = config.asset_root;
     po.overlays = config.overlays;
     po.carve_all_masks = config.carve_masks;
+    po.colour_balance = config.colour_balance;
+    po.balance_every = config.colour_balance_every;
     auto pipeline = ViewPipeline::create(node, po);
     if (!pipeline) return error(pipeline.error().message);
     PanelState panels;

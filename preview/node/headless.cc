@@ -44,6 +44,34 @@ bool replace_png(const std::string& path, const std::vector<uint8_t>& rgba, int 
   return !ec;
 }
 
+// [r, g, b] with 4 decimals.
+std::string gains_json(const Eigen::Vector3f& g) {
+  char b[64];
+  std::snprintf(b, sizeof b, "[%.4f,%.4f,%.4f]", g.x(), g.y(), g.z());
+  return b;
+}
+
+// {"on", "applied", "frames", "pairs", "residual", "gains": {camera id: [r, g, b]},
+// "estimated": {...}}: the pipeline's colour balance at the end of the run
+// (preview/rig_balance.h; gains are the estimate when applied, else 1).
+std::string balance_json(const ViewPipeline& pipeline) {
+  const RigBalance& rb = pipeline.colour_balance();
+  const offline::ColourBalance& b = rb.balance();
+  char head[160];
+  std::snprintf(head, sizeof head,
+                "{\"on\":%s,\"applied\":%s,\"frames\":%d,\"pairs\":%d,\"residual\":%.5f,"
+                "\"gains\":{",
+                pipeline.colour_balance_on() ? "true" : "false", b.applied ? "true" : "false",
+                b.frames, b.pairs, b.residual);
+  std::string out = head;
+  for (std::size_t i = 0; i < rb.cameras().size() && i < b.gains.size(); ++i)
+    out += (i ? ",\"" : "\"") + rb.cameras()[i] + "\":" + gains_json(b.gains[i]);
+  out += "},\"estimated\":{";
+  for (std::size_t i = 0; i < rb.cameras().size() && i < b.estimated.size(); ++i)
+    out += (i ? ",\"" : "\"") + rb.cameras()[i] + "\":" + gains_json(b.estimated[i]);
+  return out + "}}";
+}
+
 int error(const std::string& message, int status) {
   std::fprintf(stderr, "studio-preview: %s\n", message.c_str());
   return status;
@@ -80,6 +108,8 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   po.overlays = config.overlays;
   po.prefetch = options.every_s <= 0;  // low-rate pictures ask only for the meshes they draw
   po.carve_all_masks = config.carve_masks;
+  po.colour_balance = config.colour_balance;
+  po.balance_every = config.colour_balance_every;
   auto pipeline = ViewPipeline::create(node, po);
   if (!pipeline) return error(pipeline.error().message, 1);
   auto target = scene_render::RenderTarget::create(config.width, config.height);
@@ -134,7 +164,10 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
           << ",\"textured\":" << (r.textured ? "true" : "false") << ",\"cameras\":[";
       for (std::size_t i = 0; i < r.cameras.size(); ++i)
         log << (i ? "," : "") << "\"" << r.cameras[i] << "\"";
-      log << "],\"carving_masks\":" << r.carving_masks << "}\n";
+      log << "],\"carving_masks\":" << r.carving_masks << ",\"gains\":[";
+      for (std::size_t i = 0; i < r.gains.size(); ++i)
+        log << (i ? "," : "") << gains_json(r.gains[i]);
+      log << "],\"balance_pooled\":" << (r.balance_pooled ? "true" : "false") << "}\n";
       log.flush();
     }
     if (!every && options.duration_s <= 0 && drawn >= options.frames) break;
@@ -150,12 +183,12 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
         "{\"screenshot\":\"%s\",\"width\":%d,\"height\":%d,\"meshes\":%llu,"
         "\"textured\":%llu,\"untextured\":%llu,\"late\":%llu,\"refused\":%llu,"
         "\"skipped\":%llu,\"seconds\":%.3f,\"renderer\":\"%s\",\"overlays\":{\"heads\":%zu,"
-        "\"cameras\":%zu,\"projectors\":%zu,\"thumbnails\":%zu}}\n",
+        "\"cameras\":%zu,\"projectors\":%zu,\"thumbnails\":%zu},\"colour_balance\":%s}\n",
         options.screenshot.c_str(), config.width, config.height, (unsigned long long)c.meshes,
         (unsigned long long)c.textured, (unsigned long long)c.untextured,
         (unsigned long long)c.late, (unsigned long long)c.refused, (unsigned long long)c.skipped,
         seconds, context->renderer().c_str(), o.heads, node.cameras().size(), o.projectors,
-        o.thumbnails);
+        o.thumbnails, balance_json(**pipeline).c_str());
   else
     std::printf(
         "%s: %dx%d, %d meshes drawn (%llu textured, %llu untextured: %llu late, %llu refused; "

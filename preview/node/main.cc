@@ -17,7 +17,7 @@ namespace {
 
 constexpr const char* kUsage =
     R"(usage: studio-preview [--config preview.yaml] [--viewpoint V] [--texturing blend|nearest]
-                      [--size WxH] [--overlays LIST]
+                      [--colour-balance on|off] [--size WxH] [--overlays LIST]
        studio-preview --headless --screenshot PNG [--frames N | --duration S] [--every S]
                       [--record DIR] [--timeout S] [--settle S]
                       [--json] [same options]
@@ -39,6 +39,11 @@ Options:
   --texturing T     blend (up to three cameras: the hull carved per pixel by their keys and
                     every camera's mask of the mesh's frame, visibility by depth maps,
                     per-point ULR weights) or nearest (the paper's)
+  --colour-balance B
+                    on (default; preview.yaml's colour_balance) or off: each texturing camera's
+                    image drawn with its colour gains, estimated live from the surface points two
+                    cameras both see, so that cameras whose exposure or white balance differ
+                    leave no seams; gains stay 1 while every camera is within 3 % of the rig
   --size WxH        window or screenshot size
   --overlays LIST   which overlays the 3D view draws: any of head, cameras, projectors,
                     screens (comma separated), all or none (default all; preview.yaml's
@@ -47,7 +52,7 @@ Options:
   --screenshot PNG  headless: the last frame
   --frames N        headless: draw N new meshes, then stop (default 1; 0 = the scene only)
   --record DIR      headless: every drawn mesh's frame as DIR/<n>.png plus DIR/frames.jsonl
-                    ({"image", "source_frame", "textured", "cameras"} per line)
+                    ({"image", "source_frame", "textured", "cameras", "gains"} per line)
   --timeout S       headless: give up after S seconds (default 30)
   --settle S        headless with --frames 0: draw for S seconds before the screenshot, so
                     the scene and the overlays' topics arrive (default 1)
@@ -58,7 +63,8 @@ Options:
                     only the drawn meshes' images are requested; runs for --duration, else
                     until SIGINT/SIGTERM; exit 1 if no mesh was drawn
   --json            headless: the summary as one JSON line ("overlays": the heads, cameras,
-                    calibrated projectors and thumbnails received)
+                    calibrated projectors and thumbnails received; "colour_balance": applied,
+                    frames pooled, camera pairs and per camera id its gains)
   --test-script F   GUI: scripted input for tests (gui.h: one action per line)
 
 Headless, SIGINT/SIGTERM end the run like its deadline (the screenshot is written).
@@ -82,7 +88,7 @@ T number(const std::string& flag, const std::string& text, T lo, T hi) {
 }
 
 int run(int argc, char** argv) {
-  std::string config_path, viewpoint, texturing, size, script, overlays;
+  std::string config_path, viewpoint, texturing, size, script, overlays, balance;
   bool headless = false;
   preview::HeadlessOptions h;
   for (int i = 1; i < argc; ++i) {
@@ -101,6 +107,8 @@ int run(int argc, char** argv) {
       viewpoint = value();
     } else if (a == "--texturing") {
       texturing = value();
+    } else if (a == "--colour-balance") {
+      balance = value();
     } else if (a == "--size") {
       size = value();
     } else if (a == "--overlays") {
@@ -140,6 +148,11 @@ int run(int argc, char** argv) {
     if (texturing != "blend" && texturing != "nearest")
       die("--texturing: expected blend or nearest, got '" + texturing + "'");
     config->blend = texturing == "blend";
+  }
+  if (!balance.empty()) {
+    if (balance != "on" && balance != "off")
+      die("--colour-balance: expected on or off, got '" + balance + "'");
+    config->colour_balance = balance == "on";
   }
   if (!size.empty()) {
     const auto x = size.find('x');

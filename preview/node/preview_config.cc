@@ -11,7 +11,8 @@ struct Keys {
   std::string dds_config, log, viewpoint, texturing = "blend", asset_root, take = "take";
   std::vector<int> size{1280, 720};
   int blend_cameras = 3, wait_ms = 200;
-  bool carve_masks = true;
+  bool carve_masks = true, colour_balance = true;
+  int colour_balance_every = 4;
   bool head_marker = true, camera_frusta = true, projector_frusta = true, projector_screens = true;
   double camera_frustum_m = 0.5;
 };
@@ -29,6 +30,8 @@ const yaml::Schema<Keys> kSchema{
     yaml::field("asset_root", &Keys::asset_root).relative_path(),
     yaml::field("take", &Keys::take),
     yaml::field("carve_masks", &Keys::carve_masks),
+    yaml::field("colour_balance", &Keys::colour_balance),
+    yaml::field("colour_balance_every", &Keys::colour_balance_every).range(1, 1000),
     yaml::field("head_marker", &Keys::head_marker),
     yaml::field("camera_frusta", &Keys::camera_frusta),
     yaml::field("camera_frustum_m", &Keys::camera_frustum_m).range(0.01, 20),
@@ -66,6 +69,8 @@ Expected<PreviewConfig> read_preview_config(const std::string& path) {
   c.asset_root = k->asset_root;
   c.take = k->take;
   c.carve_masks = k->carve_masks;
+  c.colour_balance = k->colour_balance;
+  c.colour_balance_every = k->colour_balance_every;
   c.overlays.head = k->head_marker;
   c.overlays.camera_frusta = k->camera_frusta;
   c.overlays.camera_frustum_m = k->camera_frustum_m;

@@ -26,6 +26,8 @@ struct PreviewConfig {
   std::string take = "take";       // the capture panel's default take name
   OverlayOptions overlays;         // head marker, frusta, projector screens in the 3D view
   bool carve_masks = true;         // blend: carve against every camera's mask of the frame
+  bool colour_balance = true;      // the cameras' colour balance (preview/rig_balance.h)
+  int colour_balance_every = 4;    // pool one textured mesh in this many into it
   Expected<void> validate() const;
 };
 
@@ -46,6 +48,13 @@ inline constexpr const char* kConfigHelp =
     "  carve_masks: true             blend: carve the hull per pixel against every camera's\n"
     "                                actor mask of the mesh's frame (studio/camera/mask), not\n"
     "                                only the three texturing cameras' keys\n"
+    "  colour_balance: true          draw each camera's image with its colour gains, estimated\n"
+    "                                from the surface points two texturing cameras both see\n"
+    "                                (a real rig's cameras differ by a few percent per channel:\n"
+    "                                seams in the blend); gains stay 1 while every camera is\n"
+    "                                within 3 % of the rig\n"
+    "  colour_balance_every: 4       pool one textured mesh in this many into the estimate\n"
+    "                                (4-10 ms each on the render thread)\n"
     "  head_marker: true             the tracked head (studio/actor/head): a yellow sphere,\n"
     "                                its velocity (orange) and sight lines to each screen\n"
     "  camera_frusta: true           each studio camera's frustum (cyan, from\n"

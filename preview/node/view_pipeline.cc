@@ -78,6 +78,8 @@ struct ViewPipeline::Impl {
   std::vector<Camera> carving_cameras;  // the carving masks' cameras and masks (kept: uploaded)
   std::vector<Mask> carving_masks;
   std::size_t carving_count = 0;
+  RigBalance balance;
+  uint64_t textured_seen = 0;  // textured meshes so far (the first and every balance_every-th pool)
   std::shared_ptr<PrefetchState> prefetch = std::make_shared<PrefetchState>();
 
   Impl(PreviewNode& n, const PipelineOptions& o, scene_render::Renderer r, ActorTexturer t,
@@ -157,11 +159,12 @@ struct ViewPipeline::Impl {
 
   // The blend's carving masks: every calibrated camera's mask of exactly `frame` that arrived,
   // of the first such camera's size (one texture array), at most kMaxMasks; else none.
-  void set_carving_masks(const std::map<std::string, Camera>& cams, uint64_t frame) {
+  void set_carving_masks(const std::map<std::string, Camera>& cams,
+                         const std::map<std::string, RunMask>& masks) {
     carving_cameras.clear();
     carving_masks.clear();
     if (options.blend && options.carve_all_masks) {
-      for (auto& [id, m] : node->masks(frame)) {
+      for (auto& [id, m] : masks) {
         const auto c = cams.find(id);
         if (c == cams.end() || m.width() != c->second.width || m.height() != c->second.height)
           continue;
@@ -185,6 +188,30 @@ struct ViewPipeline::Impl {
     carving_count = list.size();
   }
 
+  // Pools the pending mesh's texturing images and their masks into the colour balance when it is
+  // on and this is the first textured mesh or the balance_every-th since; true when pooled.
+  bool pool_balance(const std::map<std::string, Camera>& cams,
+                    const std::map<std::string, RunMask>& masks,
+                    const std::vector<FrameImage>& imgs) {
+    const bool due = textured_seen++ % uint64_t(options.balance_every) == 0;
+    if (!options.colour_balance || !due) return false;
+    std::vector<BalanceView> views;
+    for (std::size_t i = 0; i < imgs.size(); ++i) {
+      const auto m = masks.find(pending_cameras[i]);
+      if (m == masks.end()) continue;  // its mask of the frame was lost: it takes no part
+      views.push_back({pending_cameras[i],
+                       ImageView<const Rgb8>(reinterpret_cast<const Rgb8*>(imgs[i].rgb.data()),
+                                             imgs[i].width, imgs[i].height),
+                       &m->second});
+    }
+    if (auto ok = balance.add(cams, pending->mesh, views); !ok) {
+      STUDIO_LOG(warn, "preview") << ok.error().message;
+      return false;
+    }
+    ++counts.balance_frames;
+    return true;
+  }
+
   // Promotes the pending mesh when its images are here (textured) or it waited too long.
   bool promote(bool block) {
     if (!pending) return false;
@@ -205,17 +232,29 @@ struct ViewPipeline::Impl {
     }
     bool textured = imgs.has_value();
     const auto cams = node->cameras();
-    set_carving_masks(cams, pending->source_frame);
+    const auto masks = node->masks(pending->source_frame);
+    set_carving_masks(cams, masks);
+    if (textured)
+      for (std::size_t i = 0; i < imgs->size() && textured; ++i) {
+        const auto c = cams.find(pending_cameras[i]);
+        textured = c != cams.end() && c->second.width == (*imgs)[i].width &&
+                   c->second.height == (*imgs)[i].height;
+      }
+    const bool pooled = textured && pool_balance(cams, masks, *imgs);
+    std::vector<Eigen::Vector3f> gains;
     if (textured) {
       for (std::size_t i = 0; i < imgs->size() && textured; ++i) {
-        const FrameImage& img = (*imgs)[i];
-        const auto c = cams.find(pending_cameras[i]);
-        textured = c != cams.end() && c->second.width == img.width &&
-                   c->second.height == img.height &&
-                   texturer.set_camera(int(i), c->second, img.rgb.data()).has_value();
+        const Eigen::Vector3f g =
+            options.colour_balance ? balance.gains(pending_cameras[i]) : Eigen::Vector3f::Ones();
+        gains.push_back(g);
+        textured =
+            texturer.set_camera(int(i), cams.at(pending_cameras[i]), (*imgs)[i].rgb.data(), g)
+                .has_value();
       }
     }
     current = {};
+    current.gains = std::move(gains);
+    current.balance_pooled = pooled;
     current.new_mesh = true;
     current.textured = textured;
     current.source_frame = pending->source_frame;
@@ -238,6 +277,7 @@ ViewPipeline::~ViewPipeline() { impl_->node->set_prefetch({}); }
 Expected<std::unique_ptr<ViewPipeline>> ViewPipeline::create(PreviewNode& node,
                                                              const PipelineOptions& options) {
   if (auto ok = options.blend_options.validate(); !ok) return std::unexpected(ok.error());
+  if (options.balance_every < 1) return fail("colour balance: balance_every must be >= 1");
   auto r = scene_render::Renderer::create();
   if (!r) return std::unexpected(r.error());
   if (auto ok = options.overlays.validate(); !ok) return std::unexpected(ok.error());
@@ -310,6 +350,9 @@ void ViewPipeline::set_blend(bool blend) {
   impl_->prefetch->blend = blend;
 }
 bool ViewPipeline::blend() const { return impl_->options.blend; }
+const RigBalance& ViewPipeline::colour_balance() const { return impl_->balance; }
+void ViewPipeline::set_colour_balance(bool on) { impl_->options.colour_balance = on; }
+bool ViewPipeline::colour_balance_on() const { return impl_->options.colour_balance; }
 OverlayOptions& ViewPipeline::overlays() { return impl_->options.overlays; }
 ViewPipeline::Thumbnail ViewPipeline::thumbnail(const std::string& projector_id) const {
   const auto t = impl_->overlay.thumbnail(projector_id);

@@ -22,6 +22,7 @@
 
 #include "preview/camera_select.h"
 #include "preview/overlays.h"
+#include "preview/rig_balance.h"
 #include "preview/viewpoint.h"
 #include "preview_node.h"
 
@@ -40,6 +41,13 @@ struct PipelineOptions {
   // Blend: carve the hull against every camera's actor mask of the mesh's frame
   // (studio/camera/mask), not only the three texturing cameras' keys.
   bool carve_all_masks = true;
+  // The cameras' colour balance (preview/rig_balance.h): every textured mesh is drawn with each
+  // texturing camera's gains; one textured mesh in every `balance_every` is pooled into the
+  // estimate (its texturing cameras' images and masks of the mesh's frame: 4-10 ms at 352x288 to
+  // 704x576, BENCHMARKS.md), so that the estimate follows the rig within a second without
+  // costing every frame. A rig whose cameras agree keeps gains 1 (the estimate's tolerance).
+  bool colour_balance = true;
+  int balance_every = 4;
 };
 
 struct FrameReport {
@@ -49,6 +57,10 @@ struct FrameReport {
   std::vector<std::string> cameras;  // texturing cameras (ids), with their weights
   std::vector<float> weights;
   int carving_masks = 0;  // blend: the cameras' masks of the mesh's frame carving it
+  // Per texturing camera: the colour gains (R, G, B) its image was drawn with (all 1 when the
+  // balance is off, the rig is within its tolerance or the camera is not yet linked).
+  std::vector<Eigen::Vector3f> gains;
+  bool balance_pooled = false;  // this mesh's images were pooled into the colour balance
 };
 
 // meshes = drawn meshes = textured + untextured; untextured = late (no reply within `wait`) +
@@ -56,6 +68,7 @@ struct FrameReport {
 // a newer one while their images were on the way (never drawn).
 struct PipelineCounts {
   uint64_t meshes = 0, textured = 0, untextured = 0, late = 0, refused = 0, skipped = 0;
+  uint64_t balance_frames = 0;  // textured meshes pooled into the colour balance
 };
 
 class ViewPipeline {
@@ -76,6 +89,10 @@ class ViewPipeline {
   Eigen::Vector3d actor_centre() const;
   void set_blend(bool blend);
   bool blend() const;
+  // The cameras' colour balance so far (ids in the order of balance().gains), and switching it.
+  const RigBalance& colour_balance() const;
+  void set_colour_balance(bool on);
+  bool colour_balance_on() const;
   OverlayOptions& overlays();
   // GL texture name and size of a projector's latest thumbnail (0: none yet), for the
   // Projectors panel.

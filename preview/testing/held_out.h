@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numbers>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -30,6 +31,7 @@
 #include "hull/segment_mesh.h"
 #include "hull/silhouette_cut.h"
 #include "preview/camera_select.h"
+#include "preview/rig_balance.h"
 #include "scene/view.h"
 #include "scene_render/egl_context.h"
 #include "scene_render/render_target.h"
@@ -204,6 +206,14 @@ struct Scoring {
   // Blend's carving also against every studio camera's mask (the true masks the hull was built
   // from; ActorTexturer::set_carving_masks).
   bool carve_all_cameras = false;
+  // The cameras' colour balance as the node learns it (preview/rig_balance.h): every frame pools
+  // the blend's texturing cameras' images and masks of that frame, then every variant draws with
+  // the gains so far. `balances` (when set) receives the balance after each frame.
+  bool balance = false;
+  std::vector<offline::ColourBalance>* balances = nullptr;
+  // Frames pooled before the scored ones (a preview that has been running: RigBalance applies
+  // its gains once 8 frames are pooled).
+  std::vector<int64_t> balance_warmup;
 };
 
 // Scores every variant over `frames` (a current GL context is needed).
@@ -214,7 +224,11 @@ inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<V
   o.threads = 2;
   auto studio = sim::SimulatedStudio::create(s.cameras, o).value();
   o.threads = 1;
+  o.camera_response.clear();  // the held-out camera: the reference response (1, 1, 1)
   auto held = sim::SimulatedStudio::create({s.held}, o).value();
+  std::map<std::string, Camera> rig;
+  for (const Camera& c : s.cameras) rig[c.id] = c;
+  RigBalance balance;
   TexturerOptions to = setup.texturer;
   if (!setup.hull) to.inflate_m = 0;  // the true surface has no facets to push out
   auto texturer = ActorTexturer::create(to).value();
@@ -225,18 +239,44 @@ inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<V
   Image<Rgb8> truth;
   Mask truth_mask;
   std::vector<uint8_t> rgba;
-  for (const int64_t f : frames) {
-    const sim::FrameTruth t = studio.render_all(f, &images, &masks);
-    held.render(0, f, &truth, &truth_mask);
+  // The frame's mesh (empty when the actor is not seen) and its centre.
+  auto mesh_of = [&](const sim::FrameTruth& t, Eigen::Vector3d* centre) {
     const scene::ActorMesh mesh =
         setup.hull ? hull_mesh(s.cameras, masks, setup.hull_cells) : true_mesh(t.body);
-    if (mesh.triangles.empty()) continue;
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
     for (const auto& v : mesh.vertices) {
       lo = lo.cwiseMin(v.cast<double>());
       hi = hi.cwiseMax(v.cast<double>());
     }
-    const Eigen::Vector3d centre = 0.5 * (lo + hi);
+    *centre = 0.5 * (lo + hi);
+    return mesh;
+  };
+  // Pools the frame's blend cameras into the balance, as the node does.
+  auto pool = [&](const scene::ActorMesh& mesh, const Eigen::Vector3d& centre) {
+    std::vector<RunMask> runs;
+    std::vector<BalanceView> views;
+    runs.reserve(s.cameras.size());
+    for (const CameraWeight& c : preview::blend(s.poses, s.eye, centre)) {
+      runs.push_back(RunMask::from_mask(masks[c.index].view()));
+      views.push_back({s.cameras[c.index].id, images[c.index].view(), &runs.back()});
+    }
+    EXPECT_TRUE(balance.add(rig, mesh, views).has_value());
+    if (setup.balances) setup.balances->push_back(balance.balance());
+  };
+  if (setup.balance)
+    for (const int64_t f : setup.balance_warmup) {
+      const sim::FrameTruth t = studio.render_all(f, &images, &masks);
+      Eigen::Vector3d centre;
+      const scene::ActorMesh mesh = mesh_of(t, &centre);
+      if (!mesh.triangles.empty()) pool(mesh, centre);
+    }
+  for (const int64_t f : frames) {
+    const sim::FrameTruth t = studio.render_all(f, &images, &masks);
+    held.render(0, f, &truth, &truth_mask);
+    Eigen::Vector3d centre;
+    const scene::ActorMesh mesh = mesh_of(t, &centre);
+    if (mesh.triangles.empty()) continue;
+    if (setup.balance) pool(mesh, centre);
     for (std::size_t v = 0; v < variants.size(); ++v) {
       const Variant& var = variants[v];
       const bool blend = var.mode == TextureMode::blend;
@@ -267,7 +307,8 @@ inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<V
         const int c = chosen[i].index;
         EXPECT_TRUE(texturer
                         .set_camera(int(i), s.cameras[c],
-                                    reinterpret_cast<const uint8_t*>(images[c].data()))
+                                    reinterpret_cast<const uint8_t*>(images[c].data()),
+                                    balance.gains(s.cameras[c].id))
                         .has_value());
       }
       target.bind();

@@ -6,6 +6,7 @@
 // enough for a 40-second run on a loaded 2-core machine.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdlib>
 #include <deque>
 #include <fstream>
@@ -78,8 +79,11 @@ class PreviewStudioTest : public ::testing::Test {
 
   // capture (5 cameras; the actor wears the frame code when `frame_code`) + hull, and the scene
   // server when `scene`; waits until each is ready.
-  // `count` cameras: count - 1 on the ring and one overhead.
-  void start_studio(bool scene, bool frame_code = true, int count = 5) {
+  // `count` cameras: count - 1 on the ring and one overhead; `response`: per camera its colour
+  // response (the capture config's sim `response`, sim::StudioOptions::camera_response), or
+  // empty for identical cameras.
+  void start_studio(bool scene, bool frame_code = true, int count = 5,
+                    const std::vector<std::array<double, 3>>& response = {}) {
     const auto rig = dir_ / "rig.yaml";
     ASSERT_TRUE(support::write_rig_yaml(cameras(count), rig));
     std::ofstream cap(dir_ / "capture.yaml");
@@ -88,7 +92,12 @@ class PreviewStudioTest : public ::testing::Test {
     for (int i = 0; i < count; ++i)
       cap << "  - id: cam" << i << "\n    source: {type: sim, ring: " << count << ", index: " << i
           << ", width: " << kWidth << ", height: " << kHeight
-          << ", frame_code: " << (frame_code ? "true" : "false") << "}\n";
+          << ", frame_code: " << (frame_code ? "true" : "false")
+          << (response.empty() ? std::string()
+                               : ", response: [" + std::to_string(response[i][0]) + ", " +
+                                     std::to_string(response[i][1]) + ", " +
+                                     std::to_string(response[i][2]) + "]")
+          << "}\n";
     cap.close();
     std::ofstream(dir_ / "hull.yaml")
         << "instance: hull\nhull:\n  rig: rig.yaml\n  box: [-1.5, 0.0, -1.5, 1.5, 2.4, 1.5]\n"

@@ -54,6 +54,11 @@ struct ColourBalanceOptions {
   // uncorrected and its carve 8 points worse; 2 % keeps every rig measured at its best
   // (docs/offline.md, "Colour balance between cameras").
   double tolerance = 0.02;
+  // ColourBalanceEstimator: per camera pair and channel at most this many samples are pooled,
+  // the newest (0: all). A frame's samples are always kept whole; older frames' are dropped
+  // first. A live estimate (the preview's, pooled over the frames it draws) follows a camera
+  // whose exposure or white balance is changed during the session, in bounded memory.
+  std::size_t max_pair_samples = 0;
   int threads = 1;
   Expected<void> validate() const;
 };
@@ -79,8 +84,10 @@ struct ColourBalance {
 class ColourBalanceEstimator {
  public:
   explicit ColourBalanceEstimator(std::size_t cameras, const ColourBalanceOptions& options = {});
-  // One frame's shared points. Fails (nothing added) on invalid options, a view count other
-  // than `cameras`, or a view whose image or mask size differs from its camera.
+  // One frame's shared points. A view without a camera, image or mask (all of them null or
+  // empty) takes no part in this frame (a camera whose image of the frame is not at hand: the
+  // live preview has only the texturing cameras'). Fails (nothing added) on invalid options, a
+  // view count other than `cameras`, or a view whose image or mask size differs from its camera.
   Expected<void> add(const hull::Mesh& mesh, std::span<const ColourView> views);
   // The same from the views' own hull over `grid` at no more than `columns` columns per axis.
   Expected<void> add(const hull::GridSpec& grid, std::span<const ColourView> views,
