@@ -79,7 +79,8 @@ struct ViewPipeline::Impl {
   std::vector<Mask> carving_masks;
   std::size_t carving_count = 0;
   RigBalance balance;
-  uint64_t textured_seen = 0;  // textured meshes so far (the first and every balance_every-th pool)
+  uint64_t textured_seen =
+      0;  // meshes pool_balance() saw (the first and every balance_every-th pool)
   std::shared_ptr<PrefetchState> prefetch = std::make_shared<PrefetchState>();
 
   Impl(PreviewNode& n, const PipelineOptions& o, scene_render::Renderer r, ActorTexturer t,
@@ -189,12 +190,13 @@ struct ViewPipeline::Impl {
   }
 
   // Pools the pending mesh's texturing images and their masks into the colour balance when it is
-  // on and this is the first textured mesh or the balance_every-th since; true when pooled.
+  // on, the mesh has two or more texturing cameras (nearest mode's one compares nothing) and it
+  // is the first such mesh or the balance_every-th since; true when pooled.
   bool pool_balance(const std::map<std::string, Camera>& cams,
                     const std::map<std::string, RunMask>& masks,
                     const std::vector<FrameImage>& imgs) {
-    const bool due = textured_seen++ % uint64_t(options.balance_every) == 0;
-    if (!options.colour_balance || !due) return false;
+    if (!options.colour_balance || imgs.size() < 2) return false;
+    if (textured_seen++ % uint64_t(options.balance_every) != 0) return false;
     std::vector<BalanceView> views;
     for (std::size_t i = 0; i < imgs.size(); ++i) {
       const auto m = masks.find(pending_cameras[i]);
