@@ -316,28 +316,8 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
   std::map<std::string, Process*> previews;
   for (const std::string name : {"nearest", "blend", "keys"}) {
     const std::string mode = name == "nearest" ? "nearest" : "blend";
-    previews[name] =
-        &spawn(name, "preview/studio-preview",
-               {"--headless",
-                "--config",
-                preview_config(name, 1000, name == "keys" ? "carve_masks: false\n" : ""),
-                "--viewpoint",
-                to_string(view),
-                "--texturing",
-                mode,
-                "--overlays",
-                "none",
-                "--size",
-                std::to_string(kWidth) + "x" + std::to_string(kHeight),
-                "--frames",
-                "30",
-                "--timeout",
-                "120",
-                "--record",
-                (dir_ / name).string(),
-                "--screenshot",
-                (dir_ / (name + ".png")).string(),
-                "--json"});
+    previews[name] = &recorded_preview(name, view, name == "keys" ? "carve_masks: false\n" : "",
+                                       {"--texturing", mode});
   }
   for (auto& [mode, p] : previews) {
     const auto code = p->wait_exit(std::chrono::seconds(150));
@@ -450,27 +430,8 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
   const auto [held, view] = held_out(kWidth, kHeight);
   std::map<std::string, Process*> previews;
   for (const std::string name : {"balanced", "unbalanced"})
-    previews[name] = &spawn(name, "preview/studio-preview",
-                            {"--headless",
-                             "--config",
-                             preview_config(name, 1000, "colour_balance_every: 1\n"),
-                             "--viewpoint",
-                             to_string(view),
-                             "--colour-balance",
-                             name == "balanced" ? "on" : "off",
-                             "--overlays",
-                             "none",
-                             "--size",
-                             std::to_string(kWidth) + "x" + std::to_string(kHeight),
-                             "--frames",
-                             "30",
-                             "--timeout",
-                             "120",
-                             "--record",
-                             (dir_ / name).string(),
-                             "--screenshot",
-                             (dir_ / (name + ".png")).string(),
-                             "--json"});
+    previews[name] = &recorded_preview(name, view, "colour_balance_every: 1\n",
+                                       {"--colour-balance", name == "balanced" ? "on" : "off"});
   for (auto& [name, p] : previews) {
     const auto code = p->wait_exit(std::chrono::seconds(150));
     ASSERT_TRUE(code.has_value()) << name;

@@ -13,6 +13,7 @@
 #include <numbers>
 
 #include "harness/process.h"
+#include "preview/viewpoint.h"
 #include "sim/cameras.h"
 #include "support/cameras.h"
 
@@ -125,6 +126,35 @@ class PreviewStudioTest : public ::testing::Test {
     const auto path = dir_ / (instance + ".yaml");
     std::ofstream(path) << "instance: " << instance << "\nwait_ms: " << wait_ms << "\n" << extra;
     return path.string();
+  }
+
+  // A headless preview from `view` drawing the actor only (--overlays none) at the studio's
+  // image size: 30 meshes recorded to <dir>/<name> (frames.jsonl and PNGs), the last as
+  // <dir>/<name>.png, the summary as JSON on its log. `config`: more preview.yaml lines;
+  // `args`: more command-line options.
+  Process& recorded_preview(const std::string& name, const Viewpoint& view,
+                            const std::string& config = "",
+                            const std::vector<std::string>& args = {}) {
+    std::vector<std::string> a{"--headless",
+                               "--config",
+                               preview_config(name, 1000, config),
+                               "--viewpoint",
+                               to_string(view),
+                               "--overlays",
+                               "none",
+                               "--size",
+                               std::to_string(kWidth) + "x" + std::to_string(kHeight),
+                               "--frames",
+                               "30",
+                               "--timeout",
+                               "120",
+                               "--record",
+                               (dir_ / name).string(),
+                               "--screenshot",
+                               (dir_ / (name + ".png")).string(),
+                               "--json"};
+    a.insert(a.end(), args.begin(), args.end());
+    return spawn(name, "preview/studio-preview", std::move(a));
   }
 
   studio::testing::Watchdog watchdog_{std::chrono::seconds(280)};
