@@ -264,6 +264,20 @@ Score score(const std::vector<Record>& records, const std::filesystem::path& dir
   return s;
 }
 
+// The records of two previews' recordings (--record dirs) that both drew the same mesh (source
+// frame) textured, in matching order.
+std::pair<std::vector<Record>, std::vector<Record>> same_meshes(const std::filesystem::path& a,
+                                                                const std::filesystem::path& b) {
+  std::pair<std::vector<Record>, std::vector<Record>> out;
+  for (const Record& r : read_records(a / "frames.jsonl"))
+    for (const Record& q : read_records(b / "frames.jsonl"))
+      if (r.source_frame == q.source_frame && r.textured && q.textured) {
+        out.first.push_back(r);
+        out.second.push_back(q);
+      }
+  return out;
+}
+
 // The held-out camera: between cam0 (azimuth 0) and cam1 (45), lower than the ring; it feeds
 // nothing. Its calibration and the preview's viewpoint from its pose.
 // kW x kH: the studio's image size (PreviewStudioTest::kWidth, kHeight).
@@ -348,14 +362,7 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
     return out;
   };
   // Paired: the meshes both blends drew (same source frame).
-  std::vector<Record> blend_records = read_records(dir_ / "blend" / "frames.jsonl"),
-                      keys_records = read_records(dir_ / "keys" / "frames.jsonl"), both_b, both_k;
-  for (const Record& b : blend_records)
-    for (const Record& k : keys_records)
-      if (b.source_frame == k.source_frame && b.textured && k.textured) {
-        both_b.push_back(b);
-        both_k.push_back(k);
-      }
+  const auto [both_b, both_k] = same_meshes(dir_ / "blend", dir_ / "keys");
   const Score paired_blend = score(both_b, dir_ / "blend", truth),
               paired_keys = score(both_k, dir_ / "keys", truth);
   std::printf(
@@ -500,13 +507,7 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
   sim::StudioOptions o;
   o.threads = 1;
   auto truth_studio = sim::SimulatedStudio::create({held}, o).value();
-  std::vector<Record> both_b, both_u;
-  for (const Record& r : read_records(dir_ / "balanced" / "frames.jsonl"))
-    for (const Record& u : read_records(dir_ / "unbalanced" / "frames.jsonl"))
-      if (r.source_frame == u.source_frame && r.textured && u.textured) {
-        both_b.push_back(r);
-        both_u.push_back(u);
-      }
+  const auto [both_b, both_u] = same_meshes(dir_ / "balanced", dir_ / "unbalanced");
   const Score balanced = score(both_b, dir_ / "balanced", truth_studio),
               unbalanced = score(both_u, dir_ / "unbalanced", truth_studio);
   std::printf(
