@@ -303,7 +303,7 @@ BalanceSummary balance_summary(const std::string& log) {
   if (!std::regex_search(
           log, m,
           std::regex(
-              R"re("colour_balance":\{"on":\w+,"applied":(\w+),"frames":(\d+),"pairs":(\d+))re")))
+              R"re("colour_balance":\{"on":\w+,"applied":(\w+),"frames":(\d+),"busy":\d+,"pairs":(\d+))re")))
     return b;
   b.found = true;
   b.applied = m[1] == "true";

@@ -51,24 +51,26 @@ std::string gains_json(const Eigen::Vector3f& g) {
   return b;
 }
 
-// {"on", "applied", "frames", "pairs", "residual", "gains": {camera id: [r, g, b]},
+// {"on", "applied", "frames", "busy", "pairs", "residual", "gains": {camera id: [r, g, b]},
 // "estimated": {...}}: the pipeline's colour balance at the end of the run
-// (preview/rig_balance.h; gains are the estimate when applied, else 1).
-std::string balance_json(const ViewPipeline& pipeline) {
-  const RigBalance& rb = pipeline.colour_balance();
-  const offline::ColourBalance& b = rb.balance();
+// (preview/rig_balance.h; frames pooled, busy: meshes due while the worker was still pooling;
+// gains are the estimate when applied, else 1).
+std::string balance_json(ViewPipeline& pipeline) {
+  pipeline.finish_colour_balance();
+  const BalanceSnapshot rb = pipeline.colour_balance();
+  const offline::ColourBalance& b = rb.balance;
   char head[160];
   std::snprintf(head, sizeof head,
-                "{\"on\":%s,\"applied\":%s,\"frames\":%d,\"pairs\":%d,\"residual\":%.5f,"
-                "\"gains\":{",
+                "{\"on\":%s,\"applied\":%s,\"frames\":%d,\"busy\":%llu,\"pairs\":%d,"
+                "\"residual\":%.5f,\"gains\":{",
                 pipeline.colour_balance_on() ? "true" : "false", b.applied ? "true" : "false",
-                b.frames, b.pairs, b.residual);
+                b.frames, (unsigned long long)pipeline.counts().balance_busy, b.pairs, b.residual);
   std::string out = head;
-  for (std::size_t i = 0; i < rb.cameras().size() && i < b.gains.size(); ++i)
-    out += (i ? ",\"" : "\"") + rb.cameras()[i] + "\":" + gains_json(b.gains[i]);
+  for (std::size_t i = 0; i < rb.cameras.size() && i < b.gains.size(); ++i)
+    out += (i ? ",\"" : "\"") + rb.cameras[i] + "\":" + gains_json(b.gains[i]);
   out += "},\"estimated\":{";
-  for (std::size_t i = 0; i < rb.cameras().size() && i < b.estimated.size(); ++i)
-    out += (i ? ",\"" : "\"") + rb.cameras()[i] + "\":" + gains_json(b.estimated[i]);
+  for (std::size_t i = 0; i < rb.cameras.size() && i < b.estimated.size(); ++i)
+    out += (i ? ",\"" : "\"") + rb.cameras[i] + "\":" + gains_json(b.estimated[i]);
   return out + "}}";
 }
 

@@ -64,7 +64,8 @@ Options:
                     until SIGINT/SIGTERM; exit 1 if no mesh was drawn
   --json            headless: the summary as one JSON line ("overlays": the heads, cameras,
                     calibrated projectors and thumbnails received; "colour_balance": applied,
-                    frames pooled, camera pairs and per camera id its gains)
+                    frames pooled, busy (meshes skipped while pooling the previous), camera
+                    pairs and per camera id its gains)
   --test-script F   GUI: scripted input for tests (gui.h: one action per line)
 
 Headless, SIGINT/SIGTERM end the run like its deadline (the screenshot is written).

@@ -160,17 +160,17 @@ void view_panel(PanelState& s, ViewPipeline& pipeline, Viewpoint& view, double n
   bool balance = pipeline.colour_balance_on();
   if (ImGui::Checkbox("colour balance", &balance)) pipeline.set_colour_balance(balance);
   {
-    const RigBalance& rb = pipeline.colour_balance();
-    const offline::ColourBalance& b = rb.balance();
+    const BalanceSnapshot rb = pipeline.colour_balance();
+    const offline::ColourBalance& b = rb.balance;
     ImGui::SameLine();
     if (b.applied)
       ImGui::Text("applied (%d frames, %d camera pairs)", b.frames, b.pairs);
     else
-      ImGui::Text("cameras agree within %.0f %% (%d frames, %d camera pairs)",
-                  100 * rb.options().tolerance, b.frames, b.pairs);
+      ImGui::Text("cameras agree within %.0f %% (%d frames, %d camera pairs)", 100 * rb.tolerance,
+                  b.frames, b.pairs);
     if (ImGui::CollapsingHeader("colour gains (estimated R G B)"))
-      for (std::size_t i = 0; i < rb.cameras().size() && i < b.estimated.size(); ++i)
-        ImGui::Text("%-10s %.3f %.3f %.3f", rb.cameras()[i].c_str(), b.estimated[i].x(),
+      for (std::size_t i = 0; i < rb.cameras.size() && i < b.estimated.size(); ++i)
+        ImGui::Text("%-10s %.3f %.3f %.3f", rb.cameras[i].c_str(), b.estimated[i].x(),
                     b.estimated[i].y(), b.estimated[i].z());
   }
   OverlayOptions& o = pipeline.overlays();

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "actor_texturer.h"
+#include "balance_worker.h"
 #include "core/log.h"
 #include "overlay_renderer.h"
 #include "scene/view.h"
@@ -78,7 +79,7 @@ struct ViewPipeline::Impl {
   std::vector<Camera> carving_cameras;  // the carving masks' cameras and masks (kept: uploaded)
   std::vector<Mask> carving_masks;
   std::size_t carving_count = 0;
-  RigBalance balance;
+  BalanceWorker balance;
   uint64_t textured_seen =
       0;  // meshes pool_balance() saw (the first and every balance_every-th pool)
   std::shared_ptr<PrefetchState> prefetch = std::make_shared<PrefetchState>();
@@ -189,25 +190,27 @@ struct ViewPipeline::Impl {
     carving_count = list.size();
   }
 
-  // Pools the pending mesh's texturing images and their masks into the colour balance when it is
-  // on, the mesh has two or more texturing cameras (nearest mode's one compares nothing) and it
-  // is the first such mesh or the balance_every-th since; true when pooled.
+  // Hands the pending mesh's texturing images and their masks to the colour balance's worker
+  // when the balance is on, the mesh has two or more texturing cameras (nearest mode's one
+  // compares nothing) and it is the first such mesh or the balance_every-th since; true when
+  // taken (the worker refuses while it pools the previous one: counted).
   bool pool_balance(const std::map<std::string, Camera>& cams,
                     const std::map<std::string, RunMask>& masks,
                     const std::vector<FrameImage>& imgs) {
     if (!options.colour_balance || imgs.size() < 2) return false;
     if (textured_seen++ % uint64_t(options.balance_every) != 0) return false;
-    std::vector<BalanceView> views;
+    BalanceWorker::Job job;
+    job.rig = cams;
+    job.mesh = pending->mesh;
     for (std::size_t i = 0; i < imgs.size(); ++i) {
       const auto m = masks.find(pending_cameras[i]);
       if (m == masks.end()) continue;  // its mask of the frame was lost: it takes no part
-      views.push_back({pending_cameras[i],
-                       ImageView<const Rgb8>(reinterpret_cast<const Rgb8*>(imgs[i].rgb.data()),
-                                             imgs[i].width, imgs[i].height),
-                       &m->second});
+      job.cameras.push_back(pending_cameras[i]);
+      job.images.push_back(imgs[i]);
+      job.masks.push_back(m->second);
     }
-    if (auto ok = balance.add(cams, pending->mesh, views); !ok) {
-      STUDIO_LOG(warn, "preview") << ok.error().message;
+    if (!balance.submit(std::move(job))) {
+      ++counts.balance_busy;
       return false;
     }
     ++counts.balance_frames;
@@ -245,9 +248,10 @@ struct ViewPipeline::Impl {
     const bool pooled = textured && pool_balance(cams, masks, *imgs);
     std::vector<Eigen::Vector3f> gains;
     if (textured) {
+      const BalanceSnapshot estimate = balance.snapshot();
       for (std::size_t i = 0; i < imgs->size() && textured; ++i) {
         const Eigen::Vector3f g =
-            options.colour_balance ? balance.gains(pending_cameras[i]) : Eigen::Vector3f::Ones();
+            options.colour_balance ? estimate.gains(pending_cameras[i]) : Eigen::Vector3f::Ones();
         gains.push_back(g);
         textured =
             texturer.set_camera(int(i), cams.at(pending_cameras[i]), (*imgs)[i].rgb.data(), g)
@@ -352,7 +356,8 @@ void ViewPipeline::set_blend(bool blend) {
   impl_->prefetch->blend = blend;
 }
 bool ViewPipeline::blend() const { return impl_->options.blend; }
-const RigBalance& ViewPipeline::colour_balance() const { return impl_->balance; }
+BalanceSnapshot ViewPipeline::colour_balance() const { return impl_->balance.snapshot(); }
+void ViewPipeline::finish_colour_balance() { impl_->balance.wait_idle(); }
 void ViewPipeline::set_colour_balance(bool on) { impl_->options.colour_balance = on; }
 bool ViewPipeline::colour_balance_on() const { return impl_->options.colour_balance; }
 OverlayOptions& ViewPipeline::overlays() { return impl_->options.overlays; }

@@ -42,10 +42,10 @@ struct PipelineOptions {
   // (studio/camera/mask), not only the three texturing cameras' keys.
   bool carve_all_masks = true;
   // The cameras' colour balance (preview/rig_balance.h): every textured mesh is drawn with each
-  // texturing camera's gains; one textured mesh in every `balance_every` is pooled into the
-  // estimate (its texturing cameras' images and masks of the mesh's frame: 4-10 ms at 352x288 to
-  // 704x576, BENCHMARKS.md), so that the estimate follows the rig within a second without
-  // costing every frame. A rig whose cameras agree keeps gains 1 (the estimate's tolerance).
+  // texturing camera's gains; one textured mesh in every `balance_every` (of those with two or
+  // more texturing cameras) is pooled into the estimate on a thread of its own (its texturing
+  // cameras' images and masks of the mesh's frame: 4-10 ms of CPU at 352x288 to 704x576,
+  // BENCHMARKS.md; node/balance_worker.h). A rig whose cameras agree keeps gains 1.
   bool colour_balance = true;
   int balance_every = 4;
 };
@@ -60,7 +60,7 @@ struct FrameReport {
   // Per texturing camera: the colour gains (R, G, B) its image was drawn with (all 1 when the
   // balance is off, the rig is within its tolerance or the camera is not yet linked).
   std::vector<Eigen::Vector3f> gains;
-  bool balance_pooled = false;  // this mesh's images were pooled into the colour balance
+  bool balance_pooled = false;  // this mesh's images were handed to the colour balance
 };
 
 // meshes = drawn meshes = textured + untextured; untextured = late (no reply within `wait`) +
@@ -68,7 +68,9 @@ struct FrameReport {
 // a newer one while their images were on the way (never drawn).
 struct PipelineCounts {
   uint64_t meshes = 0, textured = 0, untextured = 0, late = 0, refused = 0, skipped = 0;
-  uint64_t balance_frames = 0;  // textured meshes pooled into the colour balance
+  // Meshes handed to the colour balance's worker, and those due but refused (the worker still
+  // pooling the previous one).
+  uint64_t balance_frames = 0, balance_busy = 0;
 };
 
 class ViewPipeline {
@@ -89,8 +91,10 @@ class ViewPipeline {
   Eigen::Vector3d actor_centre() const;
   void set_blend(bool blend);
   bool blend() const;
-  // The cameras' colour balance so far (ids in the order of balance().gains), and switching it.
-  const RigBalance& colour_balance() const;
+  // The cameras' colour balance so far (its latest estimate), and switching it;
+  // finish_colour_balance() waits until the mesh the worker holds is pooled.
+  BalanceSnapshot colour_balance() const;
+  void finish_colour_balance();
   void set_colour_balance(bool on);
   bool colour_balance_on() const;
   OverlayOptions& overlays();

@@ -56,11 +56,25 @@ Expected<void> RigBalance::add(const std::map<std::string, Camera>& rig,
   return {};
 }
 
+namespace {
+
+// The gains of `id` among `ids` (sorted), 1 when absent.
+Eigen::Vector3f gains_of(const std::vector<std::string>& ids, const offline::ColourBalance& b,
+                         const std::string& id) {
+  const auto at = std::lower_bound(ids.begin(), ids.end(), id);
+  if (at == ids.end() || *at != id) return Eigen::Vector3f::Ones();
+  const std::size_t i = std::size_t(at - ids.begin());
+  return i < b.gains.size() ? b.gains[i] : Eigen::Vector3f::Ones();
+}
+
+}  // namespace
+
 Eigen::Vector3f RigBalance::gains(const std::string& id) const {
-  const auto at = std::lower_bound(ids_.begin(), ids_.end(), id);
-  if (at == ids_.end() || *at != id) return Eigen::Vector3f::Ones();
-  const std::size_t i = std::size_t(at - ids_.begin());
-  return i < balance_.gains.size() ? balance_.gains[i] : Eigen::Vector3f::Ones();
+  return gains_of(ids_, balance_, id);
+}
+
+Eigen::Vector3f BalanceSnapshot::gains(const std::string& id) const {
+  return gains_of(cameras, balance, id);
 }
 
 }  // namespace studio::preview

@@ -38,6 +38,15 @@ struct BalanceView {
   const RunMask* mask = nullptr;
 };
 
+// What a RigBalance has estimated, copied out (for a thread other than the pooling one).
+struct BalanceSnapshot {
+  std::vector<std::string> cameras;  // the rig's ids, in the order of balance.gains
+  offline::ColourBalance balance;
+  double tolerance = 0;  // ColourBalanceOptions::tolerance of the estimate
+  // As RigBalance::gains.
+  Eigen::Vector3f gains(const std::string& id) const;
+};
+
 class RigBalance {
  public:
   // The gains are applied only once `min_frames` frames are pooled: the first frames' estimate
@@ -61,6 +70,7 @@ class RigBalance {
   const std::vector<std::string>& cameras() const { return ids_; }
   const offline::ColourBalance& balance() const { return balance_; }
   const offline::ColourBalanceOptions& options() const { return options_; }
+  BalanceSnapshot snapshot() const { return {ids_, balance_, options_.tolerance}; }
 
  private:
   offline::ColourBalanceOptions options_;
