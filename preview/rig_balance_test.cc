@@ -46,5 +46,19 @@ TEST(RigBalance, RefusesViewsOutsideTheRigAndRestartsWhenTheRigChanges) {
   EXPECT_EQ(b.gains("unknown"), Eigen::Vector3f::Ones());
 }
 
+// Applied beyond the tolerance, kept until every camera is within half of it.
+TEST(RigBalance, AppliesBeyondTheToleranceAndKeepsItUntilWithinHalf) {
+  auto rig = [](float off) {
+    return std::vector<Eigen::Vector3f>{Eigen::Vector3f(1 + off, 1, 1), Eigen::Vector3f::Ones()};
+  };
+  EXPECT_FALSE(balance_applies(rig(0.025f), 0.03, false));
+  EXPECT_TRUE(balance_applies(rig(0.035f), 0.03, false));
+  EXPECT_TRUE(balance_applies(rig(-0.035f), 0.03, false));
+  EXPECT_TRUE(balance_applies(rig(0.025f), 0.03, true));  // drifting back: still balanced
+  EXPECT_TRUE(balance_applies(rig(0.016f), 0.03, true));
+  EXPECT_FALSE(balance_applies(rig(0.014f), 0.03, true));  // within half: released
+  EXPECT_FALSE(balance_applies({}, 0.03, true));
+}
+
 }  // namespace
 }  // namespace studio::preview

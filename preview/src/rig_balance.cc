@@ -17,6 +17,13 @@ offline::ColourBalanceOptions rig_balance_defaults() {
   return o;
 }
 
+bool balance_applies(const std::vector<Eigen::Vector3f>& estimated, double tolerance,
+                     bool applied_before) {
+  float off = 0;
+  for (const Eigen::Vector3f& g : estimated) off = std::max(off, (g.array() - 1).abs().maxCoeff());
+  return off > (applied_before ? 0.5 : 1.0) * tolerance;
+}
+
 RigBalance::RigBalance(const offline::ColourBalanceOptions& options, int min_frames)
     : options_(options), min_frames_(min_frames) {}
 
@@ -48,11 +55,13 @@ Expected<void> RigBalance::add(const std::map<std::string, Camera>& rig,
   m.vertices = mesh.vertices;
   m.triangles = mesh.triangles;  // normals: the estimate computes its own
   if (auto ok = estimator_->add(m, cv); !ok) return ok;
+  const bool was_applied = balance_.applied;
   balance_ = estimator_->solve();
-  if (balance_.frames < min_frames_ && balance_.applied) {  // not yet: see the constructor
-    balance_.applied = false;
-    balance_.gains.assign(ids_.size(), Eigen::Vector3f::Ones());
-  }
+  balance_.applied = balance_.frames >= min_frames_ &&  // not before: see the constructor
+                     balance_applies(balance_.estimated, options_.tolerance, was_applied);
+  balance_.gains = balance_.applied
+                       ? balance_.estimated
+                       : std::vector<Eigen::Vector3f>(ids_.size(), Eigen::Vector3f::Ones());
   return {};
 }
 

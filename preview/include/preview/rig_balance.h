@@ -9,7 +9,7 @@
 // texturing cameras; as the viewpoint moves the graph fills in. Every pair keeps its newest
 // `max_pair_samples` samples, so a camera whose exposure is changed during the session is
 // followed within a few frames. The rig-level tolerance (ColourBalanceOptions::tolerance) leaves
-// a rig whose cameras agree exactly as it is (all gains 1).
+// a rig whose cameras agree exactly as it is (all gains 1); balance_applies() below.
 //
 // Pure library: the node hands over the mesh and the images and masks of exactly the mesh's frame
 // (the frame-exact rule, preview/node/view_pipeline.h).
@@ -37,6 +37,13 @@ struct BalanceView {
   ImageView<const Rgb8> image;
   const RunMask* mask = nullptr;
 };
+
+// Whether the gains are applied: some camera's estimate beyond `tolerance` of 1 (any channel);
+// once applied, until every camera is back within half of it. The live estimate moves from
+// frame to frame: a rig near the tolerance would otherwise switch between balanced and not, a
+// flicker of the tolerance's size; within half of it, it swaps for the drift of a balanced one.
+bool balance_applies(const std::vector<Eigen::Vector3f>& estimated, double tolerance,
+                     bool applied_before);
 
 // What a RigBalance has estimated, copied out (for a thread other than the pooling one).
 struct BalanceSnapshot {
