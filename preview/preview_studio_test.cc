@@ -484,7 +484,7 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
   auto drawn_gains = [&](const std::string& name) {
     std::vector<double> out;
     std::ifstream in(dir_ / name / "frames.jsonl");
-    const std::regex list(R"re("gains":\[([^"]*)\],"balance_pooled")re"), number(R"re([0-9.]+)re");
+    const std::regex list(R"re("gains":\[([^"]*)\],"estimated")re"), number(R"re([0-9.]+)re");
     for (std::string line; std::getline(in, line);) {
       std::smatch m;
       if (!std::regex_search(line, m, list)) continue;
@@ -515,6 +515,114 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
       "%.2f dB not; the union %.2f / %.2f dB\n",
       balanced.frames, balanced.psnr_both(), unbalanced.psnr_both(), balanced.psnr(),
       unbalanced.psnr());
+}
+
+// The director raises one camera's Gain from the Cameras panel (CameraControl; the simulated
+// camera scales its 8-bit values by 10^(dB/20)) while the preview runs: on a rig whose cameras
+// agreed, the balance (newest samples per pair) follows, and the gain it settles on for that
+// camera against its neighbours undoes the change. frames.jsonl's per-mesh gains show when.
+TEST_F(PreviewStudioTest, TheColourBalanceFollowsACameraWhoseGainIsChanged) {
+  start_studio(false, false, 9);
+  const auto [held, view] = held_out(kWidth, kHeight);
+  Process& p = spawn(
+      "preview", "preview/studio-preview",
+      {"--headless", "--config", preview_config("director", 1000, "colour_balance_every: 1\n"),
+       "--viewpoint", to_string(view), "--overlays", "none", "--size",
+       std::to_string(kWidth) + "x" + std::to_string(kHeight), "--duration", "16", "--record",
+       (dir_ / "rec").string(), "--screenshot", (dir_ / "last.png").string(), "--json"});
+  auto participant = wire::Participant::create().value();
+  auto topic = wire::Topic<studio_CameraControl>::create(participant).value();
+  auto control = wire::Writer<studio_CameraControl>::create(participant, topic).value();
+  ASSERT_TRUE(control.wait_for_readers(1, 30s));
+  std::this_thread::sleep_for(5s);  // the balance has pooled the agreeing rig
+  constexpr double kGainDb = 1.5;   // cam0's values x 1.189
+  wire::Owned<studio_CameraControl> c;
+  wire::set(c->camera_id, "cam0");
+  wire::set(c->feature, "Gain");
+  c->value = kGainDb;
+  ASSERT_TRUE(control.write(*c));
+  const auto changed = std::chrono::steady_clock::now();
+  const auto code = p.wait_exit(60s);
+  ASSERT_TRUE(code.has_value());
+  ASSERT_EQ(*code, 0) << p.log();
+  const double seconds_after =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - changed).count();
+  const BalanceSummary b = balance_summary(p.log());
+  ASSERT_TRUE(b.found) << p.log();
+  EXPECT_TRUE(b.applied);
+  ASSERT_TRUE(b.estimated.count("cam0"));
+  // cam0 against each neighbour the estimate linked it with: the inverse of the gain change.
+  const double k = std::pow(10.0, kGainDb / 20);
+  double worst = 0;
+  int neighbours = 0;
+  for (const auto& [id, g] : b.estimated) {
+    if (id == "cam0" || g == Eigen::Vector3d::Ones()) continue;
+    ++neighbours;
+    for (int ch = 0; ch < 3; ++ch)
+      worst = std::max(worst, std::abs(b.estimated.at("cam0")[ch] / g[ch] * k - 1));
+  }
+  // Per drawn mesh with cam0 among its texturing cameras: the estimate's cam0 against the
+  // other texturing cameras (green; frames.jsonl "estimated"), before the change (meshes 60-109:
+  // ~2.5-4.5 s into the run, the change at ~5 s) and over the last 60 meshes. The estimate's own
+  // bias between these cameras (the view-dependent light, a few percent) is in both and cancels.
+  std::vector<double> ratio;  // per record, NaN where cam0 did not texture
+  {
+    std::ifstream in(dir_ / "rec" / "frames.jsonl");
+    const std::regex cams(R"re("cameras":\[([^\]]*)\])re"),
+        est(R"re("estimated":\[(.*)\],"balance_pooled")re"), number(R"re([0-9.]+)re"),
+        id(R"re("([^"]+)")re");
+    for (std::string line; std::getline(in, line);) {
+      ratio.push_back(std::nan(""));
+      std::smatch cm, em;
+      if (!std::regex_search(line, cm, cams) || !std::regex_search(line, em, est)) continue;
+      const std::string ids = cm[1], list = em[1];
+      std::vector<std::string> names;
+      for (auto it = std::sregex_iterator(ids.begin(), ids.end(), id); it != std::sregex_iterator();
+           ++it)
+        names.push_back((*it)[1]);
+      std::vector<double> v;
+      for (auto it = std::sregex_iterator(list.begin(), list.end(), number);
+           it != std::sregex_iterator(); ++it)
+        v.push_back(std::stod(it->str()));
+      if (v.size() != 3 * names.size() || names.size() < 2) continue;
+      double own = 0, others = 0;
+      int n = 0;
+      for (std::size_t i = 0; i < names.size(); ++i)
+        if (names[i] == "cam0")
+          own = v[3 * i + 1];
+        else {
+          others += std::log(v[3 * i + 1]);
+          ++n;
+        }
+      if (own > 0 && n > 0) ratio.back() = own / std::exp(others / n);
+    }
+  }
+  auto median_of = [&](std::size_t from, std::size_t to) {
+    std::vector<double> m;
+    for (std::size_t i = from; i < to && i < ratio.size(); ++i)
+      if (!std::isnan(ratio[i])) m.push_back(ratio[i]);
+    if (m.empty()) return std::nan("");
+    std::nth_element(m.begin(), m.begin() + std::ptrdiff_t(m.size() / 2), m.end());
+    return m[m.size() / 2];
+  };
+  ASSERT_GE(ratio.size(), 200u);
+  const double before = median_of(60, 110), after = median_of(ratio.size() - 60, ratio.size());
+  const double change = after / before;
+  std::size_t half = 0;  // the first mesh after the change with half of it (in log) taken up
+  for (std::size_t i = 110; i < ratio.size() && !half; ++i)
+    if (ratio[i] < before / std::sqrt(k)) half = i;
+  std::printf(
+      "gain +%.1f dB on cam0 (x%.3f), %zu meshes drawn: the estimate's cam0 against its "
+      "fellow texturing cameras %.4f before, %.4f over the last 60 meshes (%.1f s after "
+      "the change): x%.4f (want x%.4f); at the end against %d linked cameras within "
+      "%.2f %% of 1 / %.3f; half of it taken up at mesh %zu\n",
+      kGainDb, k, ratio.size(), before, after, seconds_after, change, 1 / k, neighbours,
+      100 * worst, k, half);
+  EXPECT_GE(neighbours, 1);
+  // Measured within 0.3-3.4 % of the change (13 runs; mostly a little past it): the live
+  // estimate's pose-dependent error (TheColourBalanceEqualisesCamerasThatDiffer: up to 4.1 %).
+  EXPECT_NEAR(change * k, 1.0, 0.06);
+  EXPECT_GT(half, 110u);
 }
 
 }  // namespace

@@ -169,6 +169,9 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
       log << "],\"carving_masks\":" << r.carving_masks << ",\"gains\":[";
       for (std::size_t i = 0; i < r.gains.size(); ++i)
         log << (i ? "," : "") << gains_json(r.gains[i]);
+      log << "],\"estimated\":[";
+      for (std::size_t i = 0; i < r.estimated.size(); ++i)
+        log << (i ? "," : "") << gains_json(r.estimated[i]);
       log << "],\"balance_pooled\":" << (r.balance_pooled ? "true" : "false") << "}\n";
       log.flush();
     }

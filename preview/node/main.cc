@@ -52,7 +52,8 @@ Options:
   --screenshot PNG  headless: the last frame
   --frames N        headless: draw N new meshes, then stop (default 1; 0 = the scene only)
   --record DIR      headless: every drawn mesh's frame as DIR/<n>.png plus DIR/frames.jsonl
-                    ({"image", "source_frame", "textured", "cameras", "gains"} per line)
+                    ({"image", "source_frame", "textured", "cameras", "gains", "estimated"}
+                    per line: gains drawn with, the colour balance's estimate then)
   --timeout S       headless: give up after S seconds (default 30)
   --settle S        headless with --frames 0: draw for S seconds before the screenshot, so
                     the scene and the overlays' topics arrive (default 1)

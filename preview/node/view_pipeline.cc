@@ -246,13 +246,14 @@ struct ViewPipeline::Impl {
                    c->second.height == (*imgs)[i].height;
       }
     const bool pooled = textured && pool_balance(cams, masks, *imgs);
-    std::vector<Eigen::Vector3f> gains;
+    std::vector<Eigen::Vector3f> gains, estimated;
     if (textured) {
       const BalanceSnapshot estimate = balance.snapshot();
       for (std::size_t i = 0; i < imgs->size() && textured; ++i) {
         const Eigen::Vector3f g =
             options.colour_balance ? estimate.gains(pending_cameras[i]) : Eigen::Vector3f::Ones();
         gains.push_back(g);
+        estimated.push_back(estimate.estimated(pending_cameras[i]));
         textured =
             texturer.set_camera(int(i), cams.at(pending_cameras[i]), (*imgs)[i].rgb.data(), g)
                 .has_value();
@@ -260,6 +261,7 @@ struct ViewPipeline::Impl {
     }
     current = {};
     current.gains = std::move(gains);
+    current.estimated = std::move(estimated);
     current.balance_pooled = pooled;
     current.new_mesh = true;
     current.textured = textured;

@@ -60,6 +60,7 @@ struct FrameReport {
   // Per texturing camera: the colour gains (R, G, B) its image was drawn with (all 1 when the
   // balance is off, the rig is within its tolerance or the camera is not yet linked).
   std::vector<Eigen::Vector3f> gains;
+  std::vector<Eigen::Vector3f> estimated;  // ... and the balance's estimate for it then
   bool balance_pooled = false;  // this mesh's images were handed to the colour balance
 };
 

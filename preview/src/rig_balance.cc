@@ -67,23 +67,27 @@ Expected<void> RigBalance::add(const std::map<std::string, Camera>& rig,
 
 namespace {
 
-// The gains of `id` among `ids` (sorted), 1 when absent.
-Eigen::Vector3f gains_of(const std::vector<std::string>& ids, const offline::ColourBalance& b,
-                         const std::string& id) {
+// The entry of `id` among `ids` (sorted) in `per_camera`, 1 when absent.
+Eigen::Vector3f gains_of(const std::vector<std::string>& ids,
+                         const std::vector<Eigen::Vector3f>& per_camera, const std::string& id) {
   const auto at = std::lower_bound(ids.begin(), ids.end(), id);
   if (at == ids.end() || *at != id) return Eigen::Vector3f::Ones();
   const std::size_t i = std::size_t(at - ids.begin());
-  return i < b.gains.size() ? b.gains[i] : Eigen::Vector3f::Ones();
+  return i < per_camera.size() ? per_camera[i] : Eigen::Vector3f::Ones();
 }
 
 }  // namespace
 
 Eigen::Vector3f RigBalance::gains(const std::string& id) const {
-  return gains_of(ids_, balance_, id);
+  return gains_of(ids_, balance_.gains, id);
 }
 
 Eigen::Vector3f BalanceSnapshot::gains(const std::string& id) const {
-  return gains_of(cameras, balance, id);
+  return gains_of(cameras, balance.gains, id);
+}
+
+Eigen::Vector3f BalanceSnapshot::estimated(const std::string& id) const {
+  return gains_of(cameras, balance.estimated, id);
 }
 
 }  // namespace studio::preview

@@ -52,6 +52,8 @@ struct BalanceSnapshot {
   double tolerance = 0;  // ColourBalanceOptions::tolerance of the estimate
   // As RigBalance::gains.
   Eigen::Vector3f gains(const std::string& id) const;
+  // The estimate for camera `id` (before the tolerance), 1 when not linked.
+  Eigen::Vector3f estimated(const std::string& id) const;
 };
 
 class RigBalance {
