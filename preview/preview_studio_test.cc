@@ -473,7 +473,7 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
       "colour balance: %d frames pooled, %d camera pairs, %zu cameras linked; worst pair "
       "ratio error %.2f %% (%.2f %% between the cameras without it)\n",
       b.frames, b.pairs, linked.size(), 100 * worst, 100 * worst_without);
-  // Measured 0.5-4.1 % over 16 runs (pooling one mesh in 2: 0.9-3.4 % in 10): the poses of a
+  // Measured 0.3-5.1 % over 38 runs (pooling one mesh in 2: 0.9-3.4 % in 10): the poses of a
   // run decide which cameras texture and how the view-dependent light (the backing's blue spill
   // above all) biases the medians. preview_quality_test holds the estimate to 1 % on fixed poses
   // (measured 0.44 %); here, against the running studio, it takes out at least half of the
@@ -620,7 +620,7 @@ TEST_F(PreviewStudioTest, TheColourBalanceFollowsACameraWhoseGainIsChanged) {
       100 * worst, k, half);
   EXPECT_GE(neighbours, 1);
   // Measured within 0.3-3.4 % of the change (13 runs; mostly a little past it): the live
-  // estimate's pose-dependent error (TheColourBalanceEqualisesCamerasThatDiffer: up to 4.1 %).
+  // estimate's pose-dependent error (TheColourBalanceEqualisesCamerasThatDiffer: up to 5.1 %).
   EXPECT_NEAR(change * k, 1.0, 0.06);
   EXPECT_GT(half, 110u);
 }
