@@ -94,6 +94,7 @@ std::optional<int> decode_preview(const cv::Mat& bgr, const Viewpoint& view,
 TEST_F(PreviewStudioTest, BadInputIsOneLineAndExitTwo) {
   std::ofstream(dir_ / "bad.yaml") << "instance: x\ntexturing: sharpest\n";
   std::ofstream(dir_ / "unknown.yaml") << "instance: x\nzoom: 3\n";
+  std::ofstream(dir_ / "every.yaml") << "instance: x\ncolour_balance_every: 0\n";
   const std::vector<std::vector<std::string>> cases{
       {"--config", (dir_ / "bad.yaml").string(), "--headless", "--screenshot", "a.png"},
       {"--config", (dir_ / "unknown.yaml").string(), "--headless", "--screenshot", "a.png"},
@@ -102,6 +103,8 @@ TEST_F(PreviewStudioTest, BadInputIsOneLineAndExitTwo) {
       {"--headless"},
       {"--frames", "-3", "--headless", "--screenshot", "a.png"},
       {"--every", "0.01", "--headless", "--screenshot", "a.png"},
+      {"--colour-balance", "maybe", "--headless", "--screenshot", "a.png"},
+      {"--config", (dir_ / "every.yaml").string(), "--headless", "--screenshot", "a.png"},
       {"--every", "2", "--frames", "0", "--headless", "--screenshot", "a.png"},
       {"--screenshot", "a.png"},
       {"--bogus"}};
