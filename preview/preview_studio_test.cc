@@ -438,15 +438,36 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
   for (double& g : response[1]) g *= 1.25;  // cam1's exposure a third of a stop up
   start_studio(false, false, 9, response);
   const auto [held, view] = held_out(kWidth, kHeight);
+  // The previews' status (studioctl's view): the balance's gauges.
+  auto participant = wire::Participant::create().value();
+  auto status_topic = wire::Topic<studio_ServiceStatus>::create(participant).value();
+  auto status = wire::Reader<studio_ServiceStatus>::create(participant, status_topic).value();
+  std::map<std::string, double> applied_on_status;  // instance -> largest colour_balance_applied
+  auto read_status = [&] {
+    for (auto& st : status.take())
+      if (st.meta.valid_data && std::string(st.data->service) == "preview")
+        for (const auto& c : wire::view(st.data->counters))
+          if (std::string(c.name) == "colour_balance_applied") {
+            double& a = applied_on_status[st.data->instance];
+            a = std::max(a, c.value);
+          }
+  };
   std::map<std::string, Process*> previews;
   for (const std::string name : {"balanced", "unbalanced"})
     previews[name] = &recorded_preview(name, view, "colour_balance_every: 1\n",
                                        {"--colour-balance", name == "balanced" ? "on" : "off"});
   for (auto& [name, p] : previews) {
+    while (p->running()) {
+      read_status();
+      std::this_thread::sleep_for(50ms);
+    }
     const auto code = p->wait_exit(std::chrono::seconds(150));
     ASSERT_TRUE(code.has_value()) << name;
     ASSERT_EQ(*code, 0) << p->log();
   }
+  read_status();
+  EXPECT_EQ(applied_on_status["balanced"], 1.0);
+  EXPECT_EQ(applied_on_status.count("unbalanced") ? applied_on_status["unbalanced"] : -1, 0.0);
   // The estimate: every pair of cameras it linked, their gain ratio against the truth's.
   const BalanceSummary b = balance_summary(previews["balanced"]->log());
   const BalanceSummary off = balance_summary(previews["unbalanced"]->log());

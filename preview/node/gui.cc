@@ -212,6 +212,7 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
     std::string screenshot_path;
     while (running && !glfwWindowShouldClose(window)) {
       glfwPollEvents();
+      (*pipeline)->report(metrics);
       service_status->tick();
       int w = 0, h = 0;
       glfwGetFramebufferSize(window, &w, &h);

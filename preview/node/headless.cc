@@ -132,6 +132,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   int drawn = 0;
   while (Clock::now() < deadline) {
     if (signals.wait(std::chrono::milliseconds(0))) break;
+    (*pipeline)->report(metrics);
     status->tick();
     if (every && Clock::now() - last_drawn < interval) {  // not yet: no render, no requests
       std::this_thread::sleep_for(std::min<Clock::duration>(interval - (Clock::now() - last_drawn),

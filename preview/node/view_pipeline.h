@@ -25,6 +25,7 @@
 #include "preview/rig_balance.h"
 #include "preview/viewpoint.h"
 #include "preview_node.h"
+#include "runtime/metrics.h"
 
 namespace studio::preview {
 
@@ -96,6 +97,10 @@ class ViewPipeline {
   // finish_colour_balance() waits until the mesh the worker holds is pooled.
   BalanceSnapshot colour_balance() const;
   void finish_colour_balance();
+  // The colour balance on the service's status (studioctl, the Services panels): gauges
+  // colour_balance_applied (0 / 1), colour_balance_frames (pooled) and colour_balance_off_pct
+  // (the estimate's largest |gain - 1| over the cameras, percent).
+  void report(runtime::Metrics& metrics) const;
   void set_colour_balance(bool on);
   bool colour_balance_on() const;
   OverlayOptions& overlays();
