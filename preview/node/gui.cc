@@ -203,6 +203,7 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
     po.balance_every = config.colour_balance_every;
     auto pipeline = ViewPipeline::create(node, po);
     if (!pipeline) return error(pipeline.error().message);
+    service_status->before_publish([&] { (*pipeline)->report(metrics); });
     PanelState panels;
     std::snprintf(panels.take, sizeof panels.take, "%s", config.take.c_str());
     Viewpoint view = config.viewpoint;
@@ -212,7 +213,6 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
     std::string screenshot_path;
     while (running && !glfwWindowShouldClose(window)) {
       glfwPollEvents();
-      (*pipeline)->report(metrics);
       service_status->tick();
       int w = 0, h = 0;
       glfwGetFramebufferSize(window, &w, &h);

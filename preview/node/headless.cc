@@ -55,8 +55,7 @@ std::string gains_json(const Eigen::Vector3f& g) {
 // "estimated": {...}}: the pipeline's colour balance at the end of the run
 // (preview/rig_balance.h; frames pooled, busy: meshes due while the worker was still pooling;
 // gains are the estimate when applied, else 1).
-std::string balance_json(ViewPipeline& pipeline) {
-  pipeline.finish_colour_balance();
+std::string balance_json(const ViewPipeline& pipeline) {
   const BalanceSnapshot rb = pipeline.colour_balance();
   const offline::ColourBalance& b = rb.balance;
   char head[160];
@@ -114,6 +113,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   po.balance_every = config.colour_balance_every;
   auto pipeline = ViewPipeline::create(node, po);
   if (!pipeline) return error(pipeline.error().message, 1);
+  status->before_publish([&] { (*pipeline)->report(metrics); });
   auto target = scene_render::RenderTarget::create(config.width, config.height);
   if (!target) return error(target.error().message, 1);
 
@@ -132,7 +132,6 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   int drawn = 0;
   while (Clock::now() < deadline) {
     if (signals.wait(std::chrono::milliseconds(0))) break;
-    (*pipeline)->report(metrics);
     status->tick();
     if (every && Clock::now() - last_drawn < interval) {  // not yet: no render, no requests
       std::this_thread::sleep_for(std::min<Clock::duration>(interval - (Clock::now() - last_drawn),
@@ -181,6 +180,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   target->bind();
   target->read_rgba(rgba);
   const bool written = replace_png(options.screenshot, rgba, config.width, config.height);
+  (*pipeline)->finish_colour_balance();  // the summary includes the mesh the worker holds
   const PipelineCounts& c = (*pipeline)->counts();
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   const OverlayCounts o = node.overlays().counts();

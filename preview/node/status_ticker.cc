@@ -15,6 +15,7 @@ void StatusTicker::tick() {
   const auto now = std::chrono::steady_clock::now();
   if (now < next_) return;
   next_ = now + period_;
+  if (fill_) fill_();
   const runtime::NodeHealth h = node_->health();
   const auto state = h.degraded ? studio_SERVICE_DEGRADED : studio_SERVICE_RUNNING;
   if (auto ok = publisher_.publish(state, h, metrics_->snapshot()); !ok)
@@ -22,6 +23,7 @@ void StatusTicker::tick() {
 }
 
 void StatusTicker::stopping() {
+  if (fill_) fill_();
   (void)publisher_.publish(studio_SERVICE_STOPPING, node_->health(), metrics_->snapshot());
 }
 

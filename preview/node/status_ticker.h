@@ -5,6 +5,7 @@
 // preview is a window or a headless renderer, not a runtime::service_main loop, so its render
 // loop calls tick() each frame.
 #include <chrono>
+#include <functional>
 
 #include "runtime/service_loop.h"
 #include "runtime/status_publisher.h"
@@ -19,6 +20,8 @@ class StatusTicker {
   void tick();
   // Publishes STOPPING (call before stopping the node).
   void stopping();
+  // Called just before each publication (fills gauges that are derived on demand).
+  void before_publish(std::function<void()> fill) { fill_ = std::move(fill); }
 
  private:
   StatusTicker(runtime::StatusPublisher publisher, runtime::Metrics& metrics, runtime::Node& node,
@@ -29,6 +32,7 @@ class StatusTicker {
   runtime::Node* node_;
   std::chrono::milliseconds period_;
   std::chrono::steady_clock::time_point next_{};
+  std::function<void()> fill_;
 };
 
 }  // namespace studio::preview

@@ -362,12 +362,9 @@ BalanceSnapshot ViewPipeline::colour_balance() const { return impl_->balance.sna
 void ViewPipeline::finish_colour_balance() { impl_->balance.wait_idle(); }
 void ViewPipeline::report(runtime::Metrics& metrics) const {
   const BalanceSnapshot b = impl_->balance.snapshot();
-  float off = 0;
-  for (const Eigen::Vector3f& g : b.balance.estimated)
-    off = std::max(off, (g.array() - 1).abs().maxCoeff());
   metrics.gauge("colour_balance_applied").set(b.balance.applied ? 1 : 0);
   metrics.gauge("colour_balance_frames").set(b.balance.frames);
-  metrics.gauge("colour_balance_off_pct").set(100.0 * off);
+  metrics.gauge("colour_balance_off_pct").set(100.0 * largest_gain_offset(b.balance.estimated));
 }
 void ViewPipeline::set_colour_balance(bool on) { impl_->options.colour_balance = on; }
 bool ViewPipeline::colour_balance_on() const { return impl_->options.colour_balance; }

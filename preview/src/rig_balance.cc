@@ -19,11 +19,15 @@ offline::ColourBalanceOptions rig_balance_defaults() {
   return o;
 }
 
-bool balance_applies(const std::vector<Eigen::Vector3f>& estimated, double tolerance,
-                     bool applied_before) {
+float largest_gain_offset(const std::vector<Eigen::Vector3f>& estimated) {
   float off = 0;
   for (const Eigen::Vector3f& g : estimated) off = std::max(off, (g.array() - 1).abs().maxCoeff());
-  return off > (applied_before ? 0.5 : 1.0) * tolerance;
+  return off;
+}
+
+bool balance_applies(const std::vector<Eigen::Vector3f>& estimated, double tolerance,
+                     bool applied_before) {
+  return largest_gain_offset(estimated) > (applied_before ? 0.5 : 1.0) * tolerance;
 }
 
 RigBalance::RigBalance(const offline::ColourBalanceOptions& options, int min_frames)

@@ -44,6 +44,8 @@ struct BalanceView {
 // flicker of the tolerance's size; within half of it, it swaps for the drift of a balanced one.
 bool balance_applies(const std::vector<Eigen::Vector3f>& estimated, double tolerance,
                      bool applied_before);
+// The largest |gain - 1| over the cameras and channels of `estimated` (0 when empty).
+float largest_gain_offset(const std::vector<Eigen::Vector3f>& estimated);
 
 // What a RigBalance has estimated, copied out (for a thread other than the pooling one).
 struct BalanceSnapshot {
