@@ -332,7 +332,9 @@ def write_markdown(r, path):
              f"frames held by every camera. Offline: {o['meshes']} meshes at {o['grid']}x{o['grid']} "
              f"columns in `{o['dir']}`; timing {json.dumps(o.get('timing'))}; IoU vs truth "
              f"{json.dumps(o.get('iou_vs_truth'))}.\n")
-    L.append(f"actor_view.png: {(r.get('pictures') or {}).get('actor_view_reason')}.\n")
+    reason = (r.get("pictures") or {}).get("actor_view_reason")
+    if reason:  # only when the picture is missing (it is shown under Projector otherwise)
+        L.append(f"actor_view.png: {reason}.\n")
     L.append("## Not built yet\n")
     for m in r.get("missing") or []:
         L.append(f"- {m['stage']} — issue {m['issue']}: {m['effect']}")
