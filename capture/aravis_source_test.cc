@@ -243,6 +243,11 @@ TEST(AravisFake, FeaturesReadBackClamped) {
   auto focus = source->set_feature("Focus", 1);
   ASSERT_FALSE(focus);
   EXPECT_NE(focus.error().message.find("not available"), std::string::npos);
+  // The fake camera has no white balance (no BalanceRatioSelector): not offered, refused.
+  for (const Feature& f : source->features()) EXPECT_NE(f.name, "BalanceRatioRed");
+  auto red = source->set_feature("BalanceRatioRed", 1.1);
+  ASSERT_FALSE(red);
+  EXPECT_NE(red.error().message.find("not available"), std::string::npos);
   EXPECT_FALSE(source->set_feature("DeviceReset", 1));
 }
 

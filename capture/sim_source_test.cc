@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <map>
 #include <thread>
 
 #include "core/clock.h"
@@ -202,6 +203,47 @@ TEST(SimFrameSource, FeaturesClampReadBackAndChangeThePicture) {
     return g;
   };
   EXPECT_LT(gradient(blurred), gradient(sharp) * 0.7);
+}
+
+TEST(SimFrameSource, BalanceRatiosScaleRedAndBlueAgainstGreen) {
+  // The same frame from a camera with ratios 1 and one white-balanced red x1.25, blue x0.8.
+  auto plain = SimFrameSource::create(small_options(false)).value();
+  auto balanced = SimFrameSource::create(small_options(false)).value();
+  EXPECT_EQ(balanced->set_feature("BalanceRatioRed", 1.25).value(), 1.25);
+  EXPECT_EQ(balanced->set_feature("BalanceRatioBlue", 0.8).value(), 0.8);
+  EXPECT_EQ(balanced->set_feature("BalanceRatioBlue", 9).value(), 4.0);  // clamped, read back
+  EXPECT_EQ(balanced->set_feature("BalanceRatioBlue", 0.8).value(), 0.8);
+  ASSERT_TRUE(plain->start());
+  ASSERT_TRUE(balanced->start());
+  std::map<uint64_t, Image<Rgb8>> seen;
+  for (int i = 0; i < 4; ++i) {
+    auto f = plain->next(1s).value();
+    seen.emplace(f->frame, f->image);
+  }
+  std::optional<Frame> match;
+  for (int i = 0; i < 8 && !match; ++i) {
+    auto f = balanced->next(1s).value();
+    if (seen.count(f->frame)) match = std::move(*f);
+  }
+  ASSERT_TRUE(match) << "no common frame";
+  const Image<Rgb8>& a = seen.at(match->frame);
+  const Image<Rgb8>& b = match->image;
+  double ra = 0, rb = 0, ba = 0, bb = 0;
+  std::size_t green_differs = 0;
+  for (std::size_t i = 0; i < a.pixels().size(); ++i) {
+    const Rgb8 p = a.pixels()[i], q = b.pixels()[i];
+    green_differs += p.g != q.g;
+    if (p.r < 190) ra += p.r, rb += q.r;  // unsaturated after x1.25
+    ba += p.b, bb += q.b;
+  }
+  EXPECT_EQ(green_differs, 0u);
+  EXPECT_NEAR(rb / ra, 1.25, 0.01);
+  EXPECT_NEAR(bb / ba, 0.8, 0.01);
+  bool listed = false;
+  for (const auto& f : balanced->features())
+    if (f.name == "BalanceRatioRed") listed = f.value == 1.25 && f.min == 0.25 && f.max == 4;
+  EXPECT_TRUE(listed);
+  EXPECT_FALSE(balanced->set_feature("BalanceRatioRed", NAN));
 }
 
 TEST(SimFrameSource, RejectsBadOptions) {

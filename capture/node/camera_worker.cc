@@ -14,7 +14,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr const char* kLog = "capture";
-constexpr std::string_view kCameraFeatures[] = {"Gain", "ExposureTime", "Focus", "Zoom", "Iris"};
+constexpr std::string_view kCameraFeatures[] = {
+    "Gain", "ExposureTime", "Focus", "Zoom", "Iris", "BalanceRatioRed", "BalanceRatioBlue"};
 
 }  // namespace
 
@@ -220,8 +221,8 @@ std::string CameraWorker::control(const CameraControlCore& c) {
   } else if (std::find(std::begin(kCameraFeatures), std::end(kCameraFeatures), c.feature) ==
              std::end(kCameraFeatures)) {
     problem = "camera " + id_ + ": feature '" + c.feature +
-              "' is not allowed (allowed: Gain, ExposureTime, Focus, Zoom, Iris, ImageRate, "
-              "ImageRaw)";
+              "' is not allowed (allowed: Gain, ExposureTime, Focus, Zoom, Iris, "
+              "BalanceRatioRed, BalanceRatioBlue, ImageRate, ImageRaw)";
   } else if (auto v = source_->set_feature(c.feature, c.value); !v) {
     problem = v.error().message;
   } else {

@@ -10,13 +10,13 @@
 //     `state_period` and whenever something changes.
 // The loop thread of runtime::ServiceLoop (runtime/service_loop.h) takes studio/camera/control
 // and studio/capture/command: CameraControl for an allow-listed GenICam feature (Gain,
-// ExposureTime, Focus, Zoom, Iris) is applied through FrameSource::set_feature and the read-back
-// value is published in CameraState; ImageRate and ImageRaw are the node's own pseudo-features;
-// KeyerPlate (keyer/keyer.h) captures a clean plate for an in-process difference key (ignored with
-// masks: false: the keyer node honours it then). CaptureCommand schedules start/stop per camera.
-// Each camera's capture thread is a loop thread (camera_worker.h).
-// The calibration of every camera (rig file, else the source's own) is published on
-// studio/camera/calibration (transient-local) at start.
+// ExposureTime, Focus, Zoom, Iris, BalanceRatioRed, BalanceRatioBlue) is applied through
+// FrameSource::set_feature and the read-back value is published in CameraState; ImageRate and
+// ImageRaw are the node's own pseudo-features; KeyerPlate (keyer/keyer.h) captures a clean plate
+// for an in-process difference key (ignored with masks: false: the keyer node honours it then).
+// CaptureCommand schedules start/stop per camera. Each camera's capture thread is a loop thread
+// (camera_worker.h). The calibration of every camera (rig file, else the source's own) is published
+// on studio/camera/calibration (transient-local) at start.
 //
 // Counters: masks_published, images_published, frames_captured, frames_recorded, frames_dropped,
 // frames_unkeyed, plates_captured, plate_saves_failed; controls_rejected and commands_rejected

@@ -70,6 +70,21 @@ void select_interfaces(const std::vector<std::string>& interfaces) {
 
 const char* const kExtraFeatures[] = {"BlackLevel", "Gamma", "Focus", "Zoom", "Iris"};
 
+// White balance: SFNC's BalanceRatio of the channel BalanceRatioSelector names, published as one
+// flat feature per channel (our features are name -> value); green is the reference.
+struct BalanceChannel {
+  const char* feature;
+  const char* selector;
+};
+constexpr BalanceChannel kBalanceChannels[] = {{"BalanceRatioRed", "Red"},
+                                               {"BalanceRatioBlue", "Blue"}};
+
+// The camera has a selectable BalanceRatio (the caller holds the device mutex).
+bool has_balance_ratio(ArvCamera* camera) {
+  return arv_camera_is_feature_available(camera, "BalanceRatioSelector", nullptr) &&
+         arv_camera_is_feature_available(camera, "BalanceRatio", nullptr);
+}
+
 }  // namespace
 
 Expected<void> AravisOptions::validate() const {
@@ -645,6 +660,12 @@ std::vector<Feature> AravisSource::features() const {
     arv_camera_get_frame_rate_bounds(d.camera, &min, &max, &error);
     add("AcquisitionFrameRate", error ? 0 : arv_camera_get_frame_rate(d.camera, &error), min, max);
   }
+  if (has_balance_ratio(d.camera))
+    for (const BalanceChannel& b : kBalanceChannels) {
+      arv_camera_set_string(d.camera, "BalanceRatioSelector", b.selector, &error);
+      if (!error) arv_camera_get_float_bounds(d.camera, "BalanceRatio", &min, &max, &error);
+      add(b.feature, error ? 0 : arv_camera_get_float(d.camera, "BalanceRatio", &error), min, max);
+    }
   ArvGc* genicam = arv_device_get_genicam(arv_camera_get_device(d.camera));
   for (const char* name : kExtraFeatures) {
     ArvGcNode* node = arv_gc_get_node(genicam, name);
@@ -693,11 +714,21 @@ Expected<double> AravisSource::set_feature(std::string_view name_view, double va
     if (!error) got = arv_camera_get_frame_rate(d.camera, &error);
     return done("set");
   }
+  for (const BalanceChannel& b : kBalanceChannels) {
+    if (name != b.feature) continue;
+    if (!has_balance_ratio(d.camera)) return fail(who + ": not available on this camera");
+    arv_camera_set_string(d.camera, "BalanceRatioSelector", b.selector, &error);
+    if (!error) arv_camera_get_float_bounds(d.camera, "BalanceRatio", &min, &max, &error);
+    if (!error) arv_camera_set_float(d.camera, "BalanceRatio", std::clamp(value, min, max), &error);
+    if (!error) got = arv_camera_get_float(d.camera, "BalanceRatio", &error);
+    return done("set");
+  }
   if (std::find(std::begin(kExtraFeatures), std::end(kExtraFeatures), name) ==
       std::end(kExtraFeatures)) {
     return fail(who +
                 ": not a remotely controllable feature (Gain, ExposureTime, "
-                "AcquisitionFrameRate, BlackLevel, Gamma, Focus, Zoom, Iris)");
+                "AcquisitionFrameRate, BalanceRatioRed, BalanceRatioBlue, BlackLevel, Gamma, "
+                "Focus, Zoom, Iris)");
   }
   ArvGcNode* node =
       arv_gc_get_node(arv_device_get_genicam(arv_camera_get_device(d.camera)), name.c_str());

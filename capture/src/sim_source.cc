@@ -15,6 +15,7 @@ namespace {
 
 constexpr double kGainMax = 24.0;
 constexpr double kExposureMin = 20.0;
+constexpr double kRatioMin = 0.25, kRatioMax = 4.0;  // BalanceRatioRed, BalanceRatioBlue
 
 double exposure_max(const FrameClock& clock) { return double(clock.period_ns) / 1000.0; }
 
@@ -228,20 +229,27 @@ Expected<std::optional<Frame>> SimFrameSource::next(std::chrono::milliseconds ti
 }
 
 void SimFrameSource::apply_features(Image<Rgb8>& image) {
-  double gain, exposure, focus;
+  double gain, exposure, focus, ratio[3] = {1, 1, 1};
   {
     std::lock_guard lock(mutex_);
     gain = gain_db_;
     exposure = exposure_us_;
     focus = focus_;
+    ratio[0] = ratio_red_;
+    ratio[2] = ratio_blue_;
   }
   const double k = std::pow(10.0, gain / 20.0) * exposure / options_.nominal_exposure_us;
-  if (std::abs(k - 1.0) > 1e-6) {
-    uint8_t lut[256];
-    for (int i = 0; i < 256; ++i) lut[i] = uint8_t(std::clamp(std::lround(i * k), 0l, 255l));
-    auto* p = reinterpret_cast<uint8_t*>(image.data());
-    const std::size_t n = image.pixels().size() * 3;
-    for (std::size_t i = 0; i < n; ++i) p[i] = lut[p[i]];
+  if (std::abs(k * ratio[0] - 1.0) > 1e-6 || std::abs(k - 1.0) > 1e-6 ||
+      std::abs(k * ratio[2] - 1.0) > 1e-6) {
+    uint8_t lut[3][256];  // per channel: red, green, blue
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < 256; ++i)
+        lut[c][i] = uint8_t(std::clamp(std::lround(i * k * ratio[c]), 0l, 255l));
+    for (Rgb8& p : image.pixels()) {
+      p.r = lut[0][p.r];
+      p.g = lut[1][p.g];
+      p.b = lut[2][p.b];
+    }
   }
   const int r = int(std::lround(std::abs(focus - options_.in_focus) * options_.max_blur_px));
   if (r > 0) {
@@ -254,7 +262,9 @@ std::vector<Feature> SimFrameSource::features() const {
   std::lock_guard lock(mutex_);
   return {{"Gain", gain_db_, 0, kGainMax, true},
           {"ExposureTime", exposure_us_, kExposureMin, exposure_max(options_.clock), true},
-          {"Focus", focus_, 0, 1, true}};
+          {"Focus", focus_, 0, 1, true},
+          {"BalanceRatioRed", ratio_red_, kRatioMin, kRatioMax, true},
+          {"BalanceRatioBlue", ratio_blue_, kRatioMin, kRatioMax, true}};
 }
 
 Expected<double> SimFrameSource::set_feature(std::string_view name, double value) {
@@ -265,6 +275,8 @@ Expected<double> SimFrameSource::set_feature(std::string_view name, double value
   if (name == "ExposureTime")
     return exposure_us_ = std::clamp(value, kExposureMin, exposure_max(options_.clock));
   if (name == "Focus") return focus_ = std::clamp(value, 0.0, 1.0);
+  if (name == "BalanceRatioRed") return ratio_red_ = std::clamp(value, kRatioMin, kRatioMax);
+  if (name == "BalanceRatioBlue") return ratio_blue_ = std::clamp(value, kRatioMin, kRatioMax);
   return fail("camera " + id() + ": feature '" + std::string(name) + "' is not available");
 }
 

@@ -12,7 +12,8 @@
 namespace studio::preview {
 namespace {
 
-constexpr const char* kFeatures[] = {"Gain", "ExposureTime", "Focus", "Zoom", "Iris"};
+constexpr const char* kFeatures[] = {"Gain", "ExposureTime",    "Focus",           "Zoom",
+                                     "Iris", "BalanceRatioRed", "BalanceRatioBlue"};
 const ImVec4 kRed{1.0f, 0.25f, 0.25f, 1.0f};
 
 void remember_window(PanelState& s, const char* title) {

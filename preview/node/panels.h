@@ -1,6 +1,7 @@
 #pragma once
 // The control panel's windows (TCSVT 2004 §II), drawn with Dear ImGui over the 3D view:
-//   Cameras    per camera the allow-listed features (Gain, ExposureTime, Focus, Zoom, Iris) as
+//   Cameras    per camera the allow-listed features (Gain, ExposureTime, Focus, Zoom, Iris,
+//              BalanceRatioRed, BalanceRatioBlue) as
 //              sliders over their published ranges; a released slider sends CameraControl; the
 //              read-back value (studio/camera/state) beside it.
 //   Capture    take name, start / stop at a frame (CaptureCommand), per camera recording, take,

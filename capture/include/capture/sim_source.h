@@ -18,6 +18,8 @@
 //   Gain          dB, 0..24            image *= 10^(Gain/20)
 //   ExposureTime  µs, 20..period       image *= ExposureTime / nominal_exposure_us
 //   Focus         0..1                 box blur of radius round(|Focus - in_focus| * max_blur_px)
+//   BalanceRatioRed, BalanceRatioBlue  0.25..4   red / blue *= the ratio (white balance against
+//                                      green; SFNC's BalanceRatio under BalanceRatioSelector)
 // Tracked (follow_pose): before rendering frame f the source asks for its camera; a changed
 // camera rebuilds the simulated camera's cached rays and background (SimulatedStudio::set_camera).
 // Imperfections on request: `offset_ns` moves the exposure instant (capture_ns) within the
@@ -106,6 +108,7 @@ class SimFrameSource : public FrameSource {
   std::condition_variable wake_;
   bool stopping_ = false;
   double gain_db_, exposure_us_, focus_;
+  double ratio_red_ = 1, ratio_blue_ = 1;  // BalanceRatioRed, BalanceRatioBlue
   SourceStats stats_;
   std::vector<uint16_t> blur_row_;
   struct Ahead {
