@@ -207,6 +207,8 @@ TEST(ColourBalance, FramesOfSomeCamerasAndABoundedWindow) {
   std::printf("  cameras 0, 1, 7 alone: worst pair ratio error %.2f %%\n", 100 * worst);
   EXPECT_LT(worst, 0.025);  // measured 1.39 %
   for (int c : {2, 3, 4, 5, 6, 8}) EXPECT_EQ(b.estimated[std::size_t(c)], Eigen::Vector3f::Ones());
+  // The linked set: 0, 1 and 7 together (named by camera 0), the rest linked to none.
+  EXPECT_EQ(b.linked_set, (std::vector<int>{0, 0, -1, -1, -1, -1, -1, 0, -1}));
   // One view present: nothing to compare, the frame counts.
   std::vector<ColourView> one(9);
   one[0] = differ.views[0];
@@ -254,6 +256,7 @@ TEST(ColourBalance, RefusesBadInputAndKeepsUnlinkedCamerasAtOne) {
   EXPECT_EQ(none.pairs, 0);
   EXPECT_FALSE(none.applied);  // (every estimate 1: nothing to apply, nothing reported applied)
   for (const auto& g : none.gains) EXPECT_EQ(g, Eigen::Vector3f::Ones());
+  EXPECT_EQ(none.linked_set, std::vector<int>(s.views.size(), -1));
   ColourBalanceOptions strict;
   strict.min_samples = 1 << 30;
   const ColourBalance unlinked = estimate_colour_balance(s.hull_mesh, s.views, strict).value();

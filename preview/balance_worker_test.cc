@@ -1,5 +1,6 @@
 // BalanceWorker (preview/node/balance_worker.h): jobs pooled on its thread, the estimate read as
-// a snapshot, a refused job not counted, a job in hand finished at destruction.
+// a snapshot, a refused job not counted, a restart forgetting the pool, a job in hand finished
+// at destruction.
 #include "balance_worker.h"
 
 #include <gtest/gtest.h>
@@ -39,6 +40,29 @@ TEST(BalanceWorker, PoolsOnItsThreadAndCountsOnlyWhatItPooled) {
   ASSERT_TRUE(w.submit(job("cam0", "cam7")));
   w.wait_idle();
   EXPECT_EQ(w.pooled(), 1u);
+  EXPECT_EQ(w.snapshot().balance.frames, 1);
+}
+
+TEST(BalanceWorker, RestartForgetsWhatWasPooled) {
+  BalanceWorker w;
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(w.submit(job("cam0", "cam1")));
+    w.wait_idle();
+  }
+  EXPECT_EQ(w.snapshot().balance.frames, 3);
+  w.restart();  // at once: an empty estimate
+  EXPECT_EQ(w.snapshot().balance.frames, 0);
+  EXPECT_TRUE(w.snapshot().cameras.empty());
+  ASSERT_TRUE(w.submit(job("cam0", "cam1")));
+  w.wait_idle();
+  EXPECT_EQ(w.snapshot().balance.frames, 1);  // pooled afresh, not the 4th
+  // A restart while a job may be in hand: that job does not reach the snapshot.
+  ASSERT_TRUE(w.submit(job("cam0", "cam1")));
+  w.restart();
+  w.wait_idle();
+  EXPECT_EQ(w.snapshot().balance.frames, 0);
+  ASSERT_TRUE(w.submit(job("cam0", "cam1")));
+  w.wait_idle();
   EXPECT_EQ(w.snapshot().balance.frames, 1);
 }
 

@@ -4,7 +4,9 @@
 // opens the Projectors panel. Checked:
 // the screenshot (the panel's title bar and the slider with its value at the places the window
 // reports, the scene drawn in the 3D view, the two views differ) and the wire (the simulated
-// camera's read-back on studio/camera/state becomes the new value).
+// camera's read-back on studio/camera/state becomes the new value). And the View panel's "Match
+// cameras" button (node/camera_matching.h), pressed by the hook: its result drawn, the cameras
+// set.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -12,6 +14,7 @@
 #include <regex>
 #include <thread>
 
+#include "sim/studio.h"
 #include "testing/studio_fixture.h"
 #include "wire/endpoint.h"
 
@@ -126,6 +129,63 @@ TEST_F(PreviewStudioTest, GuiPanelsDriveTheStudioAndTwoViewsRunSideBySide) {
       << "the title 'Projectors' in the title bar";
   EXPECT_TRUE(rect(layout, "Projectors").empty()) << "the director did not open it";
   EXPECT_NE(op_layout.find("\"meshes\":"), std::string::npos);
+}
+
+// The View panel's "Match cameras" pressed through the test hook on a rig whose cameras differ
+// (cam1 two thirds of a stop up): the panel shows what it sent, under the button where the
+// window reports it, and the simulated cameras read back the new Gain / white balance.
+TEST_F(PreviewStudioTest, GuiMatchCamerasButtonSetsTheCameras) {
+  auto response = sim::random_camera_response(9, 3, 0.1, 0.05);
+  for (double& g : response[1]) g *= 1.6;
+  start_studio(false, false, 9, response);
+  auto p = wire::Participant::create().value();
+  auto topic = wire::Topic<studio_CameraState>::create(p).value();
+  auto states = wire::Reader<studio_CameraState>::create(p, topic).value();
+  const std::string script = (dir_ / "match.txt").string();
+  std::ofstream(script) << "wait_meshes 3\nopen view\nwait 6\npress match_cameras\nwait 2\n"
+                           "screenshot "
+                        << (dir_ / "match.png").string() << "\nquit\n";
+  auto args = studio::testing::xvfb_exec("1024x768x24", dir_ / "match.xenv");
+  const std::string launcher = args.front();
+  args.erase(args.begin());
+  for (const std::string& a :
+       {studio::testing::built_binary("preview/studio-preview").string(), std::string("--config"),
+        preview_config("director", 400, "colour_balance_every: 1\n"), std::string("--viewpoint"),
+        std::string("eye=0.3,1.6,2.6,at=0,1.0,0,fov=50"), std::string("--size"),
+        std::string("960x640"), std::string("--test-script"), script})
+    args.push_back(a);
+  Process& g = spawn_path("director", launcher, args);
+  const auto code = g.wait_exit(std::chrono::seconds(150));
+  ASSERT_TRUE(code.has_value()) << "did not finish";
+  ASSERT_EQ(*code, 0) << g.log();
+  const std::string layout = slurp(dir_ / "match.png.json");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(layout, m, std::regex(R"re("match":"([^"]*)")re"))) << layout;
+  const std::string said = m[1];
+  std::printf("the panel says: %s\n", said.c_str());
+  EXPECT_NE(said.find("controls sent to"), std::string::npos) << said;
+  // The button and the result beside it, drawn where the layout says.
+  const cv::Mat shot = cv::imread((dir_ / "match.png").string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(shot.empty());
+  const auto button = rect(layout, "View/Match cameras");
+  ASSERT_EQ(button.size(), 5u) << layout;
+  EXPECT_GT(text_pixels(shot, button), 10) << "the button's label";
+  EXPECT_GT(text_pixels(shot, {button[0] + button[2], button[1], 300, button[3]}), 10)
+      << "the result beside the button";
+  // The wire: some camera no longer at its defaults (Gain 0 dB, white balance 1).
+  int changed = 0;
+  for (auto deadline = std::chrono::steady_clock::now() + 10s;
+       changed == 0 && std::chrono::steady_clock::now() < deadline;) {
+    for (auto& s : states.take())
+      if (s.meta.valid_data)
+        for (const auto& f : wire::view(s.data->features)) {
+          const std::string name(wire::str(f.name));
+          changed += (name == "Gain" && f.value != 0) ||
+                     ((name == "BalanceRatioRed" || name == "BalanceRatioBlue") && f.value != 1);
+        }
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_GT(changed, 0) << "no camera reads back a matched control";
 }
 
 }  // namespace

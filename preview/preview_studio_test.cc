@@ -107,6 +107,7 @@ TEST_F(PreviewStudioTest, BadInputIsOneLineAndExitTwo) {
       {"--config", (dir_ / "every.yaml").string(), "--headless", "--screenshot", "a.png"},
       {"--every", "2", "--frames", "0", "--headless", "--screenshot", "a.png"},
       {"--screenshot", "a.png"},
+      {"--match-cameras"},
       {"--bogus"}};
   for (const auto& args : cases) {
     Process& p = spawn("bad", "preview/studio-preview", args);
@@ -121,6 +122,7 @@ TEST_F(PreviewStudioTest, BadInputIsOneLineAndExitTwo) {
   Process& help = spawn("help", "preview/studio-preview", {"--help"});
   EXPECT_EQ(help.wait_exit(std::chrono::seconds(20)), 0);
   EXPECT_NE(help.log().find("--headless"), std::string::npos);
+  EXPECT_NE(help.log().find("--match-cameras"), std::string::npos);
 }
 
 // Like every service, the preview publishes studio/service/status: service "preview", its
@@ -648,6 +650,111 @@ TEST_F(PreviewStudioTest, TheColourBalanceFollowsACameraWhoseGainIsChanged) {
   // estimate's pose-dependent error (TheColourBalanceEqualisesCamerasThatDiffer: up to 5.1 %).
   EXPECT_NEAR(change * k, 1.0, 0.06);
   EXPECT_GT(half, 110u);
+}
+
+// "Match cameras" (node/camera_matching.h): on a rig whose cameras differ (cam1 two thirds of a
+// stop up), the headless preview sends its estimate to the capture service once it applies; the
+// simulated cameras' Gain and white balance (BalanceRatioRed / Blue) read back the values sent,
+// the cameras then differ far less against the simulator's truth, and the balance starts afresh
+// on the matched images.
+TEST_F(PreviewStudioTest, MatchCamerasMovesTheBalanceIntoTheCameras) {
+  auto response = sim::random_camera_response(9, 3, 0.1, 0.05);
+  for (double& g : response[1]) g *= 1.6;
+  start_studio(false, false, 9, response);
+  const auto [held, view] = held_out(kWidth, kHeight);
+  auto participant = wire::Participant::create().value();
+  auto state_topic = wire::Topic<studio_CameraState>::create(participant).value();
+  auto states = wire::Reader<studio_CameraState>::create(participant, state_topic).value();
+  Process& p = spawn(
+      "preview", "preview/studio-preview",
+      {"--headless", "--config", preview_config("director", 1000, "colour_balance_every: 1\n"),
+       "--viewpoint", to_string(view), "--overlays", "none", "--size",
+       std::to_string(kWidth) + "x" + std::to_string(kHeight), "--duration", "14", "--record",
+       (dir_ / "rec").string(), "--screenshot", (dir_ / "last.png").string(), "--json",
+       "--match-cameras"});
+  const auto code = p.wait_exit(60s);
+  ASSERT_TRUE(code.has_value());
+  ASSERT_EQ(*code, 0) << p.log();
+  // The plan as sent ("camera_match" of the summary).
+  const std::string log = p.log();
+  const auto at = log.find("\"camera_match\":{\"level_db\"");
+  ASSERT_NE(at, std::string::npos) << log;
+  const std::string match = log.substr(at, log.find("}}", at) - at);
+  std::map<std::string, Eigen::Vector3d> applied;  // per matched camera: the factor sent
+  std::map<std::pair<std::string, std::string>, double> sent;
+  {
+    const std::regex change(
+        R"re(\{"camera":"([^"]+)","feature":"([^"]+)","from":([-0-9.]+),"to":([-0-9.]+)\})re");
+    for (auto it = std::sregex_iterator(match.begin(), match.end(), change);
+         it != std::sregex_iterator(); ++it) {
+      const std::string cam = (*it)[1], feature = (*it)[2];
+      const double from = std::stod((*it)[3]), to = std::stod((*it)[4]);
+      sent[{cam, feature}] = to;
+      Eigen::Vector3d& f = applied.try_emplace(cam, Eigen::Vector3d::Ones()).first->second;
+      if (feature == "Gain") f *= std::pow(10.0, (to - from) / 20);
+      if (feature == "BalanceRatioRed") f.x() *= to / from;
+      if (feature == "BalanceRatioBlue") f.z() *= to / from;
+    }
+  }
+  std::vector<std::string> matched;  // the balance's linked set (the others: the level only)
+  {
+    const std::string list = match.substr(match.find("\"matched\":["));
+    const std::regex id(R"re("(cam[0-9]+)")re");
+    for (auto it = std::sregex_iterator(list.begin(), list.begin() + long(list.find(']')), id);
+         it != std::sregex_iterator(); ++it)
+      matched.push_back((*it)[1]);
+  }
+  ASSERT_FALSE(sent.empty()) << match;
+  ASSERT_GE(matched.size(), 3u) << match;
+  // The capture service read the values back (studio/camera/state, transient-local: the latest).
+  std::map<std::string, std::map<std::string, double>> read_back;
+  for (auto& st : states.take())
+    if (st.meta.valid_data)
+      for (const auto& f : wire::view(st.data->features))
+        read_back[std::string(st.data->camera_id)][std::string(f.name)] = f.value;
+  for (const auto& [key, to] : sent)
+    EXPECT_NEAR(read_back[key.first][key.second], to, 1e-4 * std::max(1.0, std::abs(to)))
+        << key.first << " " << key.second;
+  // Against the truth: the matched cameras' pair ratios, before and after the match.
+  const auto truth = sim::balancing_gains(response);
+  double before = 0, after = 0;
+  for (const std::string& a : matched)
+    for (const std::string& b : matched)
+      for (int k = 0; a < b && k < 3; ++k) {
+        const Eigen::Vector3d fa = applied.count(a) ? applied.at(a) : Eigen::Vector3d::Ones(),
+                              fb = applied.count(b) ? applied.at(b) : Eigen::Vector3d::Ones();
+        const double ta = truth[std::size_t(std::stoi(a.substr(3)))][std::size_t(k)],
+                     tb = truth[std::size_t(std::stoi(b.substr(3)))][std::size_t(k)];
+        before = std::max(before, std::abs(ta / tb - 1));
+        after = std::max(after, std::abs((ta / fa[k]) / (tb / fb[k]) - 1));
+      }
+  // The balance after the match: pooled afresh (fewer frames than meshes drawn) on the matched
+  // images; its estimate between the matched cameras.
+  const BalanceSummary b = balance_summary(log);
+  ASSERT_TRUE(b.found) << log;
+  double estimate_left = 0;
+  for (const auto& [x, gx] : b.estimated)
+    for (const auto& [y, gy] : b.estimated)
+      for (int k = 0; x < y && k < 3 && std::count(matched.begin(), matched.end(), x) &&
+                      std::count(matched.begin(), matched.end(), y);
+           ++k)
+        if (gx != Eigen::Vector3d::Ones() && gy != Eigen::Vector3d::Ones())
+          estimate_left = std::max(estimate_left, std::abs(gx[k] / gy[k] - 1));
+  int drawn = 0;
+  {
+    std::ifstream in(dir_ / "rec" / "frames.jsonl");
+    for (std::string line; std::getline(in, line);) ++drawn;
+  }
+  std::printf(
+      "match cameras: %zu controls, %zu cameras matched (%s); their worst pair ratio "
+      "against the truth %.2f %% before, %.2f %% after; the balance afterwards: %d frames "
+      "pooled of %d meshes drawn, applied %d, its worst pair ratio %.2f %%\n",
+      sent.size(), matched.size(), match.substr(0, match.find(",\"changes\"")).c_str(),
+      100 * before, 100 * after, b.frames, drawn, int(b.applied), 100 * estimate_left);
+  EXPECT_GT(before, 0.2);           // cam1's +25 % among them
+  EXPECT_LT(after, 0.35 * before);  // the live estimate's error is what remains (up to ~5 %)
+  EXPECT_GE(b.frames, 8);
+  EXPECT_LT(b.frames, drawn - 8);  // started afresh after the match
 }
 
 }  // namespace

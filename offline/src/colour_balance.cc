@@ -205,6 +205,15 @@ ColourBalance ColourBalanceEstimator::solve() {
     return i;
   };
   for (const Edge& e : edges) root[std::size_t(find(e.i))] = find(e.j);
+  out.linked_set.assign(cameras_, -1);
+  {
+    std::vector<int> smallest(cameras_, n);  // per root: the smallest index in its set
+    for (int c = 0; c < n; ++c)
+      smallest[std::size_t(find(c))] = std::min(smallest[std::size_t(find(c))], c);
+    for (const Edge& e : edges)
+      out.linked_set[std::size_t(e.i)] = out.linked_set[std::size_t(e.j)] =
+          smallest[std::size_t(find(e.i))];
+  }
   // Least squares per channel: w (g_i - g_j + m_ij)^2 over the edges (g = log gain, so that
   // the balanced colours agree: log c_i + g_i = log c_j + g_j), plus sum g = 0 per connected set.
   const int rows = int(edges.size()) + n;

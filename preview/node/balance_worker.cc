@@ -35,6 +35,13 @@ void BalanceWorker::wait_idle() {
   idle_.wait(lock, [this] { return !busy_ && !job_; });
 }
 
+void BalanceWorker::restart() {
+  std::lock_guard lock(mutex_);
+  restart_ = true;
+  job_.reset();
+  snapshot_ = RigBalance().snapshot();
+}
+
 uint64_t BalanceWorker::pooled() const {
   std::lock_guard lock(mutex_);
   return pooled_;
@@ -50,6 +57,10 @@ void BalanceWorker::run() {
       job = std::move(*job_);
       job_.reset();
       busy_ = true;
+      if (restart_) {
+        balance_ = RigBalance();
+        restart_ = false;
+      }
     }
     std::vector<BalanceView> views;
     for (std::size_t i = 0; i < job.cameras.size(); ++i)
@@ -62,7 +73,7 @@ void BalanceWorker::run() {
     if (!ok) STUDIO_LOG(warn, "preview") << ok.error().message;
     {
       std::lock_guard lock(mutex_);
-      if (ok) {
+      if (ok && !restart_) {  // a restart while pooling: this job was of the old colours
         snapshot_ = balance_.snapshot();
         ++pooled_;
       }

@@ -39,6 +39,9 @@ class BalanceWorker {
   BalanceSnapshot snapshot() const;
   // Waits until the job in hand (if any) is pooled (a run's end: its summary includes it).
   void wait_idle();
+  // Forgets everything pooled (the cameras' colours were changed at the cameras): the snapshot
+  // is an empty estimate (gains 1) at once; a job in hand is pooled into nothing.
+  void restart();
   uint64_t pooled() const;  // jobs pooled so far
 
  private:
@@ -47,7 +50,7 @@ class BalanceWorker {
   mutable std::mutex mutex_;
   std::condition_variable wake_, idle_;
   std::optional<Job> job_;
-  bool busy_ = false, stop_ = false;
+  bool busy_ = false, stop_ = false, restart_ = false;
   uint64_t pooled_ = 0;
   RigBalance balance_;  // the worker thread's alone
   BalanceSnapshot snapshot_;

@@ -78,6 +78,11 @@ class Script {
         double value = 0;
         if (!(in >> cam >> feature >> value)) return failed("set: expected CAMERA FEATURE VALUE");
         panels.scripted[cam + "/" + feature] = value;
+      } else if (verb == "press") {
+        std::string button;
+        in >> button;
+        if (button != "match_cameras") return failed("press: unknown button '" + button + "'");
+        panels.press_match = true;
       } else if (verb == "viewpoint") {
         std::string text;
         in >> text;
@@ -94,7 +99,8 @@ class Script {
       }
       ++next_;
       since_ = Clock::now();
-      if (verb == "screenshot" || verb == "open" || verb == "set") return true;  // draw first
+      if (verb == "screenshot" || verb == "open" || verb == "set" || verb == "press")
+        return true;  // draw first
     }
     (void)width;
     (void)height;
@@ -148,8 +154,13 @@ bool write_screenshot(const std::string& path, int w, int h, const PanelState& p
     rect(r, true);
     first = false;
   }
+  std::string match;  // the View panel's last "Match cameras", JSON-escaped
+  for (char c : panels.match_result) {
+    if (c == '"' || c == '\\') match += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20) match += c;
+  }
   json << "},\"view\":{\"meshes\":" << counts.meshes << ",\"textured\":" << counts.textured
-       << "}}\n";
+       << ",\"match\":\"" << match << "\"}}\n";
   return ok && json.good();
 }
 

@@ -10,11 +10,13 @@
 //   open PANEL               cameras | capture | animation | services | view | projectors
 //   set CAMERA FEATURE VALUE the camera panel's slider of FEATURE takes VALUE as if dragged
 //                            there: the panel sends CameraControl
+//   press match_cameras      the View panel's "Match cameras" button (the panel must be open)
 //   viewpoint V              eye=X,Y,Z,at=X,Y,Z[,fov=DEG]
 //   screenshot PNG           the window as drawn, plus PNG.json: {"windows": {title: [x, y, w,
 //                            h]}, "items": {"CAMERA/FEATURE": [x, y, w, h, value],
-//                            "projector/ID": [x, y, w, h, render frame]}, "view":
-//                            {"meshes": N, "textured": N}} (top-left origin, pixels)
+//                            "projector/ID": [x, y, w, h, render frame], "View/Match
+//                            cameras": [x, y, w, h, 0]}, "view": {"meshes": N, "textured": N,
+//                            "match": the button's last result}} (top-left origin, pixels)
 //   quit
 #include <string>
 

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <thread>
 
+#include "camera_matching.h"
 #include "preview_node.h"
 #include "runtime/metrics.h"
 #include "runtime/signals.h"
@@ -130,6 +131,8 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
       std::chrono::duration<double>(std::max(options.every_s, 0.0)));
   auto last_drawn = start - interval;
   int drawn = 0;
+  std::string match_json = "null";  // --match-cameras: what was sent, or why not
+  bool match_tried = false;
   while (Clock::now() < deadline) {
     if (signals.wait(std::chrono::milliseconds(0))) break;
     status->tick();
@@ -151,6 +154,21 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
     }
     if (!r.new_mesh) continue;
     ++drawn;
+    if (options.match_cameras && !match_tried) {
+      const BalanceSnapshot b = (*pipeline)->colour_balance();
+      if (b.balance.applied && b.balance.frames >= kMatchAutoFrames) {
+        match_tried = true;
+        auto m = match_cameras(node, **pipeline);
+        if (m) {
+          match_json = camera_match_json(*m);
+          std::fprintf(stderr, "studio-preview: match cameras: %s\n",
+                       camera_match_text(*m).c_str());
+        } else {
+          match_json = "{\"error\":\"" + m.error().message + "\"}";
+          std::fprintf(stderr, "studio-preview: %s\n", m.error().message.c_str());
+        }
+      }
+    }
     if (every) {
       last_drawn = Clock::now();
       target->read_rgba(rgba);
@@ -189,12 +207,13 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
         "{\"screenshot\":\"%s\",\"width\":%d,\"height\":%d,\"meshes\":%llu,"
         "\"textured\":%llu,\"untextured\":%llu,\"late\":%llu,\"refused\":%llu,"
         "\"skipped\":%llu,\"seconds\":%.3f,\"renderer\":\"%s\",\"overlays\":{\"heads\":%zu,"
-        "\"cameras\":%zu,\"projectors\":%zu,\"thumbnails\":%zu},\"colour_balance\":%s}\n",
+        "\"cameras\":%zu,\"projectors\":%zu,\"thumbnails\":%zu},\"colour_balance\":%s,"
+        "\"camera_match\":%s}\n",
         options.screenshot.c_str(), config.width, config.height, (unsigned long long)c.meshes,
         (unsigned long long)c.textured, (unsigned long long)c.untextured,
         (unsigned long long)c.late, (unsigned long long)c.refused, (unsigned long long)c.skipped,
         seconds, context->renderer().c_str(), o.heads, node.cameras().size(), o.projectors,
-        o.thumbnails, balance_json(**pipeline).c_str());
+        o.thumbnails, balance_json(**pipeline).c_str(), match_json.c_str());
   else
     std::printf(
         "%s: %dx%d, %d meshes drawn (%llu textured, %llu untextured: %llu late, %llu refused; "

@@ -19,6 +19,9 @@ struct HeadlessOptions {
   double every_s = 0;
   std::string record;  // folder: every drawn mesh's frame as <n>.png + frames.jsonl
   bool json = false;   // summary as one JSON line
+  // Once the colour balance is applied (some camera beyond its tolerance, kMatchAutoFrames
+  // pooled), send it to the cameras' controls once (node/camera_matching.h).
+  bool match_cameras = false;
 };
 
 // SIGINT/SIGTERM end the run as its deadline does (the screenshot is written).

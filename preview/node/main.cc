@@ -20,7 +20,7 @@ constexpr const char* kUsage =
                       [--colour-balance on|off] [--size WxH] [--overlays LIST]
        studio-preview --headless --screenshot PNG [--frames N | --duration S] [--every S]
                       [--record DIR] [--timeout S] [--settle S]
-                      [--json] [same options]
+                      [--match-cameras] [--json] [same options]
 
 The director's preview and control panel: the virtual scene (studio/scene/node) and the live
 actor mesh (studio/actor/mesh) from any viewpoint, the actor textured from the studio cameras
@@ -63,10 +63,18 @@ Options:
                     screenshot rewritten with each (renamed into place, never half written);
                     only the drawn meshes' images are requested; runs for --duration, else
                     until SIGINT/SIGTERM; exit 1 if no mesh was drawn
+  --match-cameras   headless: once the colour balance applies (some camera beyond 3 % of the
+                    rig, 24 frames pooled), send it to the cameras once: CameraControl Gain
+                    (dB, the green factor; one level for the rig, no camera pushed below its
+                    lowest gain; cameras the balance has not linked take that level only) and BalanceRatioRed / BalanceRatioBlue (white balance against
+                    green) where the camera has them; the balance then starts afresh and learns
+                    what the controls did not take. The GUI's View panel: "Match cameras"
   --json            headless: the summary as one JSON line ("overlays": the heads, cameras,
                     calibrated projectors and thumbnails received; "colour_balance": applied,
                     frames pooled, busy (meshes skipped while pooling the previous), camera
-                    pairs and per camera id its gains)
+                    pairs and per camera id its gains; "camera_match": null, the changes sent
+                    {"level_db", "changes": [{"camera", "feature", "from", "to"}], "left"}, or
+                    {"error"})
   --test-script F   GUI: scripted input for tests (gui.h: one action per line)
 
 Headless, SIGINT/SIGTERM end the run like its deadline (the screenshot is written).
@@ -133,6 +141,8 @@ int run(int argc, char** argv) {
       h.every_s = number<double>(a, value(), 0.04, 3600);
     } else if (a == "--json") {
       h.json = true;
+    } else if (a == "--match-cameras") {
+      h.match_cameras = true;
     } else if (a == "--test-script") {
       script = value();
     } else {
@@ -175,6 +185,8 @@ int run(int argc, char** argv) {
   }
   if (!h.screenshot.empty() || !h.record.empty())
     die("--screenshot and --record are headless options (add --headless)");
+  if (h.match_cameras)
+    die("--match-cameras is a headless option (the window has the View panel's Match cameras)");
   return preview::run_gui(*config, script);
 }
 

@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <utility>
 
+#include "camera_matching.h"
 #include "studio.h"
 
 namespace studio::preview {
@@ -153,7 +155,8 @@ void services_panel(PanelState& s, PreviewNode& node) {
   ImGui::End();
 }
 
-void view_panel(PanelState& s, ViewPipeline& pipeline, Viewpoint& view, double now_s) {
+void view_panel(PanelState& s, PreviewNode& node, ViewPipeline& pipeline, Viewpoint& view,
+                double now_s) {
   if (!ImGui::Begin("View", &s.view)) return ImGui::End();
   remember_window(s, "View");
   bool blend = pipeline.blend();
@@ -173,6 +176,17 @@ void view_panel(PanelState& s, ViewPipeline& pipeline, Viewpoint& view, double n
       for (std::size_t i = 0; i < rb.cameras.size() && i < b.estimated.size(); ++i)
         ImGui::Text("%-10s %.3f %.3f %.3f", rb.cameras[i].c_str(), b.estimated[i].x(),
                     b.estimated[i].y(), b.estimated[i].z());
+    // The estimate sent to the cameras' Gain and white balance (node/camera_matching.h).
+    if (ImGui::Button("Match cameras") || std::exchange(s.press_match, false)) {
+      auto m = match_cameras(node, pipeline);
+      s.match_result = m ? camera_match_text(*m) : m.error().message;
+    }
+    const ImVec2 a = ImGui::GetItemRectMin(), z = ImGui::GetItemRectMax();
+    s.items["View/Match cameras"] = {a.x, a.y, z.x - a.x, z.y - a.y, 0};
+    if (!s.match_result.empty()) {
+      ImGui::SameLine();
+      ImGui::TextWrapped("%s", s.match_result.c_str());
+    }
   }
   OverlayOptions& o = pipeline.overlays();
   ImGui::Checkbox("head marker", &o.head);
@@ -246,7 +260,7 @@ void draw_panels(PanelState& s, PreviewNode& node, ViewPipeline& pipeline, Viewp
   s.windows.clear();
   s.items.clear();
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-  if (s.view) view_panel(s, pipeline, view, now_s);
+  if (s.view) view_panel(s, node, pipeline, view, now_s);
   ImGui::SetNextWindowPos(ImVec2(10, 200), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(560, 300), ImGuiCond_FirstUseEver);
   if (s.cameras) cameras_panel(s, node);

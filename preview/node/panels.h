@@ -9,9 +9,10 @@
 //   Animation  play, pause, seek, speed (SceneCommand), move a node.
 //   Services   every service seen on studio/service/status: state, rates, latency; one that
 //              stopped reporting (lease expired or silent for 3 s) or failed is drawn in red.
-//   View       texturing (blend / nearest), counts of textured and untextured meshes,
-//              the overlays' switches (head marker, camera frusta, projector frusta, projector
-//              screens), bookmarks, a keyframed camera move.
+//   View       texturing (blend / nearest), the colour balance (estimate per camera; "Match
+//              cameras" sends it to the cameras' Gain and white balance), counts of textured and
+//              untextured meshes, the overlays' switches (head marker, camera frusta, projector
+//              frusta, projector screens), bookmarks, a keyframed camera move.
 //   Projectors every projector seen on studio/projector/calibration or /frame: its latest
 //              thumbnail (what it shows), render frame, mesh frame, latency and margin.
 #include <map>
@@ -46,6 +47,8 @@ struct PanelState {
   std::optional<CameraMove> move_playing;
   double move_start_s = 0;
   std::string last_error;
+  std::string match_result;  // View: the last "Match cameras" (what was sent, or why not)
+  bool press_match = false;  // the test hook's press of "Match cameras"
   // Filled while drawing, for the test hook's layout file.
   std::map<std::string, ItemRect> windows, items;
 };

@@ -80,6 +80,7 @@ struct ViewPipeline::Impl {
   std::vector<Mask> carving_masks;
   std::size_t carving_count = 0;
   BalanceWorker balance;
+  int64_t pool_from_ns = 0;  // restart_colour_balance(): meshes captured before are not pooled
   uint64_t textured_seen =
       0;  // meshes pool_balance() saw (the first and every balance_every-th pool)
   std::shared_ptr<PrefetchState> prefetch = std::make_shared<PrefetchState>();
@@ -198,6 +199,7 @@ struct ViewPipeline::Impl {
                     const std::map<std::string, RunMask>& masks,
                     const std::vector<FrameImage>& imgs) {
     if (!options.colour_balance || imgs.size() < 2) return false;
+    if (pending->capture_ns < pool_from_ns) return false;  // the colours before a camera match
     if (textured_seen++ % uint64_t(options.balance_every) != 0) return false;
     BalanceWorker::Job job;
     job.rig = cams;
@@ -359,6 +361,10 @@ void ViewPipeline::set_blend(bool blend) {
 }
 bool ViewPipeline::blend() const { return impl_->options.blend; }
 BalanceSnapshot ViewPipeline::colour_balance() const { return impl_->balance.snapshot(); }
+void ViewPipeline::restart_colour_balance(int64_t pool_from_capture_ns) {
+  impl_->pool_from_ns = pool_from_capture_ns;
+  impl_->balance.restart();
+}
 void ViewPipeline::finish_colour_balance() { impl_->balance.wait_idle(); }
 void ViewPipeline::report(runtime::Metrics& metrics) const {
   const BalanceSnapshot b = impl_->balance.snapshot();

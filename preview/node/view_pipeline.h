@@ -103,6 +103,10 @@ class ViewPipeline {
   void report(runtime::Metrics& metrics) const;
   void set_colour_balance(bool on);
   bool colour_balance_on() const;
+  // Forgets the balance's estimate (the cameras' colours were changed at the cameras:
+  // node/camera_matching.h) and pools again only meshes captured at or after
+  // `pool_from_capture_ns` (frames on the way still show the old colours).
+  void restart_colour_balance(int64_t pool_from_capture_ns);
   OverlayOptions& overlays();
   // GL texture name and size of a projector's latest thumbnail (0: none yet), for the
   // Projectors panel.

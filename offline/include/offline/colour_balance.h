@@ -72,6 +72,10 @@ struct ColourBalance {
   std::size_t points = 0;  // mesh vertices seen by two or more cameras (over all frames)
   int frames = 0;          // frames pooled (ColourBalanceEstimator)
   int pairs = 0;           // camera pairs with >= min_samples shared points (the graph's edges)
+  // Per view: the set of cameras it is linked with through those pairs, named by the smallest
+  // view index in it; -1 for a camera linked to none (its estimate is 1). Gains of cameras in
+  // different sets are not comparable (each set's geometric mean is 1 on its own).
+  std::vector<int> linked_set;
   // Median over the used pairs and channels of |log ratio| after the gains: what is left
   // between cameras (0 for a consistent rig; the spread of the data otherwise).
   double residual = 0;

@@ -1,0 +1,49 @@
+#pragma once
+// "Match cameras": the preview's colour balance (preview/rig_balance.h) sent to the cameras'
+// own controls (preview/camera_match.h: Gain, BalanceRatioRed, BalanceRatioBlue as CameraControl
+// on studio/camera/control), so that every consumer of the images sees matched cameras, not only
+// this preview's blend. The View panel's button and `studio-preview --headless --match-cameras`.
+//
+// The cameras matched are those of the balance's largest linked set (cameras linked by shared
+// surface points; gains across sets are not comparable) whose controls the capture servers
+// publish on studio/camera/state; every other camera publishing a Gain takes the rig's new level
+// only (plan_camera_match's k), so that it stays where it was against the rig. After sending, the
+// balance starts afresh and pools only meshes captured kSettle after the changes (frames on the way
+// still have the old colours), so what it learns next is what the controls did not take (clamped,
+// or a camera without white balance).
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "preview/camera_match.h"
+#include "preview_node.h"
+#include "view_pipeline.h"
+
+namespace studio::preview {
+
+inline constexpr std::chrono::milliseconds kMatchSettle{250};
+inline constexpr int kMatchMinFrames = 8;  // as RigBalance's: an estimate worth applying
+// --match-cameras waits for this many pooled frames: the estimate after 8 frames strays by a few
+// percent more than after a second of meshes (preview_quality_test, rig_balance.h).
+inline constexpr int kMatchAutoFrames = 24;
+
+struct SentMatch {
+  CameraMatch plan;
+  std::vector<std::string> matched;  // the linked set's cameras; the others took the level only
+};
+
+// Plans and sends the match; fails (nothing sent) while the balance has pooled fewer than
+// kMatchMinFrames frames or linked no cameras, when no linked camera publishes its controls, or
+// on a send that fails (the changes before it were sent).
+Expected<SentMatch> match_cameras(PreviewNode& node, ViewPipeline& pipeline,
+                                  double min_change = 0.005);
+
+// {"level_db", "matched": [ids], "changes": [{"camera", "feature", "from", "to"}],
+//  "left": {id: [r, g, b]}}
+std::string camera_match_json(const SentMatch& match);
+// One line for people: "5 controls sent to 3 cameras (3 matched, level +1.20 dB); left to the
+// preview's balance: cam3 ..."
+std::string camera_match_text(const SentMatch& match);
+
+}  // namespace studio::preview

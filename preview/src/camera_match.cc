@@ -1,0 +1,89 @@
+#include "preview/camera_match.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace studio::preview {
+namespace {
+
+bool valid(const std::optional<ControlValue>& c) {
+  return !c || (std::isfinite(c->value) && std::isfinite(c->min) && std::isfinite(c->max) &&
+                c->min <= c->max);
+}
+
+// The ratio control's new value for a wanted factor, clamped to its range; `taken` the factor
+// it applies.
+double ratio_to(const ControlValue& c, double factor, double* taken) {
+  const double to = std::clamp(c.value * factor, c.min, c.max);
+  *taken = c.value > 0 ? to / c.value : 1.0;
+  return to;
+}
+
+}  // namespace
+
+Expected<CameraMatch> plan_camera_match(const std::map<std::string, Eigen::Vector3f>& estimated,
+                                        const std::vector<CameraControls>& controls,
+                                        double min_change) {
+  if (!(min_change >= 0)) return fail("camera match: min_change must be >= 0");
+  for (const auto& [id, e] : estimated)
+    if (!e.allFinite() || (e.array() <= 0).any())
+      return fail("camera match: camera " + id + ": estimate is not finite and positive");
+  for (const CameraControls& c : controls)
+    if (!valid(c.gain_db) || !valid(c.ratio_red) || !valid(c.ratio_blue))
+      return fail("camera match: camera " + c.camera +
+                  ": a control's range is empty or not finite");
+
+  // The cameras taking part, and the gain change each wants before the common level k.
+  struct Wanted {
+    const CameraControls* c;
+    Eigen::Vector3d e;
+    double db;
+  };
+  std::vector<Wanted> wanted;
+  for (const CameraControls& c : controls)
+    if (auto e = estimated.find(c.camera); e != estimated.end())
+      wanted.push_back({&c, e->second.cast<double>(), 20 * std::log10(double(e->second.y()))});
+
+  // k: nearest 0 within every Gain's bounds (lo .. hi); the midpoint when they conflict.
+  double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Wanted& w : wanted)
+    if (const auto& g = w.c->gain_db) {
+      lo = std::max(lo, g->min - g->value - w.db);
+      hi = std::min(hi, g->max - g->value - w.db);
+    }
+  CameraMatch out;
+  out.level_db = !std::isfinite(lo) && !std::isfinite(hi) ? 0
+                 : lo <= hi                               ? std::clamp(0.0, lo, hi)
+                                                          : 0.5 * (lo + hi);
+  const double gain_step_db = 20 * std::log10(1 + min_change);
+  for (const Wanted& w : wanted) {
+    const CameraControls& c = *w.c;
+    // Wanted factors per channel, the rig's level included; what the controls take of them.
+    const Eigen::Vector3d want = w.e * std::pow(10.0, out.level_db / 20);
+    Eigen::Vector3d taken = Eigen::Vector3d::Ones();
+    if (c.gain_db) {
+      const double to =
+          std::clamp(c.gain_db->value + w.db + out.level_db, c.gain_db->min, c.gain_db->max);
+      if (std::abs(to - c.gain_db->value) > gain_step_db) {
+        out.changes.push_back({c.camera, "Gain", c.gain_db->value, to});
+        taken.setConstant(std::pow(10.0, (to - c.gain_db->value) / 20));
+      }
+    }
+    const double green = taken.y();
+    auto ratio = [&](const std::optional<ControlValue>& r, const char* name, int channel) {
+      if (!r) return;
+      double factor = 1;
+      const double to = ratio_to(*r, want[channel] / want.y(), &factor);
+      if (std::abs(factor - 1) <= min_change) return;
+      out.changes.push_back({c.camera, name, r->value, to});
+      taken[channel] = green * factor;
+    };
+    ratio(c.ratio_red, "BalanceRatioRed", 0);
+    ratio(c.ratio_blue, "BalanceRatioBlue", 2);
+    out.left[c.camera] = (want.array() / taken.array()).cast<float>();
+  }
+  return out;
+}
+
+}  // namespace studio::preview
