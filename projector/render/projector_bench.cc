@@ -104,6 +104,7 @@ enum class Work {
   single_pass,
   single_pass_bilinear,
   single_pass_pipelined,
+  single_pass_pipelined_no_mask,  // the floor: the scene through the screen, no actor mask
   two_pass,
   two_pass_full_warp,
   single_pass_readback,
@@ -216,14 +217,17 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
       masks[0] = projector::grow_mesh(f.actor, 0.02).value();
       fr->draw_masks(masks);
     } else {
-      masks[0] = projector::grow_mesh(f.actor, 0.02).value();  // per frame, as the node
+      if (work == Work::single_pass_pipelined_no_mask)
+        masks.clear();
+      else
+        masks[0] = projector::grow_mesh(f.actor, 0.02).value();  // per frame, as the node
       if (!fr->render(f.scene, kEye, masks)) state.SkipWithError("render failed");
     }
     if (work == Work::single_pass_readback || work == Work::late_latch) {
       glFinish();
       fr->read(rb);
       blackout = rb.blackout.area();
-    } else if (work == Work::single_pass_pipelined) {
+    } else if (work == Work::single_pass_pipelined || work == Work::single_pass_pipelined_no_mask) {
       // One frame in flight: llvmpipe's threads shade frame N while this thread bins frame N+1;
       // wait for frame N-1 (its fence) before queueing more.
       const GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
@@ -270,6 +274,9 @@ void BM_PlainScene(benchmark::State& s) { run(s, Work::plain); }
 void BM_SinglePass(benchmark::State& s) { run(s, Work::single_pass); }
 void BM_SinglePassBilinear(benchmark::State& s) { run(s, Work::single_pass_bilinear); }
 void BM_SinglePassPipelined(benchmark::State& s) { run(s, Work::single_pass_pipelined); }
+void BM_SinglePassPipelinedNoMask(benchmark::State& s) {
+  run(s, Work::single_pass_pipelined_no_mask);
+}
 void BM_TwoPass(benchmark::State& s) { run(s, Work::two_pass); }
 void BM_TwoPassFullWarp(benchmark::State& s) { run(s, Work::two_pass_full_warp); }
 void BM_SinglePassReadback(benchmark::State& s) { run(s, Work::single_pass_readback); }
@@ -284,6 +291,7 @@ void BM_LateLatch_720p(benchmark::State& s) { run(s, Work::late_latch, true); }
 void BM_SinglePassCached_720p(benchmark::State& s) { run(s, Work::single_pass_cached, true); }
 void BM_TwoPass_720p(benchmark::State& s) { run(s, Work::two_pass, true); }
 void BM_TwoPassHalfEye_720p(benchmark::State& s) { run(s, Work::two_pass_half_eye, true); }
+void BM_TwoPassHalfEye(benchmark::State& s) { run(s, Work::two_pass_half_eye); }
 void BM_SinglePassCacheMiss_720p(benchmark::State& s) {
   run(s, Work::single_pass_cache_miss, true);
 }
@@ -443,6 +451,7 @@ BENCHMARK(BM_PlainScene) OPTS;
 BENCHMARK(BM_SinglePass) OPTS;
 BENCHMARK(BM_SinglePassBilinear) OPTS;
 BENCHMARK(BM_SinglePassPipelined) OPTS;
+BENCHMARK(BM_SinglePassPipelinedNoMask) OPTS;
 BENCHMARK(BM_TwoPass) OPTS;
 BENCHMARK(BM_TwoPassFullWarp) OPTS;
 BENCHMARK(BM_SinglePassReadback) OPTS;
@@ -456,6 +465,7 @@ BENCHMARK(BM_SinglePassCached_720p) OPTS;
 BENCHMARK(BM_SinglePassCacheMiss_720p) OPTS;
 BENCHMARK(BM_TwoPass_720p) OPTS;
 BENCHMARK(BM_TwoPassHalfEye_720p) OPTS;
+BENCHMARK(BM_TwoPassHalfEye) OPTS;
 BENCHMARK(BM_SinglePassHold) OPTS->Arg(0)->Arg(1)->Arg(2);
 BENCHMARK(BM_TwoPassHold) OPTS->Arg(0)->Arg(1)->Arg(2);
 BENCHMARK(BM_SinglePassHold_720p) OPTS->Arg(0)->Arg(1)->Arg(2);
