@@ -152,6 +152,10 @@ struct FrameRenderer::Impl {
                              const scene::Scene* moving, const Eigen::Vector3d& eye,
                              std::span<const projector::ActorMesh> masks, bool cache);
   int draw_masks(std::span<const projector::ActorMesh> masks);
+  // The masks as occluders at depth 0 before the scene (FrameRendererOptions::masks_first).
+  int draw_mask_occluders(std::span<const projector::ActorMesh> masks);
+  // Mask i's mesh into the renderer (its actor id "\x01mask<i>"); false if the renderer refused it.
+  bool upload_mask(std::size_t i, const projector::ActorMesh& m);
   // The target's RGBA as GL gives it (bottom row first), into `out` (resized).
   void read_pixels(std::vector<std::uint8_t>& out);
 };
@@ -358,9 +362,17 @@ Expected<FrameInfo> FrameRenderer::Impl::render(const scene::Scene& still, std::
       const Eigen::Vector4f& cc = r.options.renderer.clear_colour;
       glClearColor(cc[0], cc[1], cc[2], cc[3]);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-      // Black around the screen first, at depth 0: the scene is then shaded only on the screen
-      // (inside the rectangle's bounding box, and there where the depth test lets it through).
-      r.renderer.draw_actor_occluder(kFrameId, r.mask_view, Eigen::Vector4f(0, 0, 0, 1));
+      // The masks first when nothing of this frame is kept for later frames (masks_first), then
+      // black around the screen, both at depth 0, each only where nothing lies yet (a mask's
+      // pixels stay transparent black as when laid last): the scene is then shaded only on the
+      // screen (inside the rectangle's bounding box, and there where the depth test lets it
+      // through) and not under the actor.
+      const bool first = r.options.masks_first && !keep && !masks.empty();
+      if (first) {
+        info.masks = draw_mask_occluders(masks);
+        masks = {};
+      }
+      r.renderer.draw_actor_occluder(kFrameId, r.mask_view, Eigen::Vector4f(0, 0, 0, 1), first);
       glEnable(GL_SCISSOR_TEST);
       glScissor(r.screen_box[0], r.screen_box[1], r.screen_box[2], r.screen_box[3]);
       r.renderer.draw(still, v);
@@ -413,9 +425,29 @@ Expected<FrameInfo> FrameRenderer::Impl::render(const scene::Scene& still, std::
       r.renderer.draw_texture(r.eye_target->colour_texture(), tex_from_unit);
     }
   }
-  info.masks = draw_masks(masks);
+  if (!masks.empty()) info.masks = draw_masks(masks);
   info.stored = keep;
   return info;
+}
+
+bool FrameRenderer::Impl::upload_mask(std::size_t i, const projector::ActorMesh& m) {
+  if (mask_ids.size() <= i) mask_ids.push_back("\x01mask" + std::to_string(i));
+  scratch.actor_id = mask_ids[i];
+  scratch.vertices = m.vertices;
+  scratch.triangles = m.triangles;
+  scratch.normals.assign(m.vertices.size(), Eigen::Vector3f::UnitZ());  // unused: unlit
+  return renderer.set_actor_mesh(scratch).has_value();
+}
+
+int FrameRenderer::Impl::draw_mask_occluders(std::span<const projector::ActorMesh> masks) {
+  int drawn = 0;
+  for (std::size_t i = 0; i < masks.size(); ++i) {
+    if (!masks[i].validate() || !upload_mask(i, masks[i])) continue;
+    // Transparent black, as draw_masks() lays it: the read-back's blackout is alpha 0.
+    renderer.draw_actor_occluder(mask_ids[i], mask_view, Eigen::Vector4f::Zero(), true);
+    ++drawn;
+  }
+  return drawn;
 }
 
 int FrameRenderer::Impl::draw_masks(std::span<const projector::ActorMesh> masks) {
@@ -440,12 +472,7 @@ int FrameRenderer::Impl::draw_masks(std::span<const projector::ActorMesh> masks)
       ++drawn;
       continue;
     }
-    if (r.mask_ids.size() <= i) r.mask_ids.push_back("\x01mask" + std::to_string(i));
-    r.scratch.actor_id = r.mask_ids[i];
-    r.scratch.vertices = m.vertices;
-    r.scratch.triangles = m.triangles;
-    r.scratch.normals.assign(m.vertices.size(), Eigen::Vector3f::UnitZ());  // unused: unlit
-    if (!r.renderer.set_actor_mesh(r.scratch)) continue;
+    if (!r.upload_mask(i, m)) continue;
     r.renderer.draw_actor_flat(r.mask_ids[i], r.mask_view, 0.0f, Eigen::Vector4f::Zero(),
                                rects.has_value());
     ++drawn;

@@ -466,8 +466,9 @@ Expected<FrameRenderer> back_wall_renderer(const BackWall& b, Form form) {
 }  // namespace
 
 // Late latching (FrameRenderer::prepare + draw_masks): the scene drawn ahead and the masks put
-// over it later give the frame render() gives, in both forms, value for value, with the scene
-// cache's layered path too. Control: the mask is in the frame.
+// over it later give the frame render() gives (the single pass's masks laid first, before the
+// scene: masks_first), in both forms, value for value, with the scene cache's layered path too.
+// Control: the mask is in the frame.
 TEST(FrameRenderer, SceneDrawnAheadThenMasksIsTheRenderedFrame) {
   (void)context();
   const BackWall b;
@@ -556,7 +557,8 @@ TEST(FrameRenderer, SceneFromAnotherScreenThenMasksIsTheRenderedFrame) {
 // The outline mask (projector::grow_outline) as the frame gets it: its pixel rectangles cleared
 // (ActorMesh::image_rects, glClearTexSubImage) give, value for value, the frame its quads give
 // rasterised with the renderer's once-per-pixel depth pass (the way before), and its quads
-// drawn without that pass (rectangles made for another image size) too; bands of rows and
+// drawn without that pass (rectangles made for another image size) too, and the frame drawn
+// whole by render() (the single pass lays the quads first as occluders); bands of rows and
 // every row alone (band_px 0) the same. Both forms, three margins, a box and a sphere (curved
 // outlines: bands with a rest at either end). Control: the mask blacks out pixels that the
 // scene lit.
@@ -591,16 +593,25 @@ TEST(FrameRenderer, OutlineRectanglesClearedAreTheQuadsRasterised) {
           fr->finish();
           fr->read(*into, true);
         }
+        // The frame drawn whole: the single pass lays the quads first, at depth 0 (masks_first).
+        Readback whole;
+        ASSERT_TRUE(fr->render(*scene, eye, cleared));
+        fr->finish();
+        fr->read(whole, true);
         const int differ = values_differing(*fr, want, got);
         const int differ_flat = values_differing(*fr, want, drawn);
+        const int differ_whole = values_differing(*fr, want, whole);
         const int masked = values_differing(*fr, want, bare);
-        std::printf("%s, margin %.2f m, band %d px: %zu rectangles, %d / %d values differ, "
-                    "blackout %lld px, %d values masked\n",
-                    form == Form::single_pass ? "single pass" : "two pass", margin, band,
-                    outline->image_rects->rects.size(), differ, differ_flat,
-                    static_cast<long long>(got.blackout.area()), masked);
+        std::printf(
+            "%s, margin %.2f m, band %d px: %zu rectangles, %d / %d / %d values differ, "
+            "blackout %lld px, %d values masked\n",
+            form == Form::single_pass ? "single pass" : "two pass", margin, band,
+            outline->image_rects->rects.size(), differ, differ_flat, differ_whole,
+            static_cast<long long>(got.blackout.area()), masked);
         EXPECT_EQ(differ, 0);
         EXPECT_EQ(differ_flat, 0);
+        EXPECT_EQ(differ_whole, 0);
+        EXPECT_EQ(whole.blackout, want.blackout);
         EXPECT_EQ(got.blackout, want.blackout);
         EXPECT_GT(got.blackout.area(), 10000);
         EXPECT_GT(masked, 10000);

@@ -105,6 +105,8 @@ enum class Work {
   single_pass_bilinear,
   single_pass_pipelined,
   single_pass_pipelined_no_mask,  // the floor: the scene through the screen, no actor mask
+  single_pass_pipelined_outline,  // the node's default mask: grown by its outline, rects cleared
+  single_pass_pipelined_outline_last,  // the same, masks_first off (the baseline)
   two_pass,
   two_pass_full_warp,
   single_pass_readback,
@@ -163,6 +165,7 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
   fo.form = two_pass ? Form::two_pass : Form::single_pass;
   fo.warp_screen_only = work != Work::two_pass_full_warp;
   if (work == Work::two_pass_half_eye) fo.eye_texture_size = view->suggested_texture_size() / 2;
+  fo.masks_first = work != Work::single_pass_pipelined_outline_last;
   if (work == Work::single_pass_bilinear)
     fo.renderer.texture_filter = scene_render::RendererOptions::TextureFilter::bilinear;
   auto fr = FrameRenderer::create(*view, fo);
@@ -219,6 +222,9 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
     } else {
       if (work == Work::single_pass_pipelined_no_mask)
         masks.clear();
+      else if (work == Work::single_pass_pipelined_outline ||
+               work == Work::single_pass_pipelined_outline_last)
+        masks[0] = projector::grow_outline(f.actor, 0.02, projector.camera).value();
       else
         masks[0] = projector::grow_mesh(f.actor, 0.02).value();  // per frame, as the node
       if (!fr->render(f.scene, kEye, masks)) state.SkipWithError("render failed");
@@ -227,7 +233,9 @@ void run(benchmark::State& state, Work work, bool hd720 = false) {
       glFinish();
       fr->read(rb);
       blackout = rb.blackout.area();
-    } else if (work == Work::single_pass_pipelined || work == Work::single_pass_pipelined_no_mask) {
+    } else if (work == Work::single_pass_pipelined || work == Work::single_pass_pipelined_no_mask ||
+               work == Work::single_pass_pipelined_outline ||
+               work == Work::single_pass_pipelined_outline_last) {
       // One frame in flight: llvmpipe's threads shade frame N while this thread bins frame N+1;
       // wait for frame N-1 (its fence) before queueing more.
       const GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
@@ -276,6 +284,12 @@ void BM_SinglePassBilinear(benchmark::State& s) { run(s, Work::single_pass_bilin
 void BM_SinglePassPipelined(benchmark::State& s) { run(s, Work::single_pass_pipelined); }
 void BM_SinglePassPipelinedNoMask(benchmark::State& s) {
   run(s, Work::single_pass_pipelined_no_mask);
+}
+void BM_SinglePassPipelinedOutline(benchmark::State& s) {
+  run(s, Work::single_pass_pipelined_outline);
+}
+void BM_SinglePassPipelinedOutlineLast(benchmark::State& s) {
+  run(s, Work::single_pass_pipelined_outline_last);
 }
 void BM_TwoPass(benchmark::State& s) { run(s, Work::two_pass); }
 void BM_TwoPassFullWarp(benchmark::State& s) { run(s, Work::two_pass_full_warp); }
@@ -452,6 +466,8 @@ BENCHMARK(BM_SinglePass) OPTS;
 BENCHMARK(BM_SinglePassBilinear) OPTS;
 BENCHMARK(BM_SinglePassPipelined) OPTS;
 BENCHMARK(BM_SinglePassPipelinedNoMask) OPTS;
+BENCHMARK(BM_SinglePassPipelinedOutline) OPTS;
+BENCHMARK(BM_SinglePassPipelinedOutlineLast) OPTS;
 BENCHMARK(BM_TwoPass) OPTS;
 BENCHMARK(BM_TwoPassFullWarp) OPTS;
 BENCHMARK(BM_SinglePassReadback) OPTS;

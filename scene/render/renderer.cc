@@ -642,12 +642,13 @@ void Renderer::draw_actor_flat(const std::string& actor_id, const View& view, fl
 }
 
 void Renderer::draw_actor_occluder(const std::string& actor_id, const View& view,
-                                   const Eigen::Vector4f& colour) {
+                                   const Eigen::Vector4f& colour, bool first_layer) {
   Impl& r = *impl_;
   auto it = r.actors.find(actor_id);
   if (it == r.actors.end() || it->second.index_count == 0) return;
   glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_ALWAYS);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(first_layer ? GL_LESS : GL_ALWAYS);
   glDepthRange(0.0, 0.0);  // every fragment at the near plane: nothing drawn later passes GL_LESS
   r.draw_flat(it->second, view, 0.0f, colour);
   glDepthRange(0.0, 1.0);

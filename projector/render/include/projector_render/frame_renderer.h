@@ -58,6 +58,13 @@ struct FrameRendererOptions {
   // projector, 2 px out), the rest cleared black; false: over the whole frame (the baseline,
   // black outside the screen by the warp's own test). The same frame either way.
   bool warp_screen_only = true;
+  // Single pass, a frame drawn whole (render() with masks, its static scene not kept for the
+  // cache): the actor masks are laid first, at depth 0 like the black around the screen, so the
+  // scene is not shaded under them and the frame needs no pass after the scene (an outline
+  // mask's rectangle clears make llvmpipe finish the scene first, which stops the next frame's
+  // binning from overlapping it). The same frame either way (frame_renderer_test). false: the
+  // masks over the finished scene, as draw_masks() lays them after prepare().
+  bool masks_first = true;
   // The static scene layer cached between frames (render(const LayeredScene&, ...);
   // render/static_layer.h); enabled = false: every frame draws the whole scene.
   projector::SceneCacheOptions scene_cache;

@@ -121,8 +121,12 @@ class Renderer {
                        bool disjoint = false);
   // The same mesh as an occluder: flat `colour`, written at depth 0 (the near plane) whatever
   // its distance, so a later draw(view with clear = false) shades nothing behind it.
+  // first_layer: only where nothing is at the near plane yet (GL_LESS): a mesh folding over
+  // itself is shaded once per pixel, and an earlier occluder's pixels are kept; false: every
+  // fragment written (GL_ALWAYS).
   void draw_actor_occluder(const std::string& actor_id, const View& view,
-                           const Eigen::Vector4f& colour = Eigen::Vector4f(0, 0, 0, 1));
+                           const Eigen::Vector4f& colour = Eigen::Vector4f(0, 0, 0, 1),
+                           bool first_layer = false);
   // Draws a texture (e.g. a RenderTarget's colour texture) over the whole bound framebuffer;
   // the output pixel at normalised coordinates p in [0,1]^2 (x right, y up) samples the texture
   // at dehomogenised tex_from_screen * (p, 1) (identity: a plain copy; the projector passes its
