@@ -27,6 +27,9 @@ inline constexpr int kMatchMinFrames = 8;  // as RigBalance's: an estimate worth
 // --match-cameras waits for this many pooled frames: the estimate after 8 frames strays by a few
 // percent more than after a second of meshes (preview_quality_test, rig_balance.h).
 inline constexpr int kMatchAutoFrames = 24;
+// --match-cameras matches again while the balance, pooled afresh, still applies, up to this many
+// rounds (a camera the first estimate had not linked, the first estimate's own error).
+inline constexpr int kMatchRounds = 3;
 
 struct SentMatch {
   CameraMatch plan;

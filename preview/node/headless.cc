@@ -131,8 +131,8 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
       std::chrono::duration<double>(std::max(options.every_s, 0.0)));
   auto last_drawn = start - interval;
   int drawn = 0;
-  std::string match_json = "null";  // --match-cameras: what was sent, or why not
-  bool match_tried = false;
+  std::string match_json;  // --match-cameras: each round's changes sent, or why not
+  int match_rounds = 0;    // kMatchRounds at most; set to it to stop trying
   while (Clock::now() < deadline) {
     if (signals.wait(std::chrono::milliseconds(0))) break;
     status->tick();
@@ -154,18 +154,23 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
     }
     if (!r.new_mesh) continue;
     ++drawn;
-    if (options.match_cameras && !match_tried) {
+    if (options.match_cameras && match_rounds < kMatchRounds) {
+      // Again whenever the balance, pooled afresh after the last round, still applies: the
+      // cameras it had not linked yet, and what the last round's estimate got wrong.
       const BalanceSnapshot b = (*pipeline)->colour_balance();
       if (b.balance.applied && b.balance.frames >= kMatchAutoFrames) {
-        match_tried = true;
         auto m = match_cameras(node, **pipeline);
+        match_json += match_json.empty() ? "" : ",";
         if (m) {
-          match_json = camera_match_json(*m);
+          match_json += camera_match_json(*m);
           std::fprintf(stderr, "studio-preview: match cameras: %s\n",
                        camera_match_text(*m).c_str());
+          // Nothing sent (every change within min_change, or clamped): the balance goes on.
+          match_rounds = m->plan.changes.empty() ? kMatchRounds : match_rounds + 1;
         } else {
-          match_json = "{\"error\":\"" + m.error().message + "\"}";
+          match_json += "{\"error\":\"" + m.error().message + "\"}";
           std::fprintf(stderr, "studio-preview: %s\n", m.error().message.c_str());
+          match_rounds = kMatchRounds;
         }
       }
     }
@@ -213,7 +218,8 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
         (unsigned long long)c.textured, (unsigned long long)c.untextured,
         (unsigned long long)c.late, (unsigned long long)c.refused, (unsigned long long)c.skipped,
         seconds, context->renderer().c_str(), o.heads, node.cameras().size(), o.projectors,
-        o.thumbnails, balance_json(**pipeline).c_str(), match_json.c_str());
+        o.thumbnails, balance_json(**pipeline).c_str(),
+        match_json.empty() && !options.match_cameras ? "null" : ("[" + match_json + "]").c_str());
   else
     std::printf(
         "%s: %dx%d, %d meshes drawn (%llu textured, %llu untextured: %llu late, %llu refused; "

@@ -63,18 +63,20 @@ Options:
                     screenshot rewritten with each (renamed into place, never half written);
                     only the drawn meshes' images are requested; runs for --duration, else
                     until SIGINT/SIGTERM; exit 1 if no mesh was drawn
-  --match-cameras   headless: once the colour balance applies (some camera beyond 3 % of the
-                    rig, 24 frames pooled), send it to the cameras once: CameraControl Gain
-                    (dB, the green factor; one level for the rig, no camera pushed below its
-                    lowest gain; cameras the balance has not linked take that level only) and BalanceRatioRed / BalanceRatioBlue (white balance against
-                    green) where the camera has them; the balance then starts afresh and learns
-                    what the controls did not take. The GUI's View panel: "Match cameras"
+  --match-cameras   headless: whenever the colour balance applies (some camera beyond 3 % of
+                    the rig, 24 frames pooled since the last match; 3 rounds at most), send it
+                    to the cameras: CameraControl Gain (dB, the green factor; one level for the
+                    rig, no camera pushed below its lowest gain; cameras the balance has not
+                    linked take that level only) and BalanceRatioRed / BalanceRatioBlue (white
+                    balance against green) where the camera has them; the balance then starts
+                    afresh and learns what the controls did not take. In the window: the View
+                    panel's "Match cameras"
   --json            headless: the summary as one JSON line ("overlays": the heads, cameras,
                     calibrated projectors and thumbnails received; "colour_balance": applied,
                     frames pooled, busy (meshes skipped while pooling the previous), camera
-                    pairs and per camera id its gains; "camera_match": null, the changes sent
-                    {"level_db", "changes": [{"camera", "feature", "from", "to"}], "left"}, or
-                    {"error"})
+                    pairs and per camera id its gains; "camera_match": null without
+                    --match-cameras, else per round the changes sent {"level_db", "matched",
+                    "changes": [{"camera", "feature", "from", "to"}], "left"} or {"error"})
   --test-script F   GUI: scripted input for tests (gui.h: one action per line)
 
 Headless, SIGINT/SIGTERM end the run like its deadline (the screenshot is written).
