@@ -115,6 +115,13 @@ TEST(CameraMatch, RefusesBadInputInOneLine) {
   bad.ratio_red->max = INFINITY;
   EXPECT_FALSE(plan_camera_match({{"cam0", {1, 1, 1}}}, {bad}));
   EXPECT_FALSE(plan_camera_match({{"cam0", {1, 1, 1}}}, rig, -0.1));
+  // A ratio read back as 0 (the channel off) is left alone, reported as left over.
+  CameraControls off = camera("cam0");
+  off.ratio_red->value = 0;
+  auto m = plan_camera_match({{"cam0", {1.2f, 1, 1}}}, {off});
+  ASSERT_TRUE(m);
+  EXPECT_TRUE(m->changes.empty());
+  EXPECT_NEAR(m->left.at("cam0").x(), 1.2f, 1e-5);
   EXPECT_TRUE(plan_camera_match({{"cam0", {1, 1, 1}}}, rig));  // the positive control
 }
 

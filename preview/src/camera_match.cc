@@ -16,7 +16,7 @@ bool valid(const std::optional<ControlValue>& c) {
 // it applies.
 double ratio_to(const ControlValue& c, double factor, double* taken) {
   const double to = std::clamp(c.value * factor, c.min, c.max);
-  *taken = c.value > 0 ? to / c.value : 1.0;
+  *taken = to / c.value;  // c.value > 0 (the caller's)
   return to;
 }
 
@@ -72,7 +72,7 @@ Expected<CameraMatch> plan_camera_match(const std::map<std::string, Eigen::Vecto
     }
     const double green = taken.y();
     auto ratio = [&](const std::optional<ControlValue>& r, const char* name, int channel) {
-      if (!r) return;
+      if (!r || !(r->value > 0)) return;  // a channel switched off is not a balance to scale
       double factor = 1;
       const double to = ratio_to(*r, want[channel] / want.y(), &factor);
       if (std::abs(factor - 1) <= min_change) return;
