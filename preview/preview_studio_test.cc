@@ -17,6 +17,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <regex>
+#include <set>
 #include <thread>
 
 #include "preview/viewpoint.h"
@@ -763,6 +764,46 @@ TEST_F(PreviewStudioTest, MatchCamerasMovesTheBalanceIntoTheCameras) {
   EXPECT_LT(after, 0.35 * before);  // the live estimate's error is what remains (up to ~5 %)
   EXPECT_GE(b.frames, 8);
   EXPECT_LT(b.frames, drawn - 8);  // started afresh after the match
+}
+
+// The control: on a rig whose cameras agree the balance never applies, so --match-cameras sends
+// nothing and the cameras keep their controls.
+TEST_F(PreviewStudioTest, MatchCamerasLeavesAgreeingCamerasAlone) {
+  start_studio(false, false, 9);
+  const auto [held, view] = held_out(kWidth, kHeight);
+  Process& p = spawn(
+      "preview", "preview/studio-preview",
+      {"--headless", "--config", preview_config("director", 1000, "colour_balance_every: 1\n"),
+       "--viewpoint", to_string(view), "--overlays", "none", "--size",
+       std::to_string(kWidth) + "x" + std::to_string(kHeight), "--duration", "8", "--screenshot",
+       (dir_ / "last.png").string(), "--json", "--match-cameras"});
+  const auto code = p.wait_exit(60s);
+  ASSERT_TRUE(code.has_value());
+  ASSERT_EQ(*code, 0) << p.log();
+  const BalanceSummary b = balance_summary(p.log());
+  ASSERT_TRUE(b.found) << p.log();
+  EXPECT_GE(b.frames, 24) << "pooled enough to have matched";
+  EXPECT_FALSE(b.applied);
+  EXPECT_NE(p.log().find("\"camera_match\":[]"), std::string::npos) << p.log();
+  auto participant = wire::Participant::create().value();
+  auto topic = wire::Topic<studio_CameraState>::create(participant).value();
+  auto states = wire::Reader<studio_CameraState>::create(participant, topic).value();
+  std::set<std::string> cameras;  // read back
+  for (auto deadline = std::chrono::steady_clock::now() + 10s;
+       cameras.size() < 9 && std::chrono::steady_clock::now() < deadline;) {
+    for (auto& st : states.take())
+      if (st.meta.valid_data) {
+        cameras.insert(std::string(wire::str(st.data->camera_id)));
+        for (const auto& f : wire::view(st.data->features)) {
+          const std::string name(wire::str(f.name));
+          if (name == "Gain") EXPECT_EQ(f.value, 0) << wire::str(st.data->camera_id);
+          if (name == "BalanceRatioRed" || name == "BalanceRatioBlue")
+            EXPECT_EQ(f.value, 1) << wire::str(st.data->camera_id) << " " << name;
+        }
+      }
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(cameras.size(), 9u);
 }
 
 }  // namespace

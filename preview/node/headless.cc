@@ -168,7 +168,11 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
           // Nothing sent (every change within min_change, or clamped): the balance goes on.
           match_rounds = m->plan.changes.empty() ? kMatchRounds : match_rounds + 1;
         } else {
-          match_json += "{\"error\":\"" + m.error().message + "\"}";
+          std::string text;  // the message as a JSON string's characters
+          for (char ch : m.error().message)
+            if (static_cast<unsigned char>(ch) >= 0x20)
+              text += ch == '"' || ch == '\\' ? std::string("\\") + ch : std::string(1, ch);
+          match_json += "{\"error\":\"" + text + "\"}";
           std::fprintf(stderr, "studio-preview: %s\n", m.error().message.c_str());
           match_rounds = kMatchRounds;
         }
