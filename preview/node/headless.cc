@@ -158,7 +158,8 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
       // Again whenever the balance, pooled afresh after the last round, still applies: the
       // cameras it had not linked yet, and what the last round's estimate got wrong.
       const BalanceSnapshot b = (*pipeline)->colour_balance();
-      if (b.balance.applied && b.balance.frames >= kMatchAutoFrames) {
+      if (b.balance.applied && b.balance.frames >= kMatchAutoFrames &&
+          largest_gain_offset(b.balance.estimated) > kMatchAutoOffset) {
         auto m = match_cameras(node, **pipeline);
         match_json += match_json.empty() ? "" : ",";
         if (m) {

@@ -19,9 +19,9 @@ struct HeadlessOptions {
   double every_s = 0;
   std::string record;  // folder: every drawn mesh's frame as <n>.png + frames.jsonl
   bool json = false;   // summary as one JSON line
-  // Whenever the colour balance is applied (some camera beyond its tolerance, kMatchAutoFrames
-  // pooled since the last match), send it to the cameras' controls, up to kMatchRounds times
-  // (node/camera_matching.h).
+  // Whenever the colour balance is applied with some camera beyond kMatchAutoOffset
+  // (kMatchAutoFrames pooled since the last match), send it to the cameras' controls, up to
+  // kMatchRounds times (node/camera_matching.h).
   bool match_cameras = false;
 };
 

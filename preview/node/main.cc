@@ -63,9 +63,9 @@ Options:
                     screenshot rewritten with each (renamed into place, never half written);
                     only the drawn meshes' images are requested; runs for --duration, else
                     until SIGINT/SIGTERM; exit 1 if no mesh was drawn
-  --match-cameras   headless: whenever the colour balance applies (some camera beyond 3 % of
-                    the rig, 24 frames pooled since the last match; 3 rounds at most), send it
-                    to the cameras: CameraControl Gain (dB, the green factor; one level for the
+  --match-cameras   headless: whenever the colour balance finds some camera more than 8 % off
+                    the rig (24 frames pooled since the last match; 3 rounds at most; less is
+                    within the live estimate's own error), send it to the cameras: CameraControl Gain (dB, the green factor; one level for the
                     rig, no camera pushed below its lowest gain; cameras the balance has not
                     linked take that level only) and BalanceRatioRed / BalanceRatioBlue (white
                     balance against green) where the camera has them; the balance then starts
