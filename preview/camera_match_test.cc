@@ -52,6 +52,29 @@ TEST(CameraMatch, BringsEveryCameraToTheRigWithoutDarkeningACameraAtItsLowestGai
   EXPECT_EQ(m->changes.size(), 4u);  // cam0 Gain; cam2 Gain, red, blue
 }
 
+TEST(CameraMatch, ACameraWithGammaTakesTheFactorToItsExponent) {
+  // cam1 applies Gamma 0.45 after its Gain and white balance (delivered = sensor^0.45): a
+  // factor f on its delivered values is f^(1 / 0.45) on the sensor's.
+  CameraControls gamma = camera("cam1");
+  gamma.exponent = 1 / 0.45;
+  const std::map<std::string, Eigen::Vector3f> estimate = {{"cam0", {1, 1, 1}},
+                                                           {"cam1", {1.1f, 1.05f, 0.95f}}};
+  auto m = plan_camera_match(estimate, {camera("cam0"), gamma});
+  ASSERT_TRUE(m) << m.error().message;
+  EXPECT_NEAR(m->level_db, 0, 1e-9);  // both can go where they must at level 0
+  // On the delivered values: the control factors to the power 0.45 give the estimate.
+  const Eigen::Vector3d delivered = applied(*m, gamma).array().pow(0.45);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(delivered[ch], estimate.at("cam1")[ch], 1e-5);
+  EXPECT_TRUE(m->left.at("cam1").isApprox(Eigen::Vector3f::Ones(), 1e-5f));
+  for (const ControlChange& x : m->changes) {
+    if (x.feature == "Gain") {
+      EXPECT_NEAR(x.to, 20 / 0.45 * std::log10(1.05), 1e-6);
+    }
+  }
+  gamma.exponent = 0;
+  EXPECT_FALSE(plan_camera_match(estimate, {gamma}));
+}
+
 TEST(CameraMatch, ReportsWhatTheControlsCannotTake) {
   // cam0 at its highest gain must brighten by 2 dB; cam1 has no controls but Gain; cam2 none.
   CameraControls top = camera("cam0", 24);

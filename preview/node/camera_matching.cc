@@ -45,6 +45,8 @@ Expected<SentMatch> match_cameras(PreviewNode& node, ViewPipeline& pipeline, dou
       if (f.name == "Gain") c.gain_db = v;
       if (f.name == "BalanceRatioRed") c.ratio_red = v;
       if (f.name == "BalanceRatioBlue") c.ratio_blue = v;
+      // GenICam Gamma (delivered = sensor^Gamma) acts after Gain and white balance.
+      if (f.name == "Gamma" && f.value > 0 && std::isfinite(f.value)) c.exponent = 1 / f.value;
     }
     if (c.gain_db || c.ratio_red || c.ratio_blue) controls.push_back(std::move(c));
   }

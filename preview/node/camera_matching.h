@@ -6,7 +6,8 @@
 //
 // The cameras matched are those of the balance's largest linked set (cameras linked by shared
 // surface points; gains across sets are not comparable) whose controls the capture servers
-// publish on studio/camera/state; every other camera publishing a Gain takes the rig's new level
+// publish on studio/camera/state (with GenICam Gamma when published: the controls act before
+// it, CameraControls::exponent); every other camera publishing a Gain takes the rig's new level
 // only (plan_camera_match's k), so that it stays where it was against the rig. After sending, the
 // balance starts afresh and pools only meshes captured kSettle after the changes (frames on the way
 // still have the old colours), so what it learns next is what the controls did not take (clamped,

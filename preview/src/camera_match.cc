@@ -29,28 +29,35 @@ Expected<CameraMatch> plan_camera_match(const std::map<std::string, Eigen::Vecto
   for (const auto& [id, e] : estimated)
     if (!e.allFinite() || (e.array() <= 0).any())
       return fail("camera match: camera " + id + ": estimate is not finite and positive");
-  for (const CameraControls& c : controls)
+  for (const CameraControls& c : controls) {
     if (!valid(c.gain_db) || !valid(c.ratio_red) || !valid(c.ratio_blue))
       return fail("camera match: camera " + c.camera +
                   ": a control's range is empty or not finite");
+    if (!(c.exponent > 0) || !std::isfinite(c.exponent))
+      return fail("camera match: camera " + c.camera + ": exponent must be finite and > 0");
+  }
 
-  // The cameras taking part, and the gain change each wants before the common level k.
+  // The cameras taking part, and the gain change each wants before the common level k, both in
+  // the controls' terms (the estimate raised to the camera's exponent; k is a level of the
+  // delivered values, each camera takes it to its own exponent).
   struct Wanted {
     const CameraControls* c;
-    Eigen::Vector3d e;
-    double db;
+    Eigen::Vector3d e;  // the estimate, on the delivered values
+    double db;          // the Gain change it asks for, dB
   };
   std::vector<Wanted> wanted;
   for (const CameraControls& c : controls)
     if (auto e = estimated.find(c.camera); e != estimated.end())
-      wanted.push_back({&c, e->second.cast<double>(), 20 * std::log10(double(e->second.y()))});
+      wanted.push_back(
+          {&c, e->second.cast<double>(), 20 * c.exponent * std::log10(double(e->second.y()))});
 
-  // k: nearest 0 within every Gain's bounds (lo .. hi); the midpoint when they conflict.
+  // k (dB on the delivered values): nearest 0 within every Gain's bounds (lo .. hi); the
+  // midpoint when they conflict. Camera c's Gain moves by db_c + exponent_c k.
   double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Wanted& w : wanted)
     if (const auto& g = w.c->gain_db) {
-      lo = std::max(lo, g->min - g->value - w.db);
-      hi = std::min(hi, g->max - g->value - w.db);
+      lo = std::max(lo, (g->min - g->value - w.db) / w.c->exponent);
+      hi = std::min(hi, (g->max - g->value - w.db) / w.c->exponent);
     }
   CameraMatch out;
   out.level_db = !std::isfinite(lo) && !std::isfinite(hi) ? 0
@@ -59,22 +66,25 @@ Expected<CameraMatch> plan_camera_match(const std::map<std::string, Eigen::Vecto
   const double gain_step_db = 20 * std::log10(1 + min_change);
   for (const Wanted& w : wanted) {
     const CameraControls& c = *w.c;
-    // Wanted factors per channel, the rig's level included; what the controls take of them.
+    // Wanted factors per channel on the delivered values, the rig's level included; what the
+    // controls take of them (on the delivered values too: a control factor to 1 / exponent).
+    const double x = c.exponent;
     const Eigen::Vector3d want = w.e * std::pow(10.0, out.level_db / 20);
     Eigen::Vector3d taken = Eigen::Vector3d::Ones();
     if (c.gain_db) {
       const double to =
-          std::clamp(c.gain_db->value + w.db + out.level_db, c.gain_db->min, c.gain_db->max);
-      if (std::abs(to - c.gain_db->value) > gain_step_db) {
+          std::clamp(c.gain_db->value + w.db + x * out.level_db, c.gain_db->min, c.gain_db->max);
+      if (std::abs(to - c.gain_db->value) > x * gain_step_db) {
         out.changes.push_back({c.camera, "Gain", c.gain_db->value, to});
-        taken.setConstant(std::pow(10.0, (to - c.gain_db->value) / 20));
+        taken.setConstant(std::pow(10.0, (to - c.gain_db->value) / (20 * x)));
       }
     }
     const double green = taken.y();
     auto ratio = [&](const std::optional<ControlValue>& r, const char* name, int channel) {
       if (!r || !(r->value > 0)) return;  // a channel switched off is not a balance to scale
-      double factor = 1;
-      const double to = ratio_to(*r, want[channel] / want.y(), &factor);
+      double factor = 1;                  // the control's
+      const double to = ratio_to(*r, std::pow(want[channel] / want.y(), x), &factor);
+      factor = std::pow(factor, 1 / x);  // on the delivered values
       if (std::abs(factor - 1) <= min_change) return;
       out.changes.push_back({c.camera, name, r->value, to});
       taken[channel] = green * factor;

@@ -16,7 +16,9 @@
 // range (a camera already at its lowest gain cannot be darkened: the others are brightened to
 // it); when no k keeps them all, the midpoint of the violated bounds, and each Gain is clamped.
 // What a camera's controls cannot take (a clamp, a control the camera does not have) is reported
-// as the factor left per channel: the preview's balance goes on correcting that part.
+// as the factor left per channel: the preview's balance goes on correcting that part. A camera
+// whose controls act before a transfer curve (GenICam Gamma) takes each factor to the power
+// CameraControls::exponent; the figures above are then on its delivered values.
 //
 // Pure library: the node reads the features back from studio/camera/state and sends the changes
 // as CameraControl (preview/node/camera_matching.h).
@@ -39,6 +41,11 @@ struct ControlValue {
 struct CameraControls {
   std::string camera;
   std::optional<ControlValue> gain_db, ratio_red, ratio_blue;
+  // The estimate is a factor f on the colours as delivered (8-bit, display-encoded); the
+  // controls scale what the camera has before its own transfer curve. The control's factor is
+  // f^exponent: 1 when the controls act on the delivered values (the simulated camera), 1 /
+  // Gamma for a camera applying GenICam's Gamma (delivered = sensor^Gamma) after them.
+  double exponent = 1;
 };
 
 struct ControlChange {
@@ -56,7 +63,8 @@ struct CameraMatch {
 // `estimated`: the balance's estimate per camera id (cameras not in it are left alone);
 // `controls`: the cameras' controls as read back. Changes smaller than `min_change` (a relative
 // factor: 0.005 = 0.5 %) are not made. Fails (one line) on an estimate that is not finite and
-// positive, a control whose range is empty or not finite, or a negative min_change.
+// positive, a control whose range is empty or not finite, a non-positive exponent, or a negative
+// min_change.
 Expected<CameraMatch> plan_camera_match(const std::map<std::string, Eigen::Vector3f>& estimated,
                                         const std::vector<CameraControls>& controls,
                                         double min_change = 0.005);
