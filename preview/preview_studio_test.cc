@@ -552,12 +552,7 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
 TEST_F(PreviewStudioTest, TheColourBalanceFollowsACameraWhoseGainIsChanged) {
   start_studio(false, false, 9);
   const auto [held, view] = held_out(kWidth, kHeight);
-  Process& p = spawn(
-      "preview", "preview/studio-preview",
-      {"--headless", "--config", preview_config("director", 1000, "colour_balance_every: 1\n"),
-       "--viewpoint", to_string(view), "--overlays", "none", "--size",
-       std::to_string(kWidth) + "x" + std::to_string(kHeight), "--duration", "16", "--record",
-       (dir_ / "rec").string(), "--screenshot", (dir_ / "last.png").string(), "--json"});
+  Process& p = balancing_preview(view, 16);
   auto participant = wire::Participant::create().value();
   auto topic = wire::Topic<studio_CameraControl>::create(participant).value();
   auto control = wire::Writer<studio_CameraControl>::create(participant, topic).value();
@@ -666,13 +661,7 @@ TEST_F(PreviewStudioTest, MatchCamerasMovesTheBalanceIntoTheCameras) {
   auto participant = wire::Participant::create().value();
   auto state_topic = wire::Topic<studio_CameraState>::create(participant).value();
   auto states = wire::Reader<studio_CameraState>::create(participant, state_topic).value();
-  Process& p = spawn(
-      "preview", "preview/studio-preview",
-      {"--headless", "--config", preview_config("director", 1000, "colour_balance_every: 1\n"),
-       "--viewpoint", to_string(view), "--overlays", "none", "--size",
-       std::to_string(kWidth) + "x" + std::to_string(kHeight), "--duration", "14", "--record",
-       (dir_ / "rec").string(), "--screenshot", (dir_ / "last.png").string(), "--json",
-       "--match-cameras"});
+  Process& p = balancing_preview(view, 14, {"--match-cameras"});
   const auto code = p.wait_exit(60s);
   ASSERT_TRUE(code.has_value());
   ASSERT_EQ(*code, 0) << p.log();
@@ -771,12 +760,7 @@ TEST_F(PreviewStudioTest, MatchCamerasMovesTheBalanceIntoTheCameras) {
 TEST_F(PreviewStudioTest, MatchCamerasLeavesAgreeingCamerasAlone) {
   start_studio(false, false, 9);
   const auto [held, view] = held_out(kWidth, kHeight);
-  Process& p = spawn(
-      "preview", "preview/studio-preview",
-      {"--headless", "--config", preview_config("director", 1000, "colour_balance_every: 1\n"),
-       "--viewpoint", to_string(view), "--overlays", "none", "--size",
-       std::to_string(kWidth) + "x" + std::to_string(kHeight), "--duration", "8", "--screenshot",
-       (dir_ / "last.png").string(), "--json", "--match-cameras"});
+  Process& p = balancing_preview(view, 8, {"--match-cameras"});
   const auto code = p.wait_exit(60s);
   ASSERT_TRUE(code.has_value());
   ASSERT_EQ(*code, 0) << p.log();

@@ -157,6 +157,31 @@ class PreviewStudioTest : public ::testing::Test {
     return spawn(name, "preview/studio-preview", std::move(a));
   }
 
+  // A headless preview from `view` pooling every textured mesh into its colour balance
+  // (colour_balance_every: 1) for `seconds`: the actor alone at the studio's image size, every
+  // drawn mesh recorded to <dir>/rec, the summary as JSON on its log; `more`: more options.
+  Process& balancing_preview(const Viewpoint& view, int seconds,
+                             const std::vector<std::string>& more = {}) {
+    std::vector<std::string> a{"--headless",
+                               "--config",
+                               preview_config("director", 1000, "colour_balance_every: 1\n"),
+                               "--viewpoint",
+                               to_string(view),
+                               "--overlays",
+                               "none",
+                               "--size",
+                               std::to_string(kWidth) + "x" + std::to_string(kHeight),
+                               "--duration",
+                               std::to_string(seconds),
+                               "--record",
+                               (dir_ / "rec").string(),
+                               "--screenshot",
+                               (dir_ / "last.png").string(),
+                               "--json"};
+    a.insert(a.end(), more.begin(), more.end());
+    return spawn("preview", "preview/studio-preview", std::move(a));
+  }
+
   studio::testing::Watchdog watchdog_{std::chrono::seconds(280)};
   std::filesystem::path dir_;
   studio::testing::DdsDomain dds_;
