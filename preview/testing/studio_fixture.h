@@ -128,6 +128,14 @@ class PreviewStudioTest : public ::testing::Test {
     return path.string();
   }
 
+  // The options every headless preview of the actor alone takes: `config` (a preview.yaml),
+  // `view`, no overlays, the studio's image size.
+  std::vector<std::string> actor_preview_args(const std::string& config, const Viewpoint& view) {
+    return {"--headless",  "--config",      config,
+            "--viewpoint", to_string(view), "--overlays",
+            "none",        "--size",        std::to_string(kWidth) + "x" + std::to_string(kHeight)};
+  }
+
   // A headless preview from `view` drawing the actor only (--overlays none) at the studio's
   // image size: 30 meshes recorded to <dir>/<name> (frames.jsonl and PNGs), the last as
   // <dir>/<name>.png, the summary as JSON on its log. `config`: more preview.yaml lines;
@@ -135,24 +143,12 @@ class PreviewStudioTest : public ::testing::Test {
   Process& recorded_preview(const std::string& name, const Viewpoint& view,
                             const std::string& config = "",
                             const std::vector<std::string>& args = {}) {
-    std::vector<std::string> a{"--headless",
-                               "--config",
-                               preview_config(name, 1000, config),
-                               "--viewpoint",
-                               to_string(view),
-                               "--overlays",
-                               "none",
-                               "--size",
-                               std::to_string(kWidth) + "x" + std::to_string(kHeight),
-                               "--frames",
-                               "30",
-                               "--timeout",
-                               "120",
-                               "--record",
-                               (dir_ / name).string(),
-                               "--screenshot",
-                               (dir_ / (name + ".png")).string(),
-                               "--json"};
+    std::vector<std::string> a = actor_preview_args(preview_config(name, 1000, config), view);
+    for (const std::string& x :
+         {std::string("--frames"), std::string("30"), std::string("--timeout"), std::string("120"),
+          std::string("--record"), (dir_ / name).string(), std::string("--screenshot"),
+          (dir_ / (name + ".png")).string(), std::string("--json")})
+      a.push_back(x);
     a.insert(a.end(), args.begin(), args.end());
     return spawn(name, "preview/studio-preview", std::move(a));
   }
@@ -162,22 +158,13 @@ class PreviewStudioTest : public ::testing::Test {
   // drawn mesh recorded to <dir>/rec, the summary as JSON on its log; `more`: more options.
   Process& balancing_preview(const Viewpoint& view, int seconds,
                              const std::vector<std::string>& more = {}) {
-    std::vector<std::string> a{"--headless",
-                               "--config",
-                               preview_config("director", 1000, "colour_balance_every: 1\n"),
-                               "--viewpoint",
-                               to_string(view),
-                               "--overlays",
-                               "none",
-                               "--size",
-                               std::to_string(kWidth) + "x" + std::to_string(kHeight),
-                               "--duration",
-                               std::to_string(seconds),
-                               "--record",
-                               (dir_ / "rec").string(),
-                               "--screenshot",
-                               (dir_ / "last.png").string(),
-                               "--json"};
+    std::vector<std::string> a =
+        actor_preview_args(preview_config("director", 1000, "colour_balance_every: 1\n"), view);
+    for (const std::string& x :
+         {std::string("--duration"), std::to_string(seconds), std::string("--record"),
+          (dir_ / "rec").string(), std::string("--screenshot"), (dir_ / "last.png").string(),
+          std::string("--json")})
+      a.push_back(x);
     a.insert(a.end(), more.begin(), more.end());
     return spawn("preview", "preview/studio-preview", std::move(a));
   }
