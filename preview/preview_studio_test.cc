@@ -399,7 +399,7 @@ TEST_F(PreviewStudioTest, BlendBeatsNearestAgainstAHeldOutCamera) {
         100 * sc->squared_both / sc->squared, (unsigned long long)sc->rendered_only,
         100 * sc->squared_rendered_only / sc->squared, (unsigned long long)sc->true_only,
         100 * sc->squared_true_only / sc->squared);
-  // The rig's cameras agree: the colour balance (on by default) estimates gains within its 3 %
+  // The rig's cameras agree: the colour balance (on by default) estimates gains within its 5 %
   // tolerance and applies none (measured: within 0.5 % in process, preview_quality_test).
   const BalanceSummary same = balance_summary(previews["blend"]->log());
   ASSERT_TRUE(same.found) << previews["blend"]->log();
@@ -780,9 +780,11 @@ TEST_F(PreviewStudioTest, MatchCamerasLeavesAgreeingCamerasAlone) {
         cameras.insert(std::string(wire::str(st.data->camera_id)));
         for (const auto& f : wire::view(st.data->features)) {
           const std::string name(wire::str(f.name));
-          if (name == "Gain") EXPECT_EQ(f.value, 0) << wire::str(st.data->camera_id);
-          if (name == "BalanceRatioRed" || name == "BalanceRatioBlue")
+          if (name == "Gain") {
+            EXPECT_EQ(f.value, 0) << wire::str(st.data->camera_id);
+          } else if (name == "BalanceRatioRed" || name == "BalanceRatioBlue") {
             EXPECT_EQ(f.value, 1) << wire::str(st.data->camera_id) << " " << name;
+          }
         }
       }
     std::this_thread::sleep_for(50ms);

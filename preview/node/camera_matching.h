@@ -29,10 +29,10 @@ inline constexpr int kMatchMinFrames = 8;  // as RigBalance's: an estimate worth
 // percent more than after a second of meshes (preview_quality_test, rig_balance.h).
 inline constexpr int kMatchAutoFrames = 24;
 // --match-cameras acts only when some camera's estimate is this far off 1 (any channel): on
-// cameras that agree the live estimate strays by up to ~5 % in the first seconds (the balance
-// then applies at its 3 % tolerance; preview_studio_test MatchCamerasLeavesAgreeingCamerasAlone:
-// matched at 3 % in 2 of 6 runs, controls moved by 1-5 %), and a match sent on that noise
-// would move cameras that agree. A rig that differs by more is matched whole.
+// cameras that agree the live estimate drifts by up to ~4 % over a run (preview_studio_test
+// MatchCamerasLeavesAgreeingCamerasAlone: a trigger at 3 % matched in 2 of 6 runs, controls
+// moved by 1-5 %), and a match sent on that drift would move cameras that agree. A rig that
+// differs by more is matched whole.
 inline constexpr float kMatchAutoOffset = 0.08f;
 // --match-cameras matches again while the balance, pooled afresh, still applies, up to this many
 // rounds (a camera the first estimate had not linked, the first estimate's own error).

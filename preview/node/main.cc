@@ -43,7 +43,7 @@ Options:
                     on (default; preview.yaml's colour_balance) or off: each texturing camera's
                     image drawn with its colour gains, estimated live from the surface points two
                     cameras both see, so that cameras whose exposure or white balance differ
-                    leave no seams; gains stay 1 while every camera is within 3 % of the rig
+                    leave no seams; gains stay 1 while every camera is within 5 % of the rig
   --size WxH        window or screenshot size
   --overlays LIST   which overlays the 3D view draws: any of head, cameras, projectors,
                     screens (comma separated), all or none (default all; preview.yaml's

@@ -52,7 +52,7 @@ inline constexpr const char* kConfigHelp =
     "                                from the surface points two texturing cameras both see\n"
     "                                (a real rig's cameras differ by a few percent per channel:\n"
     "                                seams in the blend); gains stay 1 while every camera is\n"
-    "                                within 3 % of the rig\n"
+    "                                within 5 % of the rig\n"
     "  colour_balance_every: 4       pool one textured mesh in this many into the estimate\n"
     "                                (4-10 ms each on the render thread)\n"
     "  head_marker: true             the tracked head (studio/actor/head): a yellow sphere,\n"

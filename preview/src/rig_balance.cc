@@ -12,10 +12,12 @@ offline::ColourBalanceOptions rig_balance_defaults() {
   // preview_studio_test).
   o.max_pair_samples = 8192;
   // The live estimate strays further from 1 on cameras that agree than the offline one (fewer
-  // frames, the coarse live hull, which poses the run sees): 0.2-1.8 % in 10 runs of
-  // preview_studio_test's identical rig, 0.5 % in process; the offline 2 % would balance an
-  // agreeing rig by its own error now and then. A 3 % difference is a faint seam at most.
-  o.tolerance = 0.03;
+  // frames, the coarse live hull, which poses the run sees): 0.2-1.8 % in 10 runs of 30 meshes
+  // of preview_studio_test's identical rig, 0.5 % in process, but up to 3.8-4.1 % as the window
+  // fills over longer runs (every mesh pooled for 8 s: 2 of 6 runs drifted there and a 3 %
+  // tolerance applied gains on cameras that agree; at 5 %, 0 of 8, largest 2.8 %). A difference
+  // within the estimate's own error is not one to correct.
+  o.tolerance = 0.05;
   return o;
 }
 
