@@ -64,26 +64,34 @@ Expected<SentMatch> match_cameras(PreviewNode& node, ViewPipeline& pipeline, dou
   return SentMatch{std::move(*plan), {matched.begin(), matched.end()}};
 }
 
+std::string json_text(std::string_view text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20) out += c;
+  }
+  return out + "\"";
+}
+
 std::string camera_match_json(const SentMatch& sent) {
   const CameraMatch& m = sent.plan;
   char b[256];
   std::snprintf(b, sizeof b, "{\"level_db\":%.4f,\"matched\":[", m.level_db);
   std::string out = b;
   for (std::size_t i = 0; i < sent.matched.size(); ++i)
-    out += (i ? ",\"" : "\"") + sent.matched[i] + "\"";
+    out += (i ? "," : "") + json_text(sent.matched[i]);
   out += "],\"changes\":[";
   for (std::size_t i = 0; i < m.changes.size(); ++i) {
     const ControlChange& c = m.changes[i];
-    std::snprintf(b, sizeof b, "%s{\"camera\":\"%s\",\"feature\":\"%s\",\"from\":%.5f,\"to\":%.5f}",
-                  i ? "," : "", c.camera.c_str(), c.feature.c_str(), c.from, c.to);
-    out += b;
+    std::snprintf(b, sizeof b, ",\"from\":%.5f,\"to\":%.5f}", c.from, c.to);
+    out += (i ? ",{\"camera\":" : "{\"camera\":") + json_text(c.camera) +
+           ",\"feature\":" + json_text(c.feature) + b;
   }
   out += "],\"left\":{";
   bool first = true;
   for (const auto& [id, g] : m.left) {
-    std::snprintf(b, sizeof b, "%s\"%s\":[%.4f,%.4f,%.4f]", first ? "" : ",", id.c_str(), g.x(),
-                  g.y(), g.z());
-    out += b;
+    std::snprintf(b, sizeof b, ":[%.4f,%.4f,%.4f]", g.x(), g.y(), g.z());
+    out += (first ? "" : ",") + json_text(id) + b;
     first = false;
   }
   return out + "}}";

@@ -14,6 +14,7 @@
 // or a camera without white balance).
 #include <chrono>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/error.h"
@@ -48,6 +49,10 @@ struct SentMatch {
 // on a send that fails (the changes before it were sent).
 Expected<SentMatch> match_cameras(PreviewNode& node, ViewPipeline& pipeline,
                                   double min_change = 0.005);
+
+// `text` as a JSON string, quotes included (quotes and backslashes escaped, control characters
+// dropped): for camera ids and messages in the preview's JSON.
+std::string json_text(std::string_view text);
 
 // {"level_db", "matched": [ids], "changes": [{"camera", "feature", "from", "to"}],
 //  "left": {id: [r, g, b]}}

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "camera_matching.h"
 #include "panels.h"
 #include "runtime/metrics.h"
 #include "status_ticker.h"
@@ -154,13 +155,8 @@ bool write_screenshot(const std::string& path, int w, int h, const PanelState& p
     rect(r, true);
     first = false;
   }
-  std::string match;  // the View panel's last "Match cameras", JSON-escaped
-  for (char c : panels.match_result) {
-    if (c == '"' || c == '\\') match += '\\';
-    if (static_cast<unsigned char>(c) >= 0x20) match += c;
-  }
   json << "},\"view\":{\"meshes\":" << counts.meshes << ",\"textured\":" << counts.textured
-       << ",\"match\":\"" << match << "\"}}\n";
+       << ",\"match\":" << json_text(panels.match_result) << "}}\n";
   return ok && json.good();
 }
 

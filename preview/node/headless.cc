@@ -67,10 +67,10 @@ std::string balance_json(const ViewPipeline& pipeline) {
                 b.frames, (unsigned long long)pipeline.counts().balance_busy, b.pairs, b.residual);
   std::string out = head;
   for (std::size_t i = 0; i < rb.cameras.size() && i < b.gains.size(); ++i)
-    out += (i ? ",\"" : "\"") + rb.cameras[i] + "\":" + gains_json(b.gains[i]);
+    out += (i ? "," : "") + json_text(rb.cameras[i]) + ":" + gains_json(b.gains[i]);
   out += "},\"estimated\":{";
   for (std::size_t i = 0; i < rb.cameras.size() && i < b.estimated.size(); ++i)
-    out += (i ? ",\"" : "\"") + rb.cameras[i] + "\":" + gains_json(b.estimated[i]);
+    out += (i ? "," : "") + json_text(rb.cameras[i]) + ":" + gains_json(b.estimated[i]);
   return out + "}}";
 }
 
@@ -169,11 +169,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
           // Nothing sent (every change within min_change, or clamped): the balance goes on.
           match_rounds = m->plan.changes.empty() ? kMatchRounds : match_rounds + 1;
         } else {
-          std::string text;  // the message as a JSON string's characters
-          for (char ch : m.error().message)
-            if (static_cast<unsigned char>(ch) >= 0x20)
-              text += ch == '"' || ch == '\\' ? std::string("\\") + ch : std::string(1, ch);
-          match_json += "{\"error\":\"" + text + "\"}";
+          match_json += "{\"error\":" + json_text(m.error().message) + "}";
           std::fprintf(stderr, "studio-preview: %s\n", m.error().message.c_str());
           match_rounds = kMatchRounds;
         }
