@@ -13,9 +13,9 @@ namespace studio::preview {
 Expected<SentMatch> match_cameras(PreviewNode& node, ViewPipeline& pipeline, double min_change) {
   const BalanceSnapshot rb = pipeline.colour_balance();
   const offline::ColourBalance& b = rb.balance;
-  if (b.frames < kMatchMinFrames)
+  if (b.frames < rb.min_frames)
     return fail("match cameras: the colour balance has pooled " + std::to_string(b.frames) +
-                " frames (" + std::to_string(kMatchMinFrames) + " needed)");
+                " frames (" + std::to_string(rb.min_frames) + " needed)");
   // The largest linked set (ties: the one named by the smallest index).
   std::map<int, int> size;
   for (std::size_t i = 0; i < rb.cameras.size() && i < b.linked_set.size(); ++i)

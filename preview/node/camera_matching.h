@@ -25,7 +25,6 @@
 namespace studio::preview {
 
 inline constexpr std::chrono::milliseconds kMatchSettle{250};
-inline constexpr int kMatchMinFrames = 8;  // as RigBalance's: an estimate worth applying
 // --match-cameras waits for this many pooled frames: the estimate after 8 frames strays by a few
 // percent more than after a second of meshes (preview_quality_test, rig_balance.h).
 inline constexpr int kMatchAutoFrames = 24;
@@ -44,9 +43,9 @@ struct SentMatch {
   std::vector<std::string> matched;  // the linked set's cameras; the others took the level only
 };
 
-// Plans and sends the match; fails (nothing sent) while the balance has pooled fewer than
-// kMatchMinFrames frames or linked no cameras, when no linked camera publishes its controls, or
-// on a send that fails (the changes before it were sent).
+// Plans and sends the match; fails (nothing sent) while the balance has pooled fewer frames than
+// its gains wait for (BalanceSnapshot::min_frames) or linked no cameras, when no linked camera
+// publishes its controls, or on a send that fails (the changes before it were sent).
 Expected<SentMatch> match_cameras(PreviewNode& node, ViewPipeline& pipeline,
                                   double min_change = 0.005);
 

@@ -52,6 +52,7 @@ struct BalanceSnapshot {
   std::vector<std::string> cameras;  // the rig's ids, in the order of balance.gains
   offline::ColourBalance balance;
   double tolerance = 0;  // ColourBalanceOptions::tolerance of the estimate
+  int min_frames = 0;    // frames pooled before the gains are applied (RigBalance's)
   // As RigBalance::gains.
   Eigen::Vector3f gains(const std::string& id) const;
   // The estimate for camera `id` (before the tolerance), 1 when not linked.
@@ -81,7 +82,7 @@ class RigBalance {
   const std::vector<std::string>& cameras() const { return ids_; }
   const offline::ColourBalance& balance() const { return balance_; }
   const offline::ColourBalanceOptions& options() const { return options_; }
-  BalanceSnapshot snapshot() const { return {ids_, balance_, options_.tolerance}; }
+  BalanceSnapshot snapshot() const { return {ids_, balance_, options_.tolerance, min_frames_}; }
 
  private:
   offline::ColourBalanceOptions options_;
