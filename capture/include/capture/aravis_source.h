@@ -106,7 +106,8 @@ class AravisSource : public FrameSource {
   Expected<std::optional<Frame>> next(std::chrono::milliseconds timeout) override;
   // Gain, ExposureTime (µs), AcquisitionFrameRate, and any of BlackLevel, Gamma, Focus, Zoom,
   // Iris the camera implements; BalanceRatioRed / BalanceRatioBlue where it has SFNC's
-  // BalanceRatioSelector + BalanceRatio (Aravis's fake camera has not). Empty while disconnected.
+  // BalanceRatioSelector + BalanceRatio (Aravis's fake camera has not; capture_gv_test extends
+  // its description with them). Empty while disconnected.
   std::vector<Feature> features() const override;
   Expected<double> set_feature(std::string_view name, double value) override;
   SourceStats stats() const override;
