@@ -48,6 +48,26 @@ TEST(FrameImageStoreTest, ARefusalSettlesTheFrameAsRefused) {
   EXPECT_TRUE(s.find(9, {"cam0"}).has_value());  // positive control: cam0's is here
 }
 
+TEST(FrameImageStoreTest, ARigWideRequestTakesWhicheverImagesCame) {
+  FrameImageStore s;
+  const std::vector<std::string> rig{"cam0", "cam1", "cam2", "cam3"};
+  s.add("cam0", image(7, 1));
+  s.add("cam2", image(7, 3));
+  s.add("cam1", image(6, 9));  // another frame: not cam1's image of frame 7
+  EXPECT_FALSE(s.answered(7, rig));
+  s.refuse("cam3", 7);
+  EXPECT_FALSE(s.answered(7, rig));  // cam1 has not answered frame 7
+  s.refuse("cam1", 7);
+  EXPECT_TRUE(s.answered(7, rig));
+  const auto here = s.here(7, rig);
+  ASSERT_EQ(here.size(), 2u);
+  EXPECT_EQ(here[0].first, "cam0");
+  EXPECT_EQ(here[0].second.rgb[0], 1);
+  EXPECT_EQ(here[1].first, "cam2");
+  EXPECT_EQ(here[1].second.frame, 7u);
+  EXPECT_TRUE(s.here(8, rig).empty());
+}
+
 TEST(FrameImageStoreTest, KeepsTheNewestFrames) {
   FrameImageStore s(3);
   for (uint64_t f = 1; f <= 5; ++f) s.add("cam0", image(f));

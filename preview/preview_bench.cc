@@ -53,9 +53,9 @@ struct Fixture {
   std::map<int, Samples> samples;  // by camera image width
 };
 
-Samples make_samples(int width) {
+Samples make_samples(int width, int count = 5) {
   sim::RingOptions ring;
-  ring.count = 5;
+  ring.count = count;
   ring.width = width;
   ring.height = width * 576 / 704;
   ring.focal_px *= width / 704.0;
@@ -200,6 +200,38 @@ BENCHMARK(BM_PreviewColourBalance)
     ->ArgNames({"image_w"})
     ->Arg(352)
     ->Arg(704)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// A rig sample (node/view_pipeline.h, balance_rig_every): one frame pooled from every camera of
+// a 9-camera rig (8 ring + overhead, as the studio tests'), against the view's three (views: 3)
+// on the same rig and frame.
+void BM_PreviewRigSample(benchmark::State& state) {
+  static const std::map<int, Samples> rigs{{352, make_samples(352, 9)},
+                                           {704, make_samples(704, 9)}};
+  const Samples& s = rigs.at(int(state.range(0)));
+  const int count = int(state.range(1));
+  std::map<std::string, Camera> rig;
+  for (const Camera& c : s.cameras) rig[c.id] = c;
+  std::vector<RunMask> runs;
+  for (const Mask& m : s.masks) runs.push_back(RunMask::from_mask(m.view()));
+  std::vector<preview::BalanceView> views;
+  for (int c = 0; c < int(s.cameras.size()); ++c)
+    if (count > 3 || c == 0 || c == 1 || c == 7)
+      views.push_back(
+          {s.cameras[std::size_t(c)].id, s.images[std::size_t(c)].view(), &runs[std::size_t(c)]});
+  preview::RigBalance balance;
+  for (auto _ : state)
+    if (auto ok = balance.add(rig, s.mesh, views); !ok)
+      state.SkipWithError(ok.error().message.c_str());
+  state.counters["pairs"] = balance.balance().pairs;
+}
+BENCHMARK(BM_PreviewRigSample)
+    ->ArgNames({"image_w", "views"})
+    ->Args({352, 3})
+    ->Args({352, 9})
+    ->Args({704, 3})
+    ->Args({704, 9})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -300,7 +300,7 @@ std::pair<Camera, Viewpoint> held_out(int kW, int kH) {
 // "estimated": {camera id: [r, g, b]}}.
 struct BalanceSummary {
   bool found = false, applied = false;
-  int frames = 0, pairs = 0;
+  int frames = 0, rig_frames = 0, pairs = 0;
   std::map<std::string, Eigen::Vector3d> estimated;
 };
 BalanceSummary balance_summary(const std::string& log) {
@@ -309,12 +309,13 @@ BalanceSummary balance_summary(const std::string& log) {
   if (!std::regex_search(
           log, m,
           std::regex(
-              R"re("colour_balance":\{"on":\w+,"applied":(\w+),"frames":(\d+),"busy":\d+,"pairs":(\d+))re")))
+              R"re("colour_balance":\{"on":\w+,"applied":(\w+),"frames":(\d+),"busy":\d+,"rig_frames":(\d+),"rig_dropped":\d+,"pairs":(\d+))re")))
     return b;
   b.found = true;
   b.applied = m[1] == "true";
   b.frames = std::stoi(m[2]);
-  b.pairs = std::stoi(m[3]);
+  b.rig_frames = std::stoi(m[3]);
+  b.pairs = std::stoi(m[4]);
   const std::size_t at = log.find("\"estimated\":{", std::size_t(m.position(0)));
   if (at == std::string::npos) return b;
   const std::string rest = log.substr(at, log.find('}', at) - at);
@@ -701,7 +702,9 @@ TEST_F(PreviewStudioTest, MatchCamerasMovesTheBalanceIntoTheCameras) {
         matched.push_back((*it)[1]);
   }
   ASSERT_FALSE(sent.empty()) << match;
-  ASSERT_GE(matched.size(), 3u) << match;
+  // The rig samples' estimate (16 samples of every camera) links the whole rig, not only the
+  // cameras near the view (3-4 of them without it).
+  EXPECT_EQ(matched.size(), 9u) << match;
   // The capture service read the values back (studio/camera/state, transient-local: the latest).
   std::map<std::string, std::map<std::string, double>> read_back;
   for (auto& st : states.take())
@@ -724,6 +727,18 @@ TEST_F(PreviewStudioTest, MatchCamerasMovesTheBalanceIntoTheCameras) {
         before = std::max(before, std::abs(ta / tb - 1));
         after = std::max(after, std::abs((ta / fa[k]) / (tb / fb[k]) - 1));
       }
+  // Every camera of the rig, matched or not (the others took the level only, which no ratio sees).
+  double rig_before = 0, rig_after = 0;
+  for (std::size_t a = 0; a < truth.size(); ++a)
+    for (std::size_t c = a + 1; c < truth.size(); ++c)
+      for (int k = 0; k < 3; ++k) {
+        const std::string ia = "cam" + std::to_string(a), ic = "cam" + std::to_string(c);
+        const Eigen::Vector3d fa = applied.count(ia) ? applied.at(ia) : Eigen::Vector3d::Ones(),
+                              fc = applied.count(ic) ? applied.at(ic) : Eigen::Vector3d::Ones();
+        const double ta = truth[a][std::size_t(k)], tc = truth[c][std::size_t(k)];
+        rig_before = std::max(rig_before, std::abs(ta / tc - 1));
+        rig_after = std::max(rig_after, std::abs((ta / fa[k]) / (tc / fc[k]) - 1));
+      }
   // The balance after the match: pooled afresh (fewer frames than meshes drawn) on the matched
   // images; its estimate between the matched cameras.
   const BalanceSummary b = balance_summary(log);
@@ -744,13 +759,18 @@ TEST_F(PreviewStudioTest, MatchCamerasMovesTheBalanceIntoTheCameras) {
   std::printf(
       "match cameras: %d rounds, %zu controls, %zu cameras matched (%s); their worst pair ratio "
       "against the truth %.2f %% before, %.2f %% after; the balance afterwards: %d frames "
-      "pooled of %d meshes drawn, applied %d, its worst pair ratio %.2f %%\n",
+      "pooled of %d meshes drawn, applied %d, its worst pair ratio %.2f %%; the whole rig's worst "
+      "pair ratio %.2f %% before, %.2f %% after\n",
       rounds, sent.size(), matched.size(), match.substr(0, match.find(",\"changes\"")).c_str(),
-      100 * before, 100 * after, b.frames, drawn, int(b.applied), 100 * estimate_left);
+      100 * before, 100 * after, b.frames, drawn, int(b.applied), 100 * estimate_left,
+      100 * rig_before, 100 * rig_after);
   EXPECT_GE(rounds, 1);
   EXPECT_LE(rounds, 3);
   EXPECT_GT(before, 0.2);           // cam1's two thirds of a stop among them
-  EXPECT_LT(after, 0.35 * before);  // the live estimate's error is what remains (up to ~5 %)
+  EXPECT_LT(after, 0.35 * before);  // the estimate's error is what remains (up to ~6 %)
+  // Measured 2.5-6.3 % over the whole rig (the overhead camera's view-dependent bias the most);
+  // matching the view's set alone left it at 8.3-10.3 % (the cameras it did not link).
+  EXPECT_LT(rig_after, 0.3 * rig_before);
   EXPECT_GE(b.frames, 8);
   EXPECT_LT(b.frames, drawn - 8);  // started afresh after the match
 }

@@ -11,7 +11,9 @@
 namespace studio::preview {
 
 Expected<SentMatch> match_cameras(PreviewNode& node, ViewPipeline& pipeline, double min_change) {
-  const BalanceSnapshot rb = pipeline.colour_balance();
+  const BalanceSnapshot rig = pipeline.rig_colour_balance();
+  const BalanceSnapshot rb =
+      rig.balance.frames >= kMatchRigFrames ? rig : pipeline.colour_balance();
   const offline::ColourBalance& b = rb.balance;
   if (b.frames < rb.min_frames)
     return fail("match cameras: the colour balance has pooled " + std::to_string(b.frames) +

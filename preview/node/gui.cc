@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -208,6 +209,8 @@ int run_gui(const PreviewConfig& config, const std::string& script_path) {
     po.carve_all_masks = config.carve_masks;
     po.colour_balance = config.colour_balance;
     po.balance_every = config.colour_balance_every;
+    po.balance_rig_every =
+        std::chrono::milliseconds(std::lround(1000 * config.colour_balance_rig_s));
     auto pipeline = ViewPipeline::create(node, po);
     if (!pipeline) return error(pipeline.error().message);
     service_status->before_publish([&] { (*pipeline)->report(metrics); });

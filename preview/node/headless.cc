@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -52,19 +53,22 @@ std::string gains_json(const Eigen::Vector3f& g) {
   return b;
 }
 
-// {"on", "applied", "frames", "busy", "pairs", "residual", "gains": {camera id: [r, g, b]},
-// "estimated": {...}}: the pipeline's colour balance at the end of the run
-// (preview/rig_balance.h; frames pooled, busy: meshes due while the worker was still pooling;
+// {"on", "applied", "frames", "busy", "rig_frames", "rig_dropped", "pairs", "residual",
+// "gains": {camera id: [r, g, b]}, "estimated": {...}}: the pipeline's colour balance at the end
+// of the run (preview/rig_balance.h; frames pooled, busy: meshes due while the worker was still
+// pooling; rig_frames: rig samples (every camera, their own estimate), rig_dropped: given up;
 // gains are the estimate when applied, else 1).
 std::string balance_json(const ViewPipeline& pipeline) {
   const BalanceSnapshot rb = pipeline.colour_balance();
   const offline::ColourBalance& b = rb.balance;
-  char head[160];
+  char head[256];
   std::snprintf(head, sizeof head,
-                "{\"on\":%s,\"applied\":%s,\"frames\":%d,\"busy\":%llu,\"pairs\":%d,"
-                "\"residual\":%.5f,\"gains\":{",
+                "{\"on\":%s,\"applied\":%s,\"frames\":%d,\"busy\":%llu,\"rig_frames\":%llu,"
+                "\"rig_dropped\":%llu,\"pairs\":%d,\"residual\":%.5f,\"gains\":{",
                 pipeline.colour_balance_on() ? "true" : "false", b.applied ? "true" : "false",
-                b.frames, (unsigned long long)pipeline.counts().balance_busy, b.pairs, b.residual);
+                b.frames, (unsigned long long)pipeline.counts().balance_busy,
+                (unsigned long long)pipeline.counts().balance_rig_frames,
+                (unsigned long long)pipeline.counts().balance_rig_dropped, b.pairs, b.residual);
   std::string out = head;
   for (std::size_t i = 0; i < rb.cameras.size() && i < b.gains.size(); ++i)
     out += (i ? "," : "") + json_text(rb.cameras[i]) + ":" + gains_json(b.gains[i]);
@@ -112,6 +116,11 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
   po.carve_all_masks = config.carve_masks;
   po.colour_balance = config.colour_balance;
   po.balance_every = config.colour_balance_every;
+  // Low-rate pictures sample no rig either: the capture servers answer for drawn meshes only.
+  po.balance_rig_every =
+      options.every_s > 0
+          ? std::chrono::milliseconds(0)
+          : std::chrono::milliseconds(std::lround(1000 * config.colour_balance_rig_s));
   auto pipeline = ViewPipeline::create(node, po);
   if (!pipeline) return error(pipeline.error().message, 1);
   status->before_publish([&] { (*pipeline)->report(metrics); });
@@ -159,6 +168,8 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
       // cameras it had not linked yet, and what the last round's estimate got wrong.
       const BalanceSnapshot b = (*pipeline)->colour_balance();
       if (b.balance.applied && b.balance.frames >= kMatchAutoFrames &&
+          (po.balance_rig_every.count() == 0 ||
+           (*pipeline)->rig_colour_balance().balance.frames >= kMatchRigFrames) &&
           largest_gain_offset(b.balance.estimated) > kMatchAutoOffset) {
         auto m = match_cameras(node, **pipeline);
         match_json += match_json.empty() ? "" : ",";

@@ -65,7 +65,9 @@ Options:
                     until SIGINT/SIGTERM; exit 1 if no mesh was drawn
   --match-cameras   headless: whenever the colour balance finds some camera more than 8 % off
                     the rig (24 frames pooled since the last match; 3 rounds at most; less is
-                    within the live estimate's own error), send it to the cameras: CameraControl Gain (dB, the green factor; one level for the
+                    within the live estimate's own error), send the whole rig's estimate (16
+                    samples of every camera's images, one each colour_balance_rig_s, 0.5 s) to
+                    the cameras: CameraControl Gain (dB, the green factor; one level for the
                     rig, no camera pushed below its lowest gain; cameras the balance has not
                     linked take that level only) and BalanceRatioRed / BalanceRatioBlue (white
                     balance against green) where the camera has them; the balance then starts
@@ -73,7 +75,8 @@ Options:
                     panel's "Match cameras"
   --json            headless: the summary as one JSON line ("overlays": the heads, cameras,
                     calibrated projectors and thumbnails received; "colour_balance": applied,
-                    frames pooled, busy (meshes skipped while pooling the previous), camera
+                    frames pooled, busy (meshes skipped while pooling the previous),
+                    rig_frames / rig_dropped (rig samples pooled / given up), camera
                     pairs and per camera id its gains; "camera_match": null without
                     --match-cameras, else per round the changes sent {"level_db", "matched",
                     "changes": [{"camera", "feature", "from", "to"}], "left"} or {"error"})

@@ -13,6 +13,7 @@ struct Keys {
   int blend_cameras = 3, wait_ms = 200;
   bool carve_masks = true, colour_balance = true;
   int colour_balance_every = 4;
+  double colour_balance_rig_s = 0.5;
   bool head_marker = true, camera_frusta = true, projector_frusta = true, projector_screens = true;
   double camera_frustum_m = 0.5;
 };
@@ -32,6 +33,7 @@ const yaml::Schema<Keys> kSchema{
     yaml::field("carve_masks", &Keys::carve_masks),
     yaml::field("colour_balance", &Keys::colour_balance),
     yaml::field("colour_balance_every", &Keys::colour_balance_every).range(1, 1000),
+    yaml::field("colour_balance_rig_s", &Keys::colour_balance_rig_s).range(0, 60),
     yaml::field("head_marker", &Keys::head_marker),
     yaml::field("camera_frusta", &Keys::camera_frusta),
     yaml::field("camera_frustum_m", &Keys::camera_frustum_m).range(0.01, 20),
@@ -71,6 +73,7 @@ Expected<PreviewConfig> read_preview_config(const std::string& path) {
   c.carve_masks = k->carve_masks;
   c.colour_balance = k->colour_balance;
   c.colour_balance_every = k->colour_balance_every;
+  c.colour_balance_rig_s = k->colour_balance_rig_s;
   c.overlays.head = k->head_marker;
   c.overlays.camera_frusta = k->camera_frusta;
   c.overlays.camera_frustum_m = k->camera_frustum_m;

@@ -28,6 +28,7 @@ struct PreviewConfig {
   bool carve_masks = true;         // blend: carve against every camera's mask of the frame
   bool colour_balance = true;      // the cameras' colour balance (preview/rig_balance.h)
   int colour_balance_every = 4;    // pool one textured mesh in this many into it
+  double colour_balance_rig_s = 0.5;  // pool every camera's images of one mesh this often (0: off)
   Expected<void> validate() const;
 };
 
@@ -54,7 +55,11 @@ inline constexpr const char* kConfigHelp =
     "                                seams in the blend); gains stay 1 while every camera is\n"
     "                                within 5 % of the rig\n"
     "  colour_balance_every: 4       pool one textured mesh in this many into the estimate\n"
-    "                                (4-10 ms each on the render thread)\n"
+    "                                (4-10 ms of CPU each, on a thread of its own)\n"
+    "  colour_balance_rig_s: 0.5     this often, pool the images of one mesh from every\n"
+    "                                camera, so that the estimate (and Match cameras) covers\n"
+    "                                the whole rig, not only the cameras near this view\n"
+    "                                (0: off)\n"
     "  head_marker: true             the tracked head (studio/actor/head): a yellow sphere,\n"
     "                                its velocity (orange) and sight lines to each screen\n"
     "  camera_frusta: true           each studio camera's frustum (cyan, from\n"

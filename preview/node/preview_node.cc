@@ -12,7 +12,10 @@ namespace studio::preview {
 namespace {
 
 constexpr const char* kLog = "preview";
-constexpr std::size_t kKeptImages = 24;      // (camera, frame) images kept for the renderer
+// (camera, frame) images kept for the renderer: the three texturing cameras' of 8 meshes, and
+// one rig sample's (ViewPipeline's balance_rig_every: every camera of one frame) beside them, so
+// that it is not trimmed while its images arrive.
+constexpr std::size_t kKeptImages = 36;
 constexpr std::size_t kKeptMaskFrames = 25;  // per camera: a second of masks at 25 fps
 
 }  // namespace
@@ -260,6 +263,17 @@ std::expected<std::vector<FrameImage>, PreviewNode::Missing> PreviewNode::images
   std::unique_lock lock(impl_->mutex);
   impl_->changed.wait_for(lock, wait, [&] { return impl_->store.settled(frame, cameras); });
   return impl_->store.find(frame, cameras);
+}
+
+bool PreviewNode::images_answered(uint64_t frame, const std::vector<std::string>& cameras) const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->store.answered(frame, cameras);
+}
+
+std::vector<std::pair<std::string, FrameImage>> PreviewNode::images_here(
+    uint64_t frame, const std::vector<std::string>& cameras) const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->store.here(frame, cameras);
 }
 
 Expected<void> PreviewNode::send_control(const std::string& camera, const std::string& feature,

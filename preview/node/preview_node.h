@@ -111,6 +111,12 @@ class PreviewNode : public runtime::Node {
                                                          const std::vector<std::string>& cameras,
                                                          std::chrono::milliseconds wait);
 
+  // Without waiting: every named camera answered `frame` (image here or refused), and the
+  // images of it that are here (a rig-wide request pools whichever came).
+  bool images_answered(uint64_t frame, const std::vector<std::string>& cameras) const;
+  std::vector<std::pair<std::string, FrameImage>> images_here(
+      uint64_t frame, const std::vector<std::string>& cameras) const;
+
   Expected<void> send_control(const std::string& camera, const std::string& feature, double value);
   Expected<void> send_capture(const std::string& take, bool start, uint64_t at_frame);
   // SceneCommand verbs PLAY, PAUSE, SEEK (value seconds), SPEED (value factor), MOVE_NODE

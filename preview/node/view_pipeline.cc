@@ -80,10 +80,20 @@ struct ViewPipeline::Impl {
   std::vector<Mask> carving_masks;
   std::size_t carving_count = 0;
   BalanceWorker balance;
+  BalanceWorker rig_balance;  // the rig samples' estimate, on a thread of its own
   int64_t pool_from_ns = 0;  // restart_colour_balance(): meshes captured before are not pooled
   uint64_t textured_seen =
       0;  // meshes pool_balance() saw (the first and every balance_every-th pool)
   std::shared_ptr<PrefetchState> prefetch = std::make_shared<PrefetchState>();
+  // The rig sample waiting for its images (PipelineOptions::balance_rig_every).
+  struct RigSample {
+    scene::ActorMesh mesh;
+    uint64_t frame = 0;
+    std::vector<std::string> cameras;
+    std::chrono::steady_clock::time_point since;
+  };
+  std::optional<RigSample> rig_sample;
+  std::chrono::steady_clock::time_point last_rig_sample{};
 
   Impl(PreviewNode& n, const PipelineOptions& o, scene_render::Renderer r, ActorTexturer t,
        OverlayRenderer ov)
@@ -151,6 +161,7 @@ struct ViewPipeline::Impl {
       hi = hi.cwiseMax(v.cast<double>());
     }
     if (!m->mesh.vertices.empty()) centre = 0.5 * (lo + hi);
+    start_rig_sample(*m);
     Choice c = choose(node->cameras(), options.blend, options.blend_options, view.eye, centre);
     pending_threshold = c.threshold;
     pending = std::move(*m);
@@ -217,6 +228,57 @@ struct ViewPipeline::Impl {
     }
     ++counts.balance_frames;
     return true;
+  }
+
+  // Makes `m` the rig sample when one is due: asks for its images from every calibrated camera.
+  void start_rig_sample(const LiveMesh& m) {
+    if (!options.colour_balance || options.balance_rig_every.count() <= 0 || rig_sample ||
+        m.capture_ns < pool_from_ns || m.mesh.triangles.empty())
+      return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_rig_sample < options.balance_rig_every) return;
+    std::vector<std::string> ids;
+    for (const auto& [id, c] : node->cameras()) ids.push_back(id);
+    if (ids.size() < 2) return;
+    last_rig_sample = now;
+    rig_sample = RigSample{m.mesh, m.source_frame, std::move(ids), now};
+    node->request_images(rig_sample->frame, rig_sample->cameras);
+  }
+
+  // Hands the rig sample to the balance's worker once every camera answered or `wait` passed
+  // (the images that came, with their masks of the frame; two at least). Its worker still busy
+  // with the previous one: tried again next frame, given up after a second.
+  void pool_rig_sample() {
+    if (!rig_sample) return;
+    const auto waited = std::chrono::steady_clock::now() - rig_sample->since;
+    if (waited < options.wait && !node->images_answered(rig_sample->frame, rig_sample->cameras))
+      return;
+    const auto cams = node->cameras();
+    const auto masks = node->masks(rig_sample->frame);
+    BalanceWorker::Job job;
+    job.rig = cams;
+    job.mesh = rig_sample->mesh;
+    for (auto& [id, image] : node->images_here(rig_sample->frame, rig_sample->cameras)) {
+      const auto c = cams.find(id);
+      const auto m = masks.find(id);
+      if (c == cams.end() || m == masks.end() || c->second.width != image.width ||
+          c->second.height != image.height)
+        continue;
+      job.cameras.push_back(id);
+      job.images.push_back(std::move(image));
+      job.masks.push_back(m->second);
+    }
+    const std::size_t images = job.cameras.size();
+    if (images < 2) {
+      ++counts.balance_rig_dropped;
+    } else if (rig_balance.submit(std::move(job))) {
+      ++counts.balance_rig_frames;
+    } else if (waited < std::chrono::seconds(1)) {
+      return;  // the worker is busy: next frame
+    } else {
+      ++counts.balance_rig_dropped;
+    }
+    rig_sample.reset();
   }
 
   // Promotes the pending mesh when its images are here (textured) or it waited too long.
@@ -327,6 +389,7 @@ FrameReport ViewPipeline::render(const Viewpoint& view, int width, int height, b
   r.refresh_scene();
   r.take_new_mesh(view);
   const bool fresh = r.promote(block);
+  r.pool_rig_sample();
   scene_render::View v;
   v.cam_from_world = scene::look_at(view.eye, view.at);
   v.clip_from_cam = scene::perspective(view.fov_deg * std::numbers::pi / 180,
@@ -361,11 +424,18 @@ void ViewPipeline::set_blend(bool blend) {
 }
 bool ViewPipeline::blend() const { return impl_->options.blend; }
 BalanceSnapshot ViewPipeline::colour_balance() const { return impl_->balance.snapshot(); }
+BalanceSnapshot ViewPipeline::rig_colour_balance() const { return impl_->rig_balance.snapshot(); }
 void ViewPipeline::restart_colour_balance(int64_t pool_from_capture_ns) {
   impl_->pool_from_ns = pool_from_capture_ns;
   impl_->balance.restart();
+  impl_->rig_balance.restart();
+  impl_->rig_sample.reset();  // its images have the old colours; the next one at once
+  impl_->last_rig_sample = {};
 }
-void ViewPipeline::finish_colour_balance() { impl_->balance.wait_idle(); }
+void ViewPipeline::finish_colour_balance() {
+  impl_->balance.wait_idle();
+  impl_->rig_balance.wait_idle();
+}
 void ViewPipeline::report(runtime::Metrics& metrics) const {
   const BalanceSnapshot b = impl_->balance.snapshot();
   metrics.gauge("colour_balance_applied").set(b.balance.applied ? 1 : 0);

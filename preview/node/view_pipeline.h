@@ -49,6 +49,18 @@ struct PipelineOptions {
   // BENCHMARKS.md; node/balance_worker.h). A rig whose cameras agree keeps gains 1.
   bool colour_balance = true;
   int balance_every = 4;
+  // Rig samples: once per this period, one mesh's images of every calibrated camera are asked
+  // for and pooled (those that come within `wait`, on a worker thread of their own, so that the
+  // live estimate's pooling never waits for them) into an estimate of their own that links the
+  // whole rig, not only the cameras near this view: Match cameras (node/camera_matching.h) sends
+  // it. The view is drawn with the live estimate of its own cameras only: over every camera the
+  // estimate's view-dependent error (the overhead camera 2.6-4 % off on agreeing cameras)
+  // crossed the live tolerance (5 %) and balanced agreeing rigs.
+  // 0: off. A sample of 9 cameras costs the worker 12.6 ms of CPU at 352x288, 36.7 ms at
+  // 704x576 (preview_bench BM_PreviewRigSample; the view's three: 4.6 / 10.6 ms): 2.5-7 % of a
+  // core at the default 0.5 s. Every camera is linked from the first sample
+  // (preview_quality_test TheColourBalancePooledFromEveryCameraLinksTheRig).
+  std::chrono::milliseconds balance_rig_every{500};
 };
 
 struct FrameReport {
@@ -73,6 +85,9 @@ struct PipelineCounts {
   // Meshes handed to the colour balance's worker, and those due but refused (the worker still
   // pooling the previous one).
   uint64_t balance_frames = 0, balance_busy = 0;
+  // Rig samples handed to the worker, and those given up (fewer than two images came, or the
+  // worker stayed busy for a second).
+  uint64_t balance_rig_frames = 0, balance_rig_dropped = 0;
 };
 
 class ViewPipeline {
@@ -96,6 +111,8 @@ class ViewPipeline {
   // The cameras' colour balance so far (its latest estimate), and switching it;
   // finish_colour_balance() waits until the mesh the worker holds is pooled.
   BalanceSnapshot colour_balance() const;
+  // The rig samples' estimate (every camera; PipelineOptions::balance_rig_every).
+  BalanceSnapshot rig_colour_balance() const;
   void finish_colour_balance();
   // The colour balance on the service's status (studioctl, the Services panels): gauges
   // colour_balance_applied (0 / 1), colour_balance_frames (pooled) and colour_balance_off_pct
@@ -103,7 +120,7 @@ class ViewPipeline {
   void report(runtime::Metrics& metrics) const;
   void set_colour_balance(bool on);
   bool colour_balance_on() const;
-  // Forgets the balance's estimate (the cameras' colours were changed at the cameras:
+  // Forgets both estimates (the cameras' colours were changed at the cameras:
   // node/camera_matching.h) and pools again only meshes captured at or after
   // `pool_from_capture_ns` (frames on the way still show the old colours).
   void restart_colour_balance(int64_t pool_from_capture_ns);

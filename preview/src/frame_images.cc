@@ -57,4 +57,19 @@ bool FrameImageStore::settled(uint64_t frame, const std::vector<std::string>& ca
   return all;
 }
 
+bool FrameImageStore::answered(uint64_t frame, const std::vector<std::string>& cameras) const {
+  return std::all_of(cameras.begin(), cameras.end(), [&](const std::string& c) {
+    return images_.count({c, frame}) > 0 || refused_.count({c, frame}) > 0;
+  });
+}
+
+std::vector<std::pair<std::string, FrameImage>> FrameImageStore::here(
+    uint64_t frame, const std::vector<std::string>& cameras) const {
+  std::vector<std::pair<std::string, FrameImage>> out;
+  for (const auto& c : cameras)
+    if (const auto it = images_.find({c, frame}); it != images_.end())
+      out.emplace_back(c, it->second);
+  return out;
+}
+
 }  // namespace studio::preview

@@ -210,6 +210,8 @@ struct Scoring {
   // the blend's texturing cameras' images and masks of that frame, then every variant draws with
   // the gains so far. `balances` (when set) receives the balance after each frame.
   bool balance = false;
+  // Pool every studio camera's image of the frame, not only the blend's (the node's rig samples).
+  bool balance_all_cameras = false;
   std::vector<offline::ColourBalance>* balances = nullptr;
   // Frames pooled before the scored ones (a preview that has been running: RigBalance applies
   // its gains once 8 frames are pooled).
@@ -256,9 +258,15 @@ inline std::vector<Breakdown> evaluate(const Scoring& setup, const std::vector<V
     std::vector<RunMask> runs;
     std::vector<BalanceView> views;
     runs.reserve(s.cameras.size());
-    for (const CameraWeight& c : preview::blend(s.poses, s.eye, centre)) {
-      runs.push_back(RunMask::from_mask(masks[c.index].view()));
-      views.push_back({s.cameras[c.index].id, images[c.index].view(), &runs.back()});
+    std::vector<int> pooled;
+    if (setup.balance_all_cameras)
+      for (std::size_t c = 0; c < s.cameras.size(); ++c) pooled.push_back(int(c));
+    else
+      for (const CameraWeight& c : preview::blend(s.poses, s.eye, centre))
+        pooled.push_back(c.index);
+    for (const int c : pooled) {
+      runs.push_back(RunMask::from_mask(masks[c].view()));
+      views.push_back({s.cameras[c].id, images[c].view(), &runs.back()});
     }
     EXPECT_TRUE(balance.add(rig, mesh, views).has_value());
     if (setup.balances) setup.balances->push_back(balance.balance());

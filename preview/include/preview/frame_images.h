@@ -40,6 +40,12 @@ class FrameImageStore {
       uint64_t frame, const std::vector<std::string>& cameras) const;
   // Nothing more to wait for: every image is here or one was refused.
   bool settled(uint64_t frame, const std::vector<std::string>& cameras) const;
+  // Every camera has answered: its image is here or it refused (a rig-wide request that takes
+  // whichever images came).
+  bool answered(uint64_t frame, const std::vector<std::string>& cameras) const;
+  // The images of exactly `frame` of those cameras whose image is here, with their ids, in order.
+  std::vector<std::pair<std::string, FrameImage>> here(
+      uint64_t frame, const std::vector<std::string>& cameras) const;
 
   std::size_t images() const { return images_.size(); }
 
