@@ -6,7 +6,6 @@
 // Every test runs under a watchdog (55 s) besides ctest's timeout.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <net/if.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -25,6 +24,7 @@
 #include "capture/freed.h"
 #include "capture/freed_listener.h"
 #include "core/clock.h"
+#include "testing/private_netns.h"
 
 namespace studio::capture {
 namespace {
@@ -32,17 +32,6 @@ namespace {
 using std::chrono::milliseconds;
 using Clock = std::chrono::steady_clock;
 constexpr char kDeviceId[] = "Aravis-Fake-GV01";
-
-// True when loopback is the only network interface: we are in a private namespace.
-bool only_loopback() {
-  struct if_nameindex* list = if_nameindex();
-  if (!list) return false;
-  bool only_lo = true;
-  for (struct if_nameindex* i = list; i->if_index != 0; ++i)
-    only_lo &= std::string(i->if_name) == "lo";
-  if_freenameindex(list);
-  return only_lo;
-}
 
 // arv-fake-gv-camera-0.8 -i 127.0.0.1 as a child process, killed with the test (PDEATHSIG).
 class FakeGvCamera {

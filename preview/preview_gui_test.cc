@@ -142,7 +142,8 @@ TEST_F(PreviewStudioTest, GuiMatchCamerasButtonSetsTheCameras) {
   auto topic = wire::Topic<studio_CameraState>::create(p).value();
   auto states = wire::Reader<studio_CameraState>::create(p, topic).value();
   const std::string script = (dir_ / "match.txt").string();
-  std::ofstream(script) << "wait_meshes 3\nopen view\nwait 6\npress match_cameras\nwait 2\n"
+  // Pressed once the whole rig is sampled (16 rig samples, one per 0.5 s).
+  std::ofstream(script) << "wait_meshes 3\nopen view\nwait 10\npress match_cameras\nwait 2\n"
                            "screenshot "
                         << (dir_ / "match.png").string() << "\nquit\n";
   auto args = studio::testing::xvfb_exec("1024x768x24", dir_ / "match.xenv");
@@ -164,6 +165,11 @@ TEST_F(PreviewStudioTest, GuiMatchCamerasButtonSetsTheCameras) {
   const std::string said = m[1];
   std::printf("the panel says: %s\n", said.c_str());
   EXPECT_NE(said.find("controls sent to"), std::string::npos) << said;
+  EXPECT_NE(said.find("(9 matched"), std::string::npos) << "the whole rig: " << said;
+  // After the match the rig is sampled afresh: the panel says what the button sends now.
+  ASSERT_TRUE(std::regex_search(layout, m, std::regex(R"re("match_source":"([^"]*)")re")))
+      << layout;
+  EXPECT_NE(std::string(m[1]).find("until the whole rig is sampled"), std::string::npos) << m[1];
   // The button and the result beside it, drawn where the layout says.
   const cv::Mat shot = cv::imread((dir_ / "match.png").string(), cv::IMREAD_COLOR);
   ASSERT_FALSE(shot.empty());

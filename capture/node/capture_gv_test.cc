@@ -10,7 +10,6 @@
 // preview/camera_match.h CameraControls::exponent).
 #include <arv.h>
 #include <gtest/gtest.h>
-#include <net/if.h>
 
 #include <cmath>
 #include <fstream>
@@ -19,6 +18,7 @@
 
 #include "capture/aravis_source.h"
 #include "harness/fixture.h"
+#include "testing/private_netns.h"
 #include "wire/endpoint.h"
 
 namespace studio::capture {
@@ -77,16 +77,6 @@ std::string white_balance_camera_xml() {
   const auto end = text.rfind("</RegisterDescription>");
   if (end == std::string::npos) return {};
   return text.insert(end, kWhiteBalanceNodes);
-}
-
-bool only_loopback() {
-  struct if_nameindex* list = if_nameindex();
-  if (!list) return false;
-  bool only_lo = true;
-  for (struct if_nameindex* i = list; i->if_index != 0; ++i)
-    only_lo &= std::string(i->if_name) == "lo";
-  if_freenameindex(list);
-  return only_lo;
 }
 
 class CaptureGvTest : public testing::ProcessTest {

@@ -1,10 +1,19 @@
 #include "balance_worker.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include "core/log.h"
 
 namespace studio::preview {
 
-BalanceWorker::BalanceWorker() : snapshot_(balance_.snapshot()), thread_([this] { run(); }) {}
+BalanceWorker::BalanceWorker(int nice)
+    : snapshot_(balance_.snapshot()), thread_([this, nice] {
+        // Linux: the nice value of a thread (its tid as the process id).
+        if (nice != 0 && setpriority(PRIO_PROCESS, gettid(), nice) != 0)
+          STUDIO_LOG(warn, "preview") << "colour balance worker: cannot set nice " << nice;
+        run();
+      }) {}
 
 BalanceWorker::~BalanceWorker() {
   {

@@ -28,7 +28,8 @@ class BalanceWorker {
     std::vector<RunMask> masks;
   };
 
-  BalanceWorker();
+  // nice > 0: the worker thread yields the CPU to the rest (background work: the rig samples).
+  explicit BalanceWorker(int nice = 0);
   ~BalanceWorker();  // finishes the job in hand, then joins
   BalanceWorker(const BalanceWorker&) = delete;
   BalanceWorker& operator=(const BalanceWorker&) = delete;

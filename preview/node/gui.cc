@@ -157,7 +157,8 @@ bool write_screenshot(const std::string& path, int w, int h, const PanelState& p
     first = false;
   }
   json << "},\"view\":{\"meshes\":" << counts.meshes << ",\"textured\":" << counts.textured
-       << ",\"match\":" << json_text(panels.match_result) << "}}\n";
+       << ",\"match\":" << json_text(panels.match_result)
+       << ",\"match_source\":" << json_text(panels.match_source) << "}}\n";
   return ok && json.good();
 }
 

@@ -187,6 +187,24 @@ void view_panel(PanelState& s, PreviewNode& node, ViewPipeline& pipeline, Viewpo
       ImGui::SameLine();
       ImGui::TextWrapped("%s", s.match_result.c_str());
     }
+    // What the button sends: the whole rig's estimate once its samples are in, else the view's.
+    const offline::ColourBalance& rig = pipeline.rig_colour_balance().balance;
+    char source[160];
+    if (!pipeline.rig_sampling()) {
+      std::snprintf(source, sizeof source, "sends this view's cameras (the rig is not sampled)");
+    } else if (rig.frames >= kMatchRigFrames) {
+      int linked = 0;
+      for (int set : rig.linked_set) linked += set >= 0;
+      std::snprintf(source, sizeof source,
+                    "sends the whole rig's estimate: %d cameras linked (%d samples)", linked,
+                    rig.frames);
+    } else {
+      std::snprintf(source, sizeof source,
+                    "sends this view's cameras until the whole rig is sampled (%d / %d)",
+                    rig.frames, kMatchRigFrames);
+    }
+    s.match_source = source;
+    ImGui::TextUnformatted(source);
   }
   OverlayOptions& o = pipeline.overlays();
   ImGui::Checkbox("head marker", &o.head);

@@ -48,6 +48,7 @@ struct PanelState {
   double move_start_s = 0;
   std::string last_error;
   std::string match_result;  // View: the last "Match cameras" (what was sent, or why not)
+  std::string match_source;  // View: what the button sends now (the whole rig's or the view's)
   bool press_match = false;  // the test hook's press of "Match cameras"
   // Filled while drawing, for the test hook's layout file.
   std::map<std::string, ItemRect> windows, items;

@@ -80,7 +80,9 @@ struct ViewPipeline::Impl {
   std::vector<Mask> carving_masks;
   std::size_t carving_count = 0;
   BalanceWorker balance;
-  BalanceWorker rig_balance;  // the rig samples' estimate, on a thread of its own
+  // The rig samples' estimate, on a thread of its own at a lower priority: background work, which
+  // must not slow the live balance, the rendering or the capture servers on the same machine.
+  BalanceWorker rig_balance{10};
   int64_t pool_from_ns = 0;  // restart_colour_balance(): meshes captured before are not pooled
   uint64_t textured_seen =
       0;  // meshes pool_balance() saw (the first and every balance_every-th pool)
@@ -425,6 +427,9 @@ void ViewPipeline::set_blend(bool blend) {
 bool ViewPipeline::blend() const { return impl_->options.blend; }
 BalanceSnapshot ViewPipeline::colour_balance() const { return impl_->balance.snapshot(); }
 BalanceSnapshot ViewPipeline::rig_colour_balance() const { return impl_->rig_balance.snapshot(); }
+bool ViewPipeline::rig_sampling() const {
+  return impl_->options.colour_balance && impl_->options.balance_rig_every.count() > 0;
+}
 void ViewPipeline::restart_colour_balance(int64_t pool_from_capture_ns) {
   impl_->pool_from_ns = pool_from_capture_ns;
   impl_->balance.restart();

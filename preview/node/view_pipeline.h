@@ -111,8 +111,10 @@ class ViewPipeline {
   // The cameras' colour balance so far (its latest estimate), and switching it;
   // finish_colour_balance() waits until the mesh the worker holds is pooled.
   BalanceSnapshot colour_balance() const;
-  // The rig samples' estimate (every camera; PipelineOptions::balance_rig_every).
+  // The rig samples' estimate (every camera; PipelineOptions::balance_rig_every), and whether
+  // the rig is sampled (the colour balance on, a period set).
   BalanceSnapshot rig_colour_balance() const;
+  bool rig_sampling() const;
   void finish_colour_balance();
   // The colour balance on the service's status (studioctl, the Services panels): gauges
   // colour_balance_applied (0 / 1), colour_balance_frames (pooled) and colour_balance_off_pct
