@@ -205,6 +205,47 @@ TEST(SimFrameSource, FeaturesClampReadBackAndChangeThePicture) {
   EXPECT_LT(gradient(blurred), gradient(sharp) * 0.7);
 }
 
+TEST(SimFrameSource, WithGammaTheControlsActBeforeTheTransferCurve) {
+  // A camera publishing Gamma 0.5: Gain +6.02 dB (x2) and red x1.44 scale its delivered values by
+  // 2^0.5 and (2 x 1.44)^0.5; the same controls on a camera without Gamma by 2 and 2.88.
+  SimSourceOptions o = small_options(false);
+  o.gamma = 0.5;
+  auto plain = SimFrameSource::create(small_options(false)).value();
+  auto curved = SimFrameSource::create(o).value();
+  EXPECT_NEAR(curved->set_feature("Gain", 20 * std::log10(2.0)).value(), 6.0206, 1e-3);
+  EXPECT_EQ(curved->set_feature("BalanceRatioRed", 1.44).value(), 1.44);
+  EXPECT_FALSE(curved->set_feature("Gamma", 1.0)) << "read-only";
+  bool listed = false;
+  for (const auto& f : curved->features())
+    if (f.name == "Gamma") listed = f.value == 0.5 && !f.writable;
+  EXPECT_TRUE(listed);
+  for (const auto& f : plain->features()) EXPECT_NE(f.name, "Gamma");
+  ASSERT_TRUE(plain->start());
+  ASSERT_TRUE(curved->start());
+  std::map<uint64_t, Image<Rgb8>> seen;
+  for (int i = 0; i < 4; ++i) {
+    auto f = plain->next(1s).value();
+    seen.emplace(f->frame, f->image);
+  }
+  std::optional<Frame> match;
+  for (int i = 0; i < 8 && !match; ++i) {
+    auto f = curved->next(1s).value();
+    if (seen.count(f->frame)) match = std::move(*f);
+  }
+  ASSERT_TRUE(match) << "no common frame";
+  const Image<Rgb8>& a = seen.at(match->frame);
+  double ga = 0, gb = 0, ra = 0, rb = 0;
+  for (std::size_t i = 0; i < a.pixels().size(); ++i) {
+    const Rgb8 p = a.pixels()[i], q = match->image.pixels()[i];
+    if (p.g < 170) ga += p.g, gb += q.g;  // unsaturated after x1.41
+    if (p.r < 140) ra += p.r, rb += q.r;  // after x1.70
+  }
+  EXPECT_NEAR(gb / ga, std::sqrt(2.0), 0.01);
+  EXPECT_NEAR(rb / ra, std::sqrt(2.0 * 1.44), 0.015);
+  o.gamma = 0.05;
+  EXPECT_FALSE(SimFrameSource::create(o)) << "gamma out of range";
+}
+
 TEST(SimFrameSource, BalanceRatiosScaleRedAndBlueAgainstGreen) {
   // The same frame from a camera with ratios 1 and one white-balanced red x1.25, blue x0.8.
   auto plain = SimFrameSource::create(small_options(false)).value();

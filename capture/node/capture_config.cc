@@ -41,7 +41,7 @@ const char kConfigHelp[] =
     "      source: {type: sim, ring: 6, index: 0, width: 704, height: 576, paced: true,\n"
     "               frame_code: false, stamp: false, offset_us: 0, jitter_us: 0, drop_every: 0,\n"
     "               readout_us: -1, motion: sequence, swing_peak_speed: 1.5,\n"
-    "               costume: plain, response: [1, 1, 1], buffers: 16}\n"
+    "               costume: plain, response: [1, 1, 1], gamma: 0, buffers: 16}\n"
     "                                    readout_us: exposure instant -> frame on the host (the\n"
     "                                    rest of the exposure, read-out, transfer); -1 (default):\n"
     "                                    a GigE camera's, half the exposure + 8 bits a pixel at\n"
@@ -66,6 +66,10 @@ const char kConfigHelp[] =
     "                                    [0.25, 4] (exposure and white balance: a real rig's\n"
     "                                    cameras differ by a few percent; what studio-hull\n"
     "                                    offline's --colour-balance corrects)\n"
+    "                                    gamma: 0 (default) or 0.1..4: the camera publishes\n"
+    "                                    GenICam Gamma (read-only) and its Gain, exposure and\n"
+    "                                    white balance act before it (a factor f scales the\n"
+    "                                    delivered values by f^gamma), as a real camera's do\n"
     "      source: {type: files, path: DIR, fps: 25, loop: false, paced: true}\n"
     "      source: {type: aravis, device: ID, pixel_format: BayerRG8, width: W, height: H,\n"
     "               fps: 25, trigger: free_run|software|line, line: Line0, buffers: 16,\n"
@@ -113,6 +117,7 @@ struct SimKeys {
   sim::Motion motion = sim::Motion::sequence;  // the simulated actor's motion (sim/actor.h)
   double swing_peak_speed = 1.5;               // arm_swing: fingertip peak speed, m/s
   std::array<double, 3> response{1, 1, 1};     // sim::StudioOptions::camera_response
+  double gamma = 0;                            // SimSourceOptions::gamma
   Expected<void> validate() const {
     if (index >= ring) return fail("index: must be below ring");
     if (readout_us < 0 && readout_us != -1) return fail("readout_us: -1 (auto) or >= 0");
@@ -171,6 +176,7 @@ const yaml::Schema<SimKeys> kSim{
                   return m;
                 }),
     yaml::field("swing_peak_speed", &SimKeys::swing_peak_speed).range(0.05, 10),
+    yaml::field("gamma", &SimKeys::gamma).range(0, 4),
     yaml::field("response", &SimKeys::response,
                 [](const yaml::Node& n) -> Expected<std::array<double, 3>> {
                   auto v = n.as_doubles(3);
@@ -290,6 +296,7 @@ Expected<CameraSetup> open_camera(const CameraKeys& c, const FrameClock& clock,
       so.studio.camera_response = {c.sim.response};  // the source's one camera
     so.studio.actor.motion = c.sim.motion;
     so.studio.actor.swing_peak_speed = c.sim.swing_peak_speed;
+    so.gamma = c.sim.gamma;
     so.stamp = c.sim.stamp;
     so.offset_ns = int64_t(c.sim.offset_us * 1000);
     so.jitter_ns = int64_t(c.sim.jitter_us * 1000);

@@ -95,6 +95,8 @@ Expected<void> SimSourceOptions::validate() const {
     return fail("sim source " + camera.id + ": jitter must be in 0..10 frame periods");
   if (readout_ns < 0 || readout_ns > clock.period_ns)
     return fail("sim source " + camera.id + ": readout must be in 0..1 frame period");
+  if (gamma != 0 && !(gamma >= 0.1 && gamma <= 4))
+    return fail("sim source " + camera.id + ": gamma must be 0 (none) or in 0.1..4");
   if (max_blur_px < 0 || max_blur_px > 64)
     return fail("sim source " + camera.id + ": max_blur_px must be in 0..64");
   return {};
@@ -239,12 +241,15 @@ void SimFrameSource::apply_features(Image<Rgb8>& image) {
     ratio[2] = ratio_blue_;
   }
   const double k = std::pow(10.0, gain / 20.0) * exposure / options_.nominal_exposure_us;
-  if (std::abs(k * ratio[0] - 1.0) > 1e-6 || std::abs(k - 1.0) > 1e-6 ||
-      std::abs(k * ratio[2] - 1.0) > 1e-6) {
+  double factor[3];  // on the delivered values, per channel
+  for (int c = 0; c < 3; ++c)
+    factor[c] = options_.gamma > 0 ? std::pow(k * ratio[c], options_.gamma) : k * ratio[c];
+  if (std::abs(factor[0] - 1.0) > 1e-6 || std::abs(factor[1] - 1.0) > 1e-6 ||
+      std::abs(factor[2] - 1.0) > 1e-6) {
     uint8_t lut[3][256];  // per channel: red, green, blue
     for (int c = 0; c < 3; ++c)
       for (int i = 0; i < 256; ++i)
-        lut[c][i] = uint8_t(std::clamp(std::lround(i * k * ratio[c]), 0l, 255l));
+        lut[c][i] = uint8_t(std::clamp(std::lround(i * factor[c]), 0l, 255l));
     for (Rgb8& p : image.pixels()) {
       p.r = lut[0][p.r];
       p.g = lut[1][p.g];
@@ -260,11 +265,15 @@ void SimFrameSource::apply_features(Image<Rgb8>& image) {
 
 std::vector<Feature> SimFrameSource::features() const {
   std::lock_guard lock(mutex_);
-  return {{"Gain", gain_db_, 0, kGainMax, true},
-          {"ExposureTime", exposure_us_, kExposureMin, exposure_max(options_.clock), true},
-          {"Focus", focus_, 0, 1, true},
-          {"BalanceRatioRed", ratio_red_, kRatioMin, kRatioMax, true},
-          {"BalanceRatioBlue", ratio_blue_, kRatioMin, kRatioMax, true}};
+  std::vector<Feature> out{
+      {"Gain", gain_db_, 0, kGainMax, true},
+      {"ExposureTime", exposure_us_, kExposureMin, exposure_max(options_.clock), true},
+      {"Focus", focus_, 0, 1, true},
+      {"BalanceRatioRed", ratio_red_, kRatioMin, kRatioMax, true},
+      {"BalanceRatioBlue", ratio_blue_, kRatioMin, kRatioMax, true}};
+  if (options_.gamma > 0)
+    out.push_back({"Gamma", options_.gamma, options_.gamma, options_.gamma, false});
+  return out;
 }
 
 Expected<double> SimFrameSource::set_feature(std::string_view name, double value) {

@@ -33,8 +33,8 @@ inline constexpr int kMatchAutoFrames = 24;
 // once it has pooled this many samples since the last match, else the view's live estimate (its
 // texturing cameras' linked set); --match-cameras waits for them when the rig is sampled.
 // Measured on the seed-3 rig with cam1 two thirds of a stop up (preview_studio_test
-// MatchCamerasMovesTheBalanceIntoTheCameras), the whole rig's worst camera pair against the truth
-// after the match: 2.5-6.3 % (6 runs; the view's set alone 8.3-10.3 %: the cameras it did not
+// PreviewMatchTest.MovesTheBalanceIntoTheCameras), the whole rig's worst camera pair against the
+// truth after the match: 2.5-6.3 % (6 runs; the view's set alone 8.3-10.3 %: the cameras it did not
 // link keep their spread; fewer samples, 4 or 8, left up to 11 %).
 inline constexpr int kMatchRigFrames = 16;
 // --match-cameras acts only when some camera's estimate is this far off 1 (any channel): on

@@ -83,8 +83,10 @@ class PreviewStudioTest : public ::testing::Test {
   // `count` cameras: count - 1 on the ring and one overhead; `response`: per camera its colour
   // response (the capture config's sim `response`, sim::StudioOptions::camera_response), or
   // empty for identical cameras.
+  // `source_extra`: more keys for every camera's sim source (e.g. ", gamma: 0.45").
   void start_studio(bool scene, bool frame_code = true, int count = 5,
-                    const std::vector<std::array<double, 3>>& response = {}) {
+                    const std::vector<std::array<double, 3>>& response = {},
+                    const std::string& source_extra = "") {
     const auto rig = dir_ / "rig.yaml";
     ASSERT_TRUE(support::write_rig_yaml(cameras(count), rig));
     std::ofstream cap(dir_ / "capture.yaml");
@@ -98,7 +100,7 @@ class PreviewStudioTest : public ::testing::Test {
                                : ", response: [" + std::to_string(response[i][0]) + ", " +
                                      std::to_string(response[i][1]) + ", " +
                                      std::to_string(response[i][2]) + "]")
-          << "}\n";
+          << source_extra << "}\n";
     cap.close();
     std::ofstream(dir_ / "hull.yaml")
         << "instance: hull\nhull:\n  rig: rig.yaml\n  box: [-1.5, 0.0, -1.5, 1.5, 2.4, 1.5]\n"

@@ -20,6 +20,10 @@
 //   Focus         0..1                 box blur of radius round(|Focus - in_focus| * max_blur_px)
 //   BalanceRatioRed, BalanceRatioBlue  0.25..4   red / blue *= the ratio (white balance against
 //                                      green; SFNC's BalanceRatio under BalanceRatioSelector)
+//   Gamma         read-only, when options.gamma > 0: the camera's transfer curve (delivered =
+//                 sensor^Gamma). Its Gain, ExposureTime and white balance then act before it, on
+//                 the sensor's linear signal, as a real camera's do: a control's factor f scales
+//                 the delivered values by f^Gamma. Without it (0) they scale the delivered values.
 // Tracked (follow_pose): before rendering frame f the source asks for its camera; a changed
 // camera rebuilds the simulated camera's cached rays and background (SimulatedStudio::set_camera).
 // Imperfections on request: `offset_ns` moves the exposure instant (capture_ns) within the
@@ -65,6 +69,7 @@ struct SimSourceOptions {
   double nominal_exposure_us = 10000;  // exposure at which the image has its natural brightness
   double focus = 0.5;
   double in_focus = 0.5;  // the Focus value that gives a sharp image
+  double gamma = 0;       // > 0 (0.1..4): the GenICam Gamma published (read-only), above
   int max_blur_px = 8;
   // Test knobs of a real camera's imperfections (issue 17 item 6):
   bool stamp = false;         // the frame number as a corner code in the pixels (sim/frame_stamp.h)
