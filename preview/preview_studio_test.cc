@@ -447,6 +447,7 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
   auto status_topic = wire::Topic<studio_ServiceStatus>::create(participant).value();
   auto status = wire::Reader<studio_ServiceStatus>::create(participant, status_topic).value();
   std::map<std::string, double> applied_on_status;  // instance -> largest colour_balance_applied
+  std::map<std::string, double> rig_linked_on_status;  // ... colour_balance_rig_linked
   auto read_status = [&] {
     for (auto& st : status.take())
       if (st.meta.valid_data && std::string(st.data->service) == "preview")
@@ -454,6 +455,9 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
           if (std::string(c.name) == "colour_balance_applied") {
             double& a = applied_on_status[st.data->instance];
             a = std::max(a, c.value);
+          } else if (std::string(c.name) == "colour_balance_rig_linked") {
+            double& l = rig_linked_on_status[st.data->instance];
+            l = std::max(l, c.value);
           }
   };
   std::map<std::string, Process*> previews;
@@ -472,6 +476,12 @@ TEST_F(PreviewStudioTest, TheColourBalanceEqualisesCamerasThatDiffer) {
   read_status();
   EXPECT_EQ(applied_on_status["balanced"], 1.0);
   EXPECT_EQ(applied_on_status.count("unbalanced") ? applied_on_status["unbalanced"] : -1, 0.0);
+  // The rig samples (every camera's images of a mesh, one per 0.5 s) link the whole rig, beyond
+  // the view's three texturing cameras; none without the balance.
+  std::printf("the whole rig's estimate on the status: %.0f cameras linked\n",
+              rig_linked_on_status["balanced"]);
+  EXPECT_EQ(rig_linked_on_status["balanced"], 9.0);
+  EXPECT_EQ(rig_linked_on_status["unbalanced"], 0.0);
   // The estimate: every pair of cameras it linked, their gain ratio against the truth's.
   const BalanceSummary b = balance_summary(previews["balanced"]->log());
   const BalanceSummary off = balance_summary(previews["unbalanced"]->log());

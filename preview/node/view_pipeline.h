@@ -118,7 +118,9 @@ class ViewPipeline {
   void finish_colour_balance();
   // The colour balance on the service's status (studioctl, the Services panels): gauges
   // colour_balance_applied (0 / 1), colour_balance_frames (pooled) and colour_balance_off_pct
-  // (the estimate's largest |gain - 1| over the cameras, percent).
+  // (the estimate's largest |gain - 1| over the cameras, percent); the whole rig's estimate:
+  // colour_balance_rig_frames (rig samples since the last match) and colour_balance_rig_linked
+  // (cameras it links).
   void report(runtime::Metrics& metrics) const;
   void set_colour_balance(bool on);
   bool colour_balance_on() const;
