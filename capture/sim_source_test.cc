@@ -205,6 +205,19 @@ TEST(SimFrameSource, FeaturesClampReadBackAndChangeThePicture) {
   EXPECT_LT(gradient(blurred), gradient(sharp) * 0.7);
 }
 
+// The same frame from two sources, started here (paced: their frames are the studio clock's): the
+// images of the first frame both delivered; empty images when none matched within 8 frames.
+std::pair<Image<Rgb8>, Image<Rgb8>> same_frame(SimFrameSource& first, SimFrameSource& second) {
+  if (!first.start() || !second.start()) return {};
+  std::map<uint64_t, Image<Rgb8>> seen;
+  for (int i = 0; i < 4; ++i)
+    if (auto f = first.next(1s); f && *f) seen.emplace((*f)->frame, (*f)->image);
+  for (int i = 0; i < 8; ++i)
+    if (auto f = second.next(1s); f && *f && seen.count((*f)->frame))
+      return {seen.at((*f)->frame), (*f)->image};
+  return {};
+}
+
 TEST(SimFrameSource, WithGammaTheControlsActBeforeTheTransferCurve) {
   // A camera publishing Gamma 0.5: Gain +6.02 dB (x2) and red x1.44 scale its delivered values by
   // 2^0.5 and (2 x 1.44)^0.5; the same controls on a camera without Gamma by 2 and 2.88.
@@ -220,23 +233,11 @@ TEST(SimFrameSource, WithGammaTheControlsActBeforeTheTransferCurve) {
     if (f.name == "Gamma") listed = f.value == 0.5 && !f.writable;
   EXPECT_TRUE(listed);
   for (const auto& f : plain->features()) EXPECT_NE(f.name, "Gamma");
-  ASSERT_TRUE(plain->start());
-  ASSERT_TRUE(curved->start());
-  std::map<uint64_t, Image<Rgb8>> seen;
-  for (int i = 0; i < 4; ++i) {
-    auto f = plain->next(1s).value();
-    seen.emplace(f->frame, f->image);
-  }
-  std::optional<Frame> match;
-  for (int i = 0; i < 8 && !match; ++i) {
-    auto f = curved->next(1s).value();
-    if (seen.count(f->frame)) match = std::move(*f);
-  }
-  ASSERT_TRUE(match) << "no common frame";
-  const Image<Rgb8>& a = seen.at(match->frame);
+  const auto [a, b] = same_frame(*plain, *curved);
+  ASSERT_FALSE(a.pixels().empty()) << "no common frame";
   double ga = 0, gb = 0, ra = 0, rb = 0;
   for (std::size_t i = 0; i < a.pixels().size(); ++i) {
-    const Rgb8 p = a.pixels()[i], q = match->image.pixels()[i];
+    const Rgb8 p = a.pixels()[i], q = b.pixels()[i];
     if (p.g < 170) ga += p.g, gb += q.g;  // unsaturated after x1.41
     if (p.r < 140) ra += p.r, rb += q.r;  // after x1.70
   }
@@ -254,21 +255,8 @@ TEST(SimFrameSource, BalanceRatiosScaleRedAndBlueAgainstGreen) {
   EXPECT_EQ(balanced->set_feature("BalanceRatioBlue", 0.8).value(), 0.8);
   EXPECT_EQ(balanced->set_feature("BalanceRatioBlue", 9).value(), 4.0);  // clamped, read back
   EXPECT_EQ(balanced->set_feature("BalanceRatioBlue", 0.8).value(), 0.8);
-  ASSERT_TRUE(plain->start());
-  ASSERT_TRUE(balanced->start());
-  std::map<uint64_t, Image<Rgb8>> seen;
-  for (int i = 0; i < 4; ++i) {
-    auto f = plain->next(1s).value();
-    seen.emplace(f->frame, f->image);
-  }
-  std::optional<Frame> match;
-  for (int i = 0; i < 8 && !match; ++i) {
-    auto f = balanced->next(1s).value();
-    if (seen.count(f->frame)) match = std::move(*f);
-  }
-  ASSERT_TRUE(match) << "no common frame";
-  const Image<Rgb8>& a = seen.at(match->frame);
-  const Image<Rgb8>& b = match->image;
+  const auto [a, b] = same_frame(*plain, *balanced);
+  ASSERT_FALSE(a.pixels().empty()) << "no common frame";
   double ra = 0, rb = 0, ba = 0, bb = 0;
   std::size_t green_differs = 0;
   for (std::size_t i = 0; i < a.pixels().size(); ++i) {
