@@ -60,5 +60,12 @@ TEST(RigBalance, AppliesBeyondTheToleranceAndKeepsItUntilWithinHalf) {
   EXPECT_FALSE(balance_applies({}, 0.03, true));
 }
 
+TEST(RigBalance, CountsTheLinkedCamerasOfEverySet) {
+  offline::ColourBalance b;
+  EXPECT_EQ(linked_cameras(b), 0);
+  b.linked_set = {0, 0, -1, 3, 3, -1};  // two sets, two cameras linked to none
+  EXPECT_EQ(linked_cameras(b), 4);
+}
+
 }  // namespace
 }  // namespace studio::preview

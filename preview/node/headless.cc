@@ -168,7 +168,7 @@ int run_headless(const PreviewConfig& config, const HeadlessOptions& options) {
       // cameras it had not linked yet, and what the last round's estimate got wrong.
       const BalanceSnapshot b = (*pipeline)->colour_balance();
       if (b.balance.applied && b.balance.frames >= kMatchAutoFrames &&
-          (po.balance_rig_every.count() == 0 ||
+          (!(*pipeline)->rig_sampling() ||
            (*pipeline)->rig_colour_balance().balance.frames >= kMatchRigFrames) &&
           largest_gain_offset(b.balance.estimated) > kMatchAutoOffset) {
         auto m = match_cameras(node, **pipeline);

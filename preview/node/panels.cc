@@ -193,11 +193,9 @@ void view_panel(PanelState& s, PreviewNode& node, ViewPipeline& pipeline, Viewpo
     if (!pipeline.rig_sampling()) {
       std::snprintf(source, sizeof source, "sends this view's cameras (the rig is not sampled)");
     } else if (rig.frames >= kMatchRigFrames) {
-      int linked = 0;
-      for (int set : rig.linked_set) linked += set >= 0;
       std::snprintf(source, sizeof source,
-                    "sends the whole rig's estimate: %d cameras linked (%d samples)", linked,
-                    rig.frames);
+                    "sends the whole rig's estimate: %d cameras linked (%d samples)",
+                    linked_cameras(rig), rig.frames);
     } else {
       std::snprintf(source, sizeof source,
                     "sends this view's cameras until the whole rig is sampled (%d / %d)",

@@ -447,10 +447,8 @@ void ViewPipeline::report(runtime::Metrics& metrics) const {
   metrics.gauge("colour_balance_frames").set(b.balance.frames);
   metrics.gauge("colour_balance_off_pct").set(100.0 * largest_gain_offset(b.balance.estimated));
   const BalanceSnapshot rig = impl_->rig_balance.snapshot();
-  int linked = 0;
-  for (int set : rig.balance.linked_set) linked += set >= 0;
   metrics.gauge("colour_balance_rig_frames").set(rig.balance.frames);
-  metrics.gauge("colour_balance_rig_linked").set(linked);
+  metrics.gauge("colour_balance_rig_linked").set(linked_cameras(rig.balance));
 }
 void ViewPipeline::set_colour_balance(bool on) { impl_->options.colour_balance = on; }
 bool ViewPipeline::colour_balance_on() const { return impl_->options.colour_balance; }

@@ -27,6 +27,11 @@ float largest_gain_offset(const std::vector<Eigen::Vector3f>& estimated) {
   return off;
 }
 
+int linked_cameras(const offline::ColourBalance& balance) {
+  return int(std::count_if(balance.linked_set.begin(), balance.linked_set.end(),
+                           [](int set) { return set >= 0; }));
+}
+
 bool balance_applies(const std::vector<Eigen::Vector3f>& estimated, double tolerance,
                      bool applied_before) {
   return largest_gain_offset(estimated) > (applied_before ? 0.5 : 1.0) * tolerance;

@@ -46,6 +46,8 @@ bool balance_applies(const std::vector<Eigen::Vector3f>& estimated, double toler
                      bool applied_before);
 // The largest |gain - 1| over the cameras and channels of `estimated` (0 when empty).
 float largest_gain_offset(const std::vector<Eigen::Vector3f>& estimated);
+// The cameras the estimate links to some other camera (ColourBalance::linked_set >= 0).
+int linked_cameras(const offline::ColourBalance& balance);
 
 // What a RigBalance has estimated, copied out (for a thread other than the pooling one).
 struct BalanceSnapshot {
